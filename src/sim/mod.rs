@@ -1,0 +1,1 @@
+//! Mass-spring simulation of deformable objects and the built-in pawn scene.
