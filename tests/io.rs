@@ -1,0 +1,1 @@
+//! Tests of `dhcd::io` (suite being written).

@@ -1,0 +1,1 @@
+//! Tests of `dhcd::narrow` (suite being written).

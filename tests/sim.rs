@@ -1,0 +1,1 @@
+//! Tests of `dhcd::sim` (suite being written).
