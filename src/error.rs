@@ -14,7 +14,9 @@ pub enum Error {
     TooManyVertices(usize),
     #[error("mesh has {0} triangles; at most {max} are supported", max = u32::MAX - 1)]
     TooManyTriangles(usize),
-    #[error("triangle {triangle} uses vertex {index}, but the mesh has only {vertex_count} vertices")]
+    #[error(
+        "triangle {triangle} uses vertex {index}, but the mesh has only {vertex_count} vertices"
+    )]
     IndexOutOfRange {
         triangle: usize,
         index: u32,
@@ -30,7 +32,7 @@ pub enum Error {
     NonFinite { vertex: usize, position: [f32; 3] },
     #[error("position update has {got} vertices, but the mesh has {expected}")]
     WrongVertexCount { expected: usize, got: usize },
-    #[error("levels must be between 1 and 16, got {got}")]
+    #[error("levels must be between 1 and {max}, got {got}", max = crate::tree::MAX_LEVELS)]
     InvalidLevels { got: usize },
     #[error("invalid option: {0}")]
     InvalidOption(String),

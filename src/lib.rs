@@ -5,13 +5,42 @@
 //! stackless level-synchronous traversal, and an exact triangle-triangle narrow phase.
 //! Every query counts its work (`N_V`, `N_P`, `N_U`) for the cost model
 //! `T = N_V*C_V + N_P*C_P + N_U*C_U`.
+//!
+//! ```
+//! use dhcd::{bv::Dh, collide, Hierarchy, Mesh, Options};
+//! let tri = |dx: f32| Mesh::new(
+//!     vec![[dx, 0.0, 0.0], [dx + 1.0, 0.0, 0.0], [dx, 1.0, 0.0]],
+//!     vec![[0, 1, 2]],
+//! ).unwrap();
+//! let mut a = Hierarchy::<Dh>::new(&tri(0.0), Options::default())?;
+//! let mut b = Hierarchy::<Dh>::new(&tri(0.5), Options::default())?;
+//! assert_eq!(collide(&mut a, &mut b).pairs, vec![[0, 0]]);
+//! // Deform: move B away; the lazy refit follows.
+//! b.update_positions(&[[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, 1.0, 0.0]])?;
+//! assert!(collide(&mut a, &mut b).pairs.is_empty());
+//! # Ok::<(), dhcd::Error>(())
+//! ```
 #![forbid(unsafe_code)]
 
+pub mod any;
+pub mod bv;
+pub mod counters;
 pub mod error;
+pub mod hierarchy;
 pub mod io;
 pub mod mesh;
 pub mod narrow;
+pub mod points;
+pub mod shapes;
 pub mod sim;
+pub mod traverse;
+pub mod tree;
 
+pub use any::AnyHierarchy;
+pub use bv::Method;
+pub use counters::Counters;
 pub use error::{Error, Result};
+pub use hierarchy::{Hierarchy, InvariantError, Options, Refit};
 pub use mesh::Mesh;
+pub use traverse::{collide, collide_with, Contacts, Workspace};
+pub use tree::RegionTree;

@@ -1,4 +1,7 @@
+//! The `dhcd` command line: `collide`, `experiment`, `self`, `scene`.
+
+mod cli;
+
 fn main() {
-    eprintln!("dhcd: CLI not wired yet");
-    std::process::exit(2);
+    std::process::exit(cli::run());
 }

@@ -45,7 +45,10 @@ fn spheres_overlap(a: [f32; 3], ra: f32, b: [f32; 3], rb: f32) -> bool {
 
 fn check_lengths(ia: &[u32], ib: &[u32], out: &[u32]) {
     assert_eq!(ia.len(), ib.len(), "overlap: ia and ib differ in length");
-    assert!(out.len() >= ia.len(), "overlap: out is shorter than the pair list");
+    assert!(
+        out.len() >= ia.len(),
+        "overlap: out is shorter than the pair list"
+    );
 }
 
 /// Scalar reference of [`sphere_pairs`].

@@ -1,0 +1,142 @@
+//! The three bounding-volume kinds over one region tree: Distance Hierarchy (`Dh`), spheres
+//! (`Sphere`, the paper's SBV) and axis-aligned boxes (`Aabb`).
+//!
+//! The kind is a compile-time policy ([`BvKind`]); node data lives in structure-of-arrays
+//! buffers (one array per record field, padded to [`PAD`] entries) so that one SIMD load
+//! covers a block of nodes. [`Method`] names a kind where it is chosen at run time.
+
+mod aabb;
+mod dh;
+mod sphere;
+
+pub use aabb::{Aabb, AabbNode, AabbNodes};
+pub use dh::{Dh, DhNode, DhNodes};
+pub use sphere::{Sphere, SphereNode, SphereNodes};
+
+use crate::points::Points;
+use crate::tree::RegionTree;
+
+/// Node buffers are padded to a multiple of this many entries (the widest SIMD block:
+/// 16 f32 lanes of AVX-512). Padding entries never overlap anything.
+pub const PAD: usize = 16;
+
+/// Relative inflation of every computed radius. Radii and overlap tests are evaluated in
+/// f32; each is off by a few ulps. Growing radii by 16 ulps keeps every sphere test
+/// conservative: two regions that share a point always test as overlapping.
+const RADIUS_INFLATION: f32 = 1.0 + 16.0 * f32::EPSILON;
+
+/// A radius that encloses a point at squared distance `d2` despite rounding in `d2`.
+#[inline]
+pub(crate) fn conservative_radius(d2: f32) -> f32 {
+    d2.sqrt() * RADIUS_INFLATION + f32::MIN_POSITIVE
+}
+
+/// Rounds a sum of distances up the same way (bottom-up bounds).
+#[inline]
+pub(crate) fn conservative_sum(a: f32, b: f32) -> f32 {
+    (a + b) * RADIUS_INFLATION + f32::MIN_POSITIVE
+}
+
+pub(crate) fn padded(n: usize) -> usize {
+    n.div_ceil(PAD).max(1) * PAD
+}
+
+/// The hierarchy kinds, for choosing one at run time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Method {
+    Dh,
+    Sphere,
+    Aabb,
+}
+
+impl Method {
+    pub const ALL: [Method; 3] = [Method::Dh, Method::Sphere, Method::Aabb];
+
+    /// The name used on the command line and in reports: `dh`, `sphere`, `aabb`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Dh => "dh",
+            Method::Sphere => "sphere",
+            Method::Aabb => "aabb",
+        }
+    }
+
+    /// Size of one node record: 8, 16 or 24 bytes.
+    pub fn bytes_per_node(self) -> usize {
+        match self {
+            Method::Dh => std::mem::size_of::<DhNode>(),
+            Method::Sphere => std::mem::size_of::<SphereNode>(),
+            Method::Aabb => std::mem::size_of::<AabbNode>(),
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = crate::Error;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "dh" => Ok(Method::Dh),
+            "sphere" | "sbv" => Ok(Method::Sphere),
+            "aabb" => Ok(Method::Aabb),
+            _ => Err(crate::Error::InvalidOption(format!(
+                "unknown method {s:?} (expected dh, sphere or aabb)"
+            ))),
+        }
+    }
+}
+
+mod sealed {
+    pub trait Sealed {}
+}
+
+/// A bounding-volume kind: its node record, its SoA buffers, how to fit a node to the
+/// current pose, and the batch overlap test. Sealed: the three kinds are the set the
+/// library compares.
+pub trait BvKind:
+    sealed::Sealed + Copy + Default + Send + Sync + std::fmt::Debug + 'static
+{
+    const METHOD: Method;
+    /// One node as a plain record (`#[repr(C)]`, Pod; size pinned at compile time).
+    type Record: bytemuck::Pod + std::fmt::Debug + PartialEq + Send + Sync;
+    /// All nodes of one hierarchy, structure-of-arrays.
+    type Nodes: Clone + std::fmt::Debug + Send + Sync;
+
+    /// Allocates the buffers and fits every node to the rest pose `rest`.
+    fn build(tree: &RegionTree, rest: &Points) -> Self::Nodes;
+    /// The tight BV of node `n` for the current positions `p` (reads the node's vertices).
+    fn fit(nodes: &Self::Nodes, tree: &RegionTree, p: &Points, n: usize) -> Self::Record;
+    /// A BV of internal node `n` that encloses its children's current BVs (bottom-up refit).
+    fn merge(nodes: &Self::Nodes, tree: &RegionTree, p: &Points, n: usize) -> Self::Record;
+    fn get(nodes: &Self::Nodes, n: usize) -> Self::Record;
+    fn set(nodes: &mut Self::Nodes, n: usize, r: Self::Record);
+    /// Batch overlap test of node pairs `(ia[k], ib[k])`; writes `out[k]` (1 = overlap) and
+    /// returns the number of overlapping pairs.
+    #[allow(clippy::too_many_arguments)]
+    fn overlap(
+        a: &Self::Nodes,
+        pa: &Points,
+        b: &Self::Nodes,
+        pb: &Points,
+        ia: &[u32],
+        ib: &[u32],
+        out: &mut [u32],
+    ) -> usize;
+    /// Whether record `r` encloses point `v` of `p` (checked in f64; for validation).
+    fn encloses(r: &Self::Record, p: &Points, v: usize) -> bool;
+}
+
+#[inline]
+pub(crate) fn dist2_f64(a: [f32; 3], b: [f32; 3]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let d = a[k] as f64 - b[k] as f64;
+            d * d
+        })
+        .sum()
+}

@@ -1,0 +1,43 @@
+//! Command-line front end. Every failure is one line on stderr and a non-zero exit code.
+
+mod collide;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "dhcd",
+    version,
+    about = "Collision detection between deformable triangle meshes (Distance Hierarchy, sphere and AABB hierarchies)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Contacts (intersecting triangle pairs) between two meshes.
+    Collide(collide::CollideArgs),
+}
+
+/// Parses the arguments, runs the command, returns the process exit code.
+pub fn run() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() { 2 } else { 0 };
+        }
+    };
+    let result = match cli.command {
+        Command::Collide(args) => collide::run(args),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("dhcd: error: {e}");
+            1
+        }
+    }
+}

@@ -1,0 +1,255 @@
+//! A bounding-volume hierarchy of one deformable mesh: the shared region tree, the live
+//! vertex positions (internal order), the node buffers of one kind, and the lazy-refit state.
+
+use std::sync::Arc;
+
+use crate::bv::{BvKind, Method};
+use crate::error::{Error, Result};
+use crate::mesh::{check_positions, Mesh};
+use crate::points::Points;
+use crate::tree::{RegionTree, DEFAULT_LEVELS};
+
+/// When bounding volumes follow a deformation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Refit {
+    /// The paper's lazy evaluation: a node is refitted just before its first overlap test
+    /// after a position update, and only if it is tested at all.
+    #[default]
+    Lazy,
+    /// Every node is refitted exactly (from its vertices) in `update_positions`.
+    Eager,
+    /// Every node in `update_positions`, bottom-up: leaves exactly, each internal node as a
+    /// bound of its children (for DH, `r_p = max_c(|C_p - C_c| + r_c)`): cheaper, looser.
+    EagerBottomUp,
+}
+
+impl std::str::FromStr for Refit {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "lazy" => Ok(Refit::Lazy),
+            "eager" => Ok(Refit::Eager),
+            "bottom-up" | "eager-bottom-up" => Ok(Refit::EagerBottomUp),
+            _ => Err(Error::InvalidOption(format!(
+                "unknown refit mode {s:?} (expected lazy, eager or bottom-up)"
+            ))),
+        }
+    }
+}
+
+/// Build options of a hierarchy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// Levels of the region tree (root = level 0); the paper uses 5.
+    pub levels: usize,
+    pub refit: Refit,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            levels: DEFAULT_LEVELS,
+            refit: Refit::Lazy,
+        }
+    }
+}
+
+/// A node whose bounding volume fails to enclose its region (a bug in dhcd, never bad input).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{method} node {node} does not enclose vertex {vertex} (original index) of its region: {record}")]
+pub struct InvariantError {
+    pub method: Method,
+    pub node: usize,
+    pub vertex: u32,
+    pub record: String,
+}
+
+/// The hierarchy of one deformable mesh, for bounding-volume kind `K`
+/// ([`Dh`](crate::bv::Dh), [`Sphere`](crate::bv::Sphere) or [`Aabb`](crate::bv::Aabb)).
+#[derive(Clone, Debug)]
+pub struct Hierarchy<K: BvKind> {
+    tree: Arc<RegionTree>,
+    points: Points,
+    nodes: K::Nodes,
+    /// `stamp[n] == epoch` iff node `n` is fitted to the current positions.
+    stamp: Vec<u32>,
+    epoch: u32,
+    refit: Refit,
+    /// BV updates done since the last query took them (see [`Hierarchy::take_updates`]).
+    updates: u64,
+}
+
+impl<K: BvKind> Hierarchy<K> {
+    /// Builds the region tree over `mesh` (its positions are the rest pose) and fits `K`'s
+    /// volumes to it.
+    pub fn new(mesh: &Mesh, options: Options) -> Result<Self> {
+        let tree = Arc::new(RegionTree::build(mesh, options.levels)?);
+        Self::with_tree(tree, mesh, options.refit)
+    }
+
+    /// Fits `K`'s volumes over an existing region tree of `mesh`, so several kinds can
+    /// share one tree (identical regions).
+    pub fn with_tree(tree: Arc<RegionTree>, mesh: &Mesh, refit: Refit) -> Result<Self> {
+        if tree.vertex_total() != mesh.vertex_count()
+            || tree.triangle_total() != mesh.triangle_count()
+        {
+            return Err(Error::InvalidOption(format!(
+                "region tree of {} vertices / {} triangles does not fit a mesh of {} / {}",
+                tree.vertex_total(),
+                tree.triangle_total(),
+                mesh.vertex_count(),
+                mesh.triangle_count()
+            )));
+        }
+        let points = Points::gather(mesh.positions(), tree.vert_order());
+        let nodes = K::build(&tree, &points);
+        let stamp = vec![0; tree.node_count()];
+        Ok(Self {
+            tree,
+            points,
+            nodes,
+            stamp,
+            epoch: 0,
+            refit,
+            updates: 0,
+        })
+    }
+
+    /// Hands the hierarchy the mesh's new vertex positions (caller's vertex order, same
+    /// count, finite). Every bounding volume becomes stale; with [`Refit::Lazy`] each is
+    /// refitted when first tested, otherwise all are refitted now. On error nothing changes.
+    pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {
+        check_positions(positions, self.tree.vertex_total())?;
+        self.points.gather_from(positions, self.tree.vert_order());
+        if self.epoch == u32::MAX {
+            self.stamp.fill(0);
+            self.epoch = 1;
+        } else {
+            self.epoch += 1;
+        }
+        match self.refit {
+            Refit::Lazy => {}
+            Refit::Eager => self.refit_all(),
+            Refit::EagerBottomUp => self.refit_bottom_up(),
+        }
+        Ok(())
+    }
+
+    /// Refits every stale node exactly.
+    pub fn refit_all(&mut self) {
+        let all: Vec<u32> = (0..self.node_count() as u32).collect();
+        self.ensure_fitted(&all);
+    }
+
+    /// Refits every node bottom-up: stale leaves exactly, internal nodes from their children.
+    pub fn refit_bottom_up(&mut self) {
+        let tree = Arc::clone(&self.tree);
+        for d in (0..tree.depth_count()).rev() {
+            for n in tree.level_nodes(d) {
+                if self.stamp[n] == self.epoch {
+                    continue;
+                }
+                let r = if tree.is_leaf(n) {
+                    K::fit(&self.nodes, &tree, &self.points, n)
+                } else {
+                    K::merge(&self.nodes, &tree, &self.points, n)
+                };
+                K::set(&mut self.nodes, n, r);
+                self.stamp[n] = self.epoch;
+                self.updates += 1;
+            }
+        }
+    }
+
+    /// Lazy refit: fits every node of `ids` that is stale (each once), counting the updates.
+    pub(crate) fn ensure_fitted(&mut self, ids: &[u32]) {
+        for &n in ids {
+            let n = n as usize;
+            if self.stamp[n] != self.epoch {
+                let r = K::fit(&self.nodes, &self.tree, &self.points, n);
+                K::set(&mut self.nodes, n, r);
+                self.stamp[n] = self.epoch;
+                self.updates += 1;
+            }
+        }
+    }
+
+    /// The BV updates done since the last call (queries add them to their `bv_updates`).
+    pub fn take_updates(&mut self) -> u64 {
+        std::mem::take(&mut self.updates)
+    }
+
+    /// Checks that every fitted node's volume encloses every vertex of its region in the
+    /// current pose (so it encloses the region's triangles), and that DH central vertices lie
+    /// in their regions. Stale nodes (lazy refit, not yet tested) are skipped: they are
+    /// never tested before being refitted. Returns the number of nodes checked.
+    pub fn validate(&self) -> std::result::Result<usize, InvariantError> {
+        let mut checked = 0;
+        for n in 0..self.node_count() {
+            if self.stamp[n] != self.epoch {
+                continue;
+            }
+            let rec = K::get(&self.nodes, n);
+            if let Some(v) = self
+                .tree
+                .region_vertices(n)
+                .find(|&v| !K::encloses(&rec, &self.points, v as usize))
+            {
+                return Err(InvariantError {
+                    method: K::METHOD,
+                    node: n,
+                    vertex: self.tree.vert_order()[v as usize],
+                    record: format!("{rec:?}"),
+                });
+            }
+            checked += 1;
+        }
+        Ok(checked)
+    }
+
+    /// Whether node `n` is fitted to the current positions.
+    pub fn is_fitted(&self, n: usize) -> bool {
+        self.stamp[n] == self.epoch
+    }
+
+    /// Node `n`'s record (possibly stale: see [`Hierarchy::is_fitted`]).
+    pub fn record(&self, n: usize) -> K::Record {
+        K::get(&self.nodes, n)
+    }
+
+    pub fn tree(&self) -> &Arc<RegionTree> {
+        &self.tree
+    }
+
+    pub fn nodes(&self) -> &K::Nodes {
+        &self.nodes
+    }
+
+    /// Current positions in internal vertex order (see [`RegionTree::vert_order`]).
+    pub fn points(&self) -> &Points {
+        &self.points
+    }
+
+    pub fn refit_mode(&self) -> Refit {
+        self.refit
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.tree.node_count()
+    }
+
+    pub fn method(&self) -> Method {
+        K::METHOD
+    }
+
+    /// Bytes of one node record: 8 (DH), 16 (sphere), 24 (AABB).
+    pub fn bytes_per_node(&self) -> usize {
+        std::mem::size_of::<K::Record>()
+    }
+
+    /// Bytes of all node records of this hierarchy (`node_count * bytes_per_node`; the
+    /// shared topology is [`RegionTree::topology_bytes`], the SIMD padding is not counted).
+    pub fn bv_bytes(&self) -> usize {
+        self.node_count() * self.bytes_per_node()
+    }
+}

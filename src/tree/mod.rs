@@ -1,0 +1,164 @@
+//! The region tree: one octree topology over the rest pose, shared by all three
+//! bounding-volume kinds so that they bound identical regions.
+//!
+//! Layout (all indices are `u32`):
+//! - nodes are numbered breadth-first, root `0`; the children of a node are contiguous;
+//! - triangles are reordered so that every node's triangles are one contiguous run
+//!   `tri_range(n)` of the internal triangle array (leaves own triangles);
+//! - vertices are reordered by first appearance in that triangle order, so a node's vertex
+//!   set (the vertices of its triangles) is one contiguous run `vert_run(n)` plus a few
+//!   `borrowed(n)` vertices that first appeared in an earlier subtree (region boundaries);
+//! - `tri_order`/`vert_order` map internal indices back to the caller's original ones.
+
+mod build;
+mod validate;
+
+pub use validate::TreeError;
+
+use std::ops::Range;
+
+/// Largest supported number of levels (root = level 0).
+pub const MAX_LEVELS: usize = 16;
+/// The paper's choice: five levels.
+pub const DEFAULT_LEVELS: usize = 5;
+
+/// The shared region hierarchy (topology and reordering only; no bounding volumes).
+#[derive(Clone, Debug)]
+pub struct RegionTree {
+    levels: usize,
+    first_child: Vec<u32>,
+    child_count: Vec<u8>,
+    depth: Vec<u8>,
+    tri_start: Vec<u32>,
+    tri_end: Vec<u32>,
+    vert_start: Vec<u32>,
+    vert_end: Vec<u32>,
+    borrowed_start: Vec<u32>,
+    borrowed: Vec<u32>,
+    level_start: Vec<u32>,
+    tris: Vec<[u32; 3]>,
+    tri_order: Vec<u32>,
+    vert_order: Vec<u32>,
+    vert_slot: Vec<u32>,
+    referenced_vertices: u32,
+}
+
+impl RegionTree {
+    /// Number of levels requested at build (the actual depth may be smaller).
+    pub fn levels(&self) -> usize {
+        self.levels
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.first_child.len()
+    }
+
+    /// Nodes at depth `d` are `level_nodes(d)`; `d` ranges over `0..depth_count()`.
+    pub fn level_nodes(&self, d: usize) -> Range<usize> {
+        self.level_start[d] as usize..self.level_start[d + 1] as usize
+    }
+
+    /// Number of non-empty levels.
+    pub fn depth_count(&self) -> usize {
+        self.level_start.len() - 1
+    }
+
+    #[inline]
+    pub fn is_leaf(&self, n: usize) -> bool {
+        self.child_count[n] == 0
+    }
+
+    #[inline]
+    pub fn children(&self, n: usize) -> Range<usize> {
+        let f = self.first_child[n] as usize;
+        f..f + self.child_count[n] as usize
+    }
+
+    #[inline]
+    pub fn depth(&self, n: usize) -> usize {
+        self.depth[n] as usize
+    }
+
+    /// The node's triangles, as a run of internal triangle indices.
+    #[inline]
+    pub fn tri_range(&self, n: usize) -> Range<usize> {
+        self.tri_start[n] as usize..self.tri_end[n] as usize
+    }
+
+    /// The node's own contiguous run of internal vertex indices.
+    #[inline]
+    pub fn vert_run(&self, n: usize) -> Range<usize> {
+        self.vert_start[n] as usize..self.vert_end[n] as usize
+    }
+
+    /// The node's other vertices (internal indices below its run, owned by earlier subtrees).
+    #[inline]
+    pub fn borrowed(&self, n: usize) -> &[u32] {
+        &self.borrowed[self.borrowed_start[n] as usize..self.borrowed_start[n + 1] as usize]
+    }
+
+    /// Size of the node's vertex set.
+    #[inline]
+    pub fn vertex_count(&self, n: usize) -> usize {
+        self.vert_run(n).len() + self.borrowed(n).len()
+    }
+
+    /// Internal vertex indices of every vertex of the node's region.
+    pub fn region_vertices(&self, n: usize) -> impl Iterator<Item = u32> + '_ {
+        self.vert_run(n)
+            .map(|v| v as u32)
+            .chain(self.borrowed(n).iter().copied())
+    }
+
+    /// Internal triangles (corner indices are internal vertex indices).
+    #[inline]
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.tris
+    }
+
+    /// Internal triangle index -> the caller's triangle index.
+    #[inline]
+    pub fn tri_order(&self) -> &[u32] {
+        &self.tri_order
+    }
+
+    /// Internal vertex index -> the caller's vertex index (every vertex of the mesh; those no
+    /// triangle uses come last).
+    #[inline]
+    pub fn vert_order(&self) -> &[u32] {
+        &self.vert_order
+    }
+
+    /// Caller's vertex index -> internal vertex index.
+    #[inline]
+    pub fn vert_slot(&self) -> &[u32] {
+        &self.vert_slot
+    }
+
+    pub fn vertex_total(&self) -> usize {
+        self.vert_order.len()
+    }
+
+    pub fn triangle_total(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// Vertices used by at least one triangle (internal indices `0..referenced_vertices()`).
+    pub fn referenced_vertices(&self) -> usize {
+        self.referenced_vertices as usize
+    }
+
+    /// Bytes of topology (shared by the three kinds; not part of a BV's record).
+    pub fn topology_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.first_child[..])
+            + size_of_val(&self.child_count[..])
+            + size_of_val(&self.depth[..])
+            + size_of_val(&self.tri_start[..])
+            + size_of_val(&self.tri_end[..])
+            + size_of_val(&self.vert_start[..])
+            + size_of_val(&self.vert_end[..])
+            + size_of_val(&self.borrowed_start[..])
+            + size_of_val(&self.borrowed[..])
+    }
+}

@@ -1,0 +1,101 @@
+//! Structural invariants of the region tree.
+
+use super::RegionTree;
+use crate::mesh::Mesh;
+
+/// A broken structural invariant of a [`RegionTree`] (a bug in dhcd, never bad input).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("region tree invariant violated at node {node}: {what}")]
+pub struct TreeError {
+    pub node: usize,
+    pub what: String,
+}
+
+fn fail(node: usize, what: impl Into<String>) -> Result<(), TreeError> {
+    Err(TreeError {
+        node,
+        what: what.into(),
+    })
+}
+
+impl RegionTree {
+    /// Checks the topology against the mesh it was built from: levels contiguous and
+    /// breadth-first, children nested and partitioning their parent's triangles, leaves
+    /// covering every triangle exactly once, each node's vertex set (run + borrowed) equal
+    /// to the vertices of its triangles, and the permutations consistent with the mesh.
+    pub fn check_topology(&self, mesh: &Mesh) -> Result<(), TreeError> {
+        let nodes = self.node_count();
+        if self.tris.len() != mesh.triangle_count() || self.vert_order.len() != mesh.vertex_count()
+        {
+            return fail(0, "triangle or vertex count differs from the mesh");
+        }
+        if self.depth_count() > self.levels {
+            return fail(0, "deeper than the requested levels");
+        }
+        if self.tri_range(0) != (0..self.tris.len()) {
+            return fail(0, "root does not own every triangle");
+        }
+        for (i, &o) in self.vert_order.iter().enumerate() {
+            if self.vert_slot[o as usize] as usize != i {
+                return fail(0, format!("vertex permutation broken at internal {i}"));
+            }
+        }
+        for (i, tri) in self.tris.iter().enumerate() {
+            let orig = mesh.triangles()[self.tri_order[i] as usize];
+            if tri.map(|v| self.vert_order[v as usize]) != orig {
+                return fail(0, format!("internal triangle {i} does not match the mesh"));
+            }
+        }
+        let mut covered = vec![false; self.tris.len()];
+        for d in 0..self.depth_count() {
+            for n in self.level_nodes(d) {
+                if self.depth(n) != d {
+                    return fail(n, "stored in the wrong level");
+                }
+                if self.tri_range(n).is_empty() {
+                    return fail(n, "empty region");
+                }
+                if self.is_leaf(n) {
+                    for t in self.tri_range(n) {
+                        if std::mem::replace(&mut covered[t], true) {
+                            return fail(n, format!("triangle {t} in two leaves"));
+                        }
+                    }
+                } else {
+                    let mut next = self.tri_range(n).start;
+                    for c in self.children(n) {
+                        if c >= nodes || self.depth(c) != d + 1 {
+                            return fail(
+                                n,
+                                format!("child {c} out of range or at the wrong depth"),
+                            );
+                        }
+                        if self.tri_range(c).start != next {
+                            return fail(n, "children do not partition the parent's triangles");
+                        }
+                        next = self.tri_range(c).end;
+                    }
+                    if next != self.tri_range(n).end {
+                        return fail(n, "children do not cover the parent's triangles");
+                    }
+                }
+                let mut expected: Vec<u32> = self.tris[self.tri_range(n)]
+                    .iter()
+                    .flatten()
+                    .copied()
+                    .collect();
+                expected.sort_unstable();
+                expected.dedup();
+                let mut got: Vec<u32> = self.region_vertices(n).collect();
+                got.sort_unstable();
+                if got != expected {
+                    return fail(n, "vertex set differs from the vertices of its triangles");
+                }
+            }
+        }
+        if let Some(t) = covered.iter().position(|&c| !c) {
+            return fail(0, format!("triangle {t} is in no leaf"));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,403 @@
+//! The hierarchies against the exact brute-force oracle: every kind, many poses, deforming
+//! sequences, all refit modes, bad input.
+
+use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
+use dhcd::narrow::brute_force_pairs;
+use dhcd::shapes::{grid, icosphere, translated, wave};
+use dhcd::{collide, Error, Hierarchy, Mesh, Method, Options, Refit, RegionTree};
+use proptest::prelude::*;
+
+const MODES: [Refit; 3] = [Refit::Lazy, Refit::Eager, Refit::EagerBottomUp];
+
+fn with_positions(mesh: &Mesh, positions: Vec<[f32; 3]>) -> Mesh {
+    Mesh::new(positions, mesh.triangles().to_vec()).unwrap()
+}
+
+/// Collides `a` and `b` (rest poses) with kind `K`, checks invariants, returns the pairs.
+fn pairs_of<K: BvKind>(a: &Mesh, b: &Mesh, options: Options) -> Vec<[u32; 2]> {
+    let mut ha = Hierarchy::<K>::new(a, options).unwrap();
+    let mut hb = Hierarchy::<K>::new(b, options).unwrap();
+    ha.tree().check_topology(a).unwrap();
+    ha.validate().unwrap();
+    hb.validate().unwrap();
+    let c = collide(&mut ha, &mut hb);
+    ha.validate().unwrap();
+    hb.validate().unwrap();
+    assert_eq!(c.counters.contacts as usize, c.pairs.len());
+    assert!(
+        c.pairs.windows(2).all(|w| w[0] < w[1]),
+        "pairs sorted, unique"
+    );
+    c.pairs
+}
+
+/// Every kind returns exactly the brute-force set.
+fn assert_exact(a: &Mesh, b: &Mesh, levels: usize) -> Vec<[u32; 2]> {
+    let expected = brute_force_pairs(a, b);
+    let options = Options {
+        levels,
+        ..Options::default()
+    };
+    assert_eq!(
+        pairs_of::<Dh>(a, b, options),
+        expected,
+        "dh, levels {levels}"
+    );
+    assert_eq!(
+        pairs_of::<Sphere>(a, b, options),
+        expected,
+        "sphere, levels {levels}"
+    );
+    assert_eq!(
+        pairs_of::<Aabb>(a, b, options),
+        expected,
+        "aabb, levels {levels}"
+    );
+    expected
+}
+
+#[test]
+fn overlapping_spheres_equal_brute_force() {
+    let a = icosphere(2, 1.0, [0.0, 0.0, 0.0]);
+    for (dx, dy) in [(1.3, 0.0), (1.0, 0.5), (0.2, 0.1), (1.99, 0.0)] {
+        let b = icosphere(2, 1.0, [dx, dy, 0.1]);
+        for levels in [1, 2, 5, 7] {
+            let pairs = assert_exact(&a, &b, levels);
+            assert!(!pairs.is_empty(), "offset ({dx}, {dy}) must intersect");
+        }
+    }
+}
+
+#[test]
+fn far_apart_and_nested_have_no_contacts() {
+    let a = icosphere(2, 1.0, [0.0, 0.0, 0.0]);
+    assert!(assert_exact(&a, &icosphere(2, 1.0, [5.0, 0.0, 0.0]), 5).is_empty());
+    // Nested: every BV of the inner sphere lies inside the outer's root, none touch.
+    assert!(assert_exact(&a, &icosphere(2, 0.5, [0.1, 0.0, 0.0]), 5).is_empty());
+}
+
+#[test]
+fn coincident_copies() {
+    let a = icosphere(1, 1.0, [0.0, 0.0, 0.0]);
+    let pairs = assert_exact(&a, &a.clone(), 5);
+    // Every triangle meets itself and its neighbours.
+    for t in 0..a.triangle_count() as u32 {
+        assert!(pairs.binary_search(&[t, t]).is_ok());
+    }
+}
+
+#[test]
+fn touching_grids() {
+    // Two grids in the same plane sharing one edge line x = 4 exactly.
+    let a = grid(4, 4, 1.0, [0.0, 0.0, 0.0]);
+    let b = grid(4, 4, 1.0, [4.0, 0.0, 0.0]);
+    assert!(!assert_exact(&a, &b, 5).is_empty());
+    // Perpendicular grid touching a along one line.
+    let c = Mesh::new(
+        a.positions().iter().map(|p| [p[0], 2.0, p[1]]).collect(),
+        a.triangles().to_vec(),
+    )
+    .unwrap();
+    assert!(!assert_exact(&a, &c, 5).is_empty());
+    // A grid just above: no contact; exactly on: contact.
+    let up = with_positions(&a, translated(a.positions(), [0.5, 0.5, 1e-6]));
+    assert!(assert_exact(&a, &up, 5).is_empty());
+    let on = with_positions(&a, translated(a.positions(), [0.5, 0.5, 0.0]));
+    assert!(!assert_exact(&a, &on, 5).is_empty());
+}
+
+#[test]
+fn degenerate_triangles_at_build() {
+    // A fan with a collinear (zero-area) triangle and a point-like triangle.
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.5, 0.5, 0.0],
+        [0.5, 0.5, 0.0],
+        [0.5, 0.5, 0.0],
+    ];
+    let a = Mesh::new(positions, vec![[0, 1, 2], [0, 1, 3], [4, 5, 6]]).unwrap();
+    let b = grid(2, 2, 0.75, [-0.25, -0.25, 0.0]);
+    let pairs = assert_exact(&a, &b, 3);
+    assert!(
+        pairs.iter().any(|p| p[0] == 0),
+        "the segment triangle touches the grid"
+    );
+    assert!(
+        pairs.iter().any(|p| p[0] == 2),
+        "the point triangle touches the grid"
+    );
+}
+
+/// A deforming sequence: two spheres wobble through each other for `steps` steps; every step
+/// compares every kind and refit mode with brute force and checks invariants after refit.
+fn deforming_sequence<K: BvKind>(refit: Refit, steps: usize) -> Vec<Vec<[u32; 2]>> {
+    let a = icosphere(2, 1.0, [0.0, 0.0, 0.0]);
+    let b = icosphere(2, 0.8, [0.0, 0.0, 0.0]);
+    let options = Options { levels: 5, refit };
+    let mut ha = Hierarchy::<K>::new(&a, options).unwrap();
+    let mut hb = Hierarchy::<K>::new(&b, options).unwrap();
+    let mut all = Vec::new();
+    for step in 0..steps {
+        let t = step as f32 * 0.3;
+        let pa = wave(a.positions(), t, 0.15, [0.0, 0.0, 0.0]);
+        let pb = wave(b.positions(), -t, 0.2, [2.2 - 0.08 * step as f32, 0.1, 0.0]);
+        ha.update_positions(&pa).unwrap();
+        hb.update_positions(&pb).unwrap();
+        if refit != Refit::Lazy {
+            assert_eq!(
+                ha.validate().unwrap(),
+                ha.node_count(),
+                "eager refit fits all"
+            );
+        }
+        let c = collide(&mut ha, &mut hb);
+        ha.validate().unwrap();
+        hb.validate().unwrap();
+        let expected = brute_force_pairs(&with_positions(&a, pa), &with_positions(&b, pb));
+        assert_eq!(c.pairs, expected, "{:?} {refit:?} step {step}", K::METHOD);
+        if refit == Refit::Lazy {
+            assert!(
+                c.counters.bv_updates > 0 && c.counters.bv_updates <= 2 * ha.node_count() as u64
+            );
+        }
+        all.push(c.pairs);
+    }
+    all
+}
+
+#[test]
+fn deforming_sequences_all_kinds_all_refit_modes() {
+    for refit in MODES {
+        let dh = deforming_sequence::<Dh>(refit, 24);
+        assert!(
+            dh.iter().filter(|p| !p.is_empty()).count() > 10,
+            "the spheres must meet"
+        );
+        assert_eq!(dh, deforming_sequence::<Sphere>(refit, 24));
+        assert_eq!(dh, deforming_sequence::<Aabb>(refit, 24));
+    }
+}
+
+#[test]
+fn collapse_to_degenerate_during_deformation() {
+    let a = grid(3, 3, 1.0, [0.0, 0.0, 0.0]);
+    let b = grid(3, 3, 1.0, [0.5, 0.5, 0.0]);
+    let mut hb = Hierarchy::<Dh>::new(&b, Options::default()).unwrap();
+    let mut ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
+    // Flatten b onto a line (every triangle becomes a segment), lifted so it crosses a.
+    let flat: Vec<[f32; 3]> = b
+        .positions()
+        .iter()
+        .map(|p| [p[0], 1.25, p[1] - 1.5])
+        .collect();
+    hb.update_positions(&flat).unwrap();
+    let c = collide(&mut ha, &mut hb);
+    hb.validate().unwrap();
+    assert_eq!(c.pairs, brute_force_pairs(&a, &with_positions(&b, flat)));
+    assert!(!c.pairs.is_empty());
+}
+
+#[test]
+fn record_sizes_and_memory() {
+    assert_eq!(std::mem::size_of::<dhcd::bv::DhNode>(), 8);
+    assert_eq!(std::mem::size_of::<dhcd::bv::SphereNode>(), 16);
+    assert_eq!(std::mem::size_of::<dhcd::bv::AabbNode>(), 24);
+    let m = icosphere(3, 1.0, [0.0; 3]);
+    let dh = Hierarchy::<Dh>::new(&m, Options::default()).unwrap();
+    let sp = Hierarchy::<Sphere>::new(&m, Options::default()).unwrap();
+    let bx = Hierarchy::<Aabb>::new(&m, Options::default()).unwrap();
+    assert_eq!(dh.bv_bytes(), 8 * dh.node_count());
+    assert_eq!(sp.bv_bytes(), 16 * dh.node_count());
+    assert_eq!(bx.bv_bytes(), 24 * dh.node_count());
+    assert_eq!(Method::Dh.bytes_per_node(), 8);
+    assert_eq!(dh.tree().depth_count(), 5);
+}
+
+#[test]
+fn shared_tree_gives_identical_regions() {
+    let m = icosphere(2, 1.0, [0.0; 3]);
+    let tree = std::sync::Arc::new(RegionTree::build(&m, 4).unwrap());
+    let dh = Hierarchy::<Dh>::with_tree(tree.clone(), &m, Refit::Lazy).unwrap();
+    let bx = Hierarchy::<Aabb>::with_tree(tree.clone(), &m, Refit::Lazy).unwrap();
+    assert!(std::sync::Arc::ptr_eq(dh.tree(), bx.tree()));
+    let other = icosphere(1, 1.0, [0.0; 3]);
+    assert!(matches!(
+        Hierarchy::<Dh>::with_tree(tree, &other, Refit::Lazy),
+        Err(Error::InvalidOption(_))
+    ));
+}
+
+#[test]
+fn dh_central_vertex_is_closest_to_region_centroid() {
+    let m = icosphere(2, 1.0, [0.0; 3]);
+    let h = Hierarchy::<Dh>::new(&m, Options::default()).unwrap();
+    let tree = h.tree();
+    let p = h.points();
+    for n in 0..h.node_count() {
+        let verts: Vec<u32> = tree.region_vertices(n).collect();
+        let mean: [f64; 3] = std::array::from_fn(|k| {
+            verts
+                .iter()
+                .map(|&v| p.get(v as usize)[k] as f64)
+                .sum::<f64>()
+                / verts.len() as f64
+        });
+        let d = |v: u32| -> f64 {
+            (0..3)
+                .map(|k| (p.get(v as usize)[k] as f64 - mean[k]).powi(2))
+                .sum()
+        };
+        let c = h.record(n).vertex;
+        assert!(verts.contains(&c));
+        assert!(verts.iter().all(|&v| d(c) <= d(v)), "node {n}");
+    }
+}
+
+#[test]
+fn lazy_refit_updates_only_tested_nodes() {
+    let a = icosphere(3, 1.0, [0.0; 3]);
+    let b = icosphere(3, 1.0, [10.0, 0.0, 0.0]);
+    let mut ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
+    let mut hb = Hierarchy::<Dh>::new(&b, Options::default()).unwrap();
+    ha.update_positions(&wave(a.positions(), 1.0, 0.1, [0.0; 3]))
+        .unwrap();
+    hb.update_positions(&wave(b.positions(), 1.0, 0.1, [0.0; 3]))
+        .unwrap();
+    let c = collide(&mut ha, &mut hb);
+    // Far apart: only the roots are tested, so only the roots are refitted.
+    assert_eq!(c.counters.bv_tests, 1);
+    assert_eq!(c.counters.bv_updates, 2);
+    assert_eq!(ha.validate().unwrap(), 1);
+    // A second query in the same step refits nothing.
+    assert_eq!(collide(&mut ha, &mut hb).counters.bv_updates, 0);
+}
+
+#[test]
+fn bad_mesh_input_is_a_typed_error() {
+    let p = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    assert_eq!(Mesh::new(vec![], vec![[0, 1, 2]]), Err(Error::NoVertices));
+    assert_eq!(Mesh::new(p.clone(), vec![]), Err(Error::NoTriangles));
+    assert!(matches!(
+        Mesh::new(p.clone(), vec![[0, 1, 3]]),
+        Err(Error::IndexOutOfRange {
+            triangle: 0,
+            index: 3,
+            vertex_count: 3
+        })
+    ));
+    assert!(matches!(
+        Mesh::new(p.clone(), vec![[0, 1, 1]]),
+        Err(Error::RepeatedIndex { .. })
+    ));
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        let mut q = p.clone();
+        q[1][2] = bad;
+        assert!(matches!(
+            Mesh::new(q, vec![[0, 1, 2]]),
+            Err(Error::NonFinite { vertex: 1, .. })
+        ));
+    }
+    let m = Mesh::new(p, vec![[0, 1, 2]]).unwrap();
+    for levels in [0, 17] {
+        assert_eq!(
+            Hierarchy::<Dh>::new(
+                &m,
+                Options {
+                    levels,
+                    ..Options::default()
+                }
+            )
+            .err(),
+            Some(Error::InvalidLevels { got: levels })
+        );
+    }
+    // Messages are one clear line.
+    let msg = Error::IndexOutOfRange {
+        triangle: 4,
+        index: 9,
+        vertex_count: 3,
+    }
+    .to_string();
+    assert!(msg.contains("triangle 4") && msg.contains('9') && !msg.contains('\n'));
+}
+
+#[test]
+fn bad_update_is_an_error_and_changes_nothing() {
+    let a = icosphere(2, 1.0, [0.0; 3]);
+    let b = icosphere(2, 1.0, [1.5, 0.0, 0.0]);
+    for method in Method::ALL {
+        let mut ha = dhcd::AnyHierarchy::new(method, &a, Options::default()).unwrap();
+        let mut hb = dhcd::AnyHierarchy::new(method, &b, Options::default()).unwrap();
+        let mut ws = dhcd::Workspace::default();
+        let before = ha.collide(&mut hb, &mut ws).unwrap().pairs;
+        let n = a.vertex_count();
+        assert_eq!(
+            ha.update_positions(&a.positions()[..n - 1]),
+            Err(Error::WrongVertexCount {
+                expected: n,
+                got: n - 1
+            })
+        );
+        let mut nan = a.positions().to_vec();
+        nan[7][0] = f32::NAN;
+        assert!(matches!(
+            ha.update_positions(&nan),
+            Err(Error::NonFinite { vertex: 7, .. })
+        ));
+        let mut inf = a.positions().to_vec();
+        inf[3][1] = f32::INFINITY;
+        assert!(matches!(
+            ha.update_positions(&inf),
+            Err(Error::NonFinite { vertex: 3, .. })
+        ));
+        assert_eq!(ha.collide(&mut hb, &mut ws).unwrap().pairs, before);
+        ha.validate().unwrap();
+        let mut other = dhcd::AnyHierarchy::new(
+            Method::ALL[(method as usize + 1) % 3],
+            &b,
+            Options::default(),
+        )
+        .unwrap();
+        assert!(ha.collide(&mut other, &mut ws).is_err());
+    }
+}
+
+#[test]
+fn method_names_parse() {
+    for m in Method::ALL {
+        assert_eq!(m.name().parse::<Method>().unwrap(), m);
+    }
+    assert!("obb".parse::<Method>().is_err());
+}
+
+/// Random triangle soups on a coarse grid (so touching and coplanar cases are frequent).
+fn soup(max_tris: usize) -> impl Strategy<Value = Mesh> {
+    let coord = (-4i32..=4).prop_map(|c| c as f32 * 0.5);
+    let point = [coord.clone(), coord.clone(), coord];
+    prop::collection::vec(prop::collection::vec(point, 3), 1..max_tris).prop_map(|tris| {
+        let positions: Vec<[f32; 3]> = tris.iter().flatten().copied().collect();
+        let triangles = (0..tris.len() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect();
+        Mesh::new(positions, triangles).unwrap()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn random_soups_equal_brute_force(a in soup(40), b in soup(40), levels in 1usize..7) {
+        assert_exact(&a, &b, levels);
+    }
+
+    #[test]
+    fn random_poses_of_spheres(dx in -2.0f32..2.0, dy in -2.0f32..2.0, dz in -2.0f32..2.0, t in 0.0f32..6.0, amp in 0.0f32..0.4) {
+        let a = icosphere(1, 1.0, [0.0; 3]);
+        let b = with_positions(&a, wave(a.positions(), t, amp, [dx, dy, dz]));
+        assert_exact(&a, &b, 4);
+    }
+}
