@@ -7,6 +7,7 @@ use crate::bv::{Aabb, Dh, Method, Sphere};
 use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
 use crate::mesh::Mesh;
+use crate::par::Par;
 use crate::traverse::{collide_with, Contacts, Workspace};
 use crate::tree::RegionTree;
 
@@ -76,11 +77,16 @@ impl AnyHierarchy {
     }
 
     /// Contacts between two hierarchies of the same kind; an error if the kinds differ.
-    pub fn collide(&mut self, other: &mut AnyHierarchy, ws: &mut Workspace) -> Result<Contacts> {
+    pub fn collide(
+        &mut self,
+        other: &mut AnyHierarchy,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<Contacts> {
         match (self, other) {
-            (Self::Dh(a), Self::Dh(b)) => Ok(collide_with(a, b, ws)),
-            (Self::Sphere(a), Self::Sphere(b)) => Ok(collide_with(a, b, ws)),
-            (Self::Aabb(a), Self::Aabb(b)) => Ok(collide_with(a, b, ws)),
+            (Self::Dh(a), Self::Dh(b)) => Ok(collide_with(a, b, ws, par)),
+            (Self::Sphere(a), Self::Sphere(b)) => Ok(collide_with(a, b, ws, par)),
+            (Self::Aabb(a), Self::Aabb(b)) => Ok(collide_with(a, b, ws, par)),
             (a, b) => Err(Error::InvalidOption(format!(
                 "cannot collide a {} hierarchy with a {} hierarchy",
                 a.method(),

@@ -138,7 +138,7 @@ impl<K: BvKind> Hierarchy<K> {
     /// Refits every stale node exactly.
     pub fn refit_all(&mut self) {
         let all: Vec<u32> = (0..self.node_count() as u32).collect();
-        self.ensure_fitted(&all);
+        self.ensure_fitted(&all, false, &mut Vec::new());
     }
 
     /// Refits every node bottom-up: stale leaves exactly, internal nodes from their children.
@@ -162,14 +162,34 @@ impl<K: BvKind> Hierarchy<K> {
     }
 
     /// Lazy refit: fits every node of `ids` that is stale (each once), counting the updates.
-    pub(crate) fn ensure_fitted(&mut self, ids: &[u32]) {
+    /// `stale` is scratch. In parallel, the fits are computed on the current rayon pool and
+    /// stored in order; a fit reads only positions and its own node, so the result is the
+    /// same either way.
+    pub(crate) fn ensure_fitted(&mut self, ids: &[u32], parallel: bool, stale: &mut Vec<u32>) {
+        stale.clear();
         for &n in ids {
-            let n = n as usize;
-            if self.stamp[n] != self.epoch {
-                let r = K::fit(&self.nodes, &self.tree, &self.points, n);
-                K::set(&mut self.nodes, n, r);
-                self.stamp[n] = self.epoch;
-                self.updates += 1;
+            let slot = &mut self.stamp[n as usize];
+            if *slot != self.epoch {
+                *slot = self.epoch;
+                stale.push(n);
+            }
+        }
+        self.updates += stale.len() as u64;
+        if parallel && stale.len() > 1 {
+            use rayon::prelude::*;
+            let (nodes, tree, points) = (&self.nodes, &*self.tree, &self.points);
+            let fitted: Vec<K::Record> = stale
+                .par_iter()
+                .with_min_len(4)
+                .map(|&n| K::fit(nodes, tree, points, n as usize))
+                .collect();
+            for (&n, r) in stale.iter().zip(fitted) {
+                K::set(&mut self.nodes, n as usize, r);
+            }
+        } else {
+            for &n in stale.iter() {
+                let r = K::fit(&self.nodes, &self.tree, &self.points, n as usize);
+                K::set(&mut self.nodes, n as usize, r);
             }
         }
     }

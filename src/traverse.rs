@@ -2,15 +2,22 @@
 //! narrow phase on the triangle pairs of overlapping leaves.
 //!
 //! The frontier is an array of node pairs. Each round refits the stale nodes it names (lazy
-//! refit), batch-tests all its pairs with one kernel call, and expands the overlapping pairs:
-//! two leaves become a leaf pair; a leaf against an internal node pairs the leaf with the
-//! node's children; two internal nodes pair all their children. Every node pair is produced
-//! at most once, so no contact is reported twice.
+//! refit), batch-tests all its pairs with one kernel call per chunk, and expands the
+//! overlapping pairs: two leaves become a leaf pair; a leaf against an internal node pairs
+//! the leaf with the node's children; two internal nodes pair all their children. Every node
+//! pair is produced at most once, so no contact is reported twice.
+//!
+//! In parallel, each round is cut into chunks of `grain` pairs (leaf pairs: `grain / 64`)
+//! whose outputs are concatenated in chunk order, so contacts and counters are identical for
+//! every thread count.
+
+use rayon::prelude::*;
 
 use crate::bv::BvKind;
 use crate::counters::Counters;
 use crate::hierarchy::Hierarchy;
 use crate::narrow;
+use crate::par::Par;
 use crate::points::Points;
 use crate::tree::RegionTree;
 
@@ -22,112 +29,199 @@ pub struct Contacts {
     pub counters: Counters,
 }
 
-/// Reusable scratch of a query (frontier arrays, masks, leaf pairs); keep one per thread to
-/// avoid allocating every step.
-#[derive(Clone, Debug, Default)]
+/// Default number of node pairs per parallel task.
+pub const DEFAULT_GRAIN: usize = 1024;
+
+/// Reusable scratch of a query (frontier arrays, masks, leaf pairs): keep one per thread to
+/// avoid allocating every step. Also holds the parallel grain.
+#[derive(Clone, Debug)]
 pub struct Workspace {
+    grain: usize,
     ia: Vec<u32>,
     ib: Vec<u32>,
     next_a: Vec<u32>,
     next_b: Vec<u32>,
     mask: Vec<u32>,
     leaves: Vec<[u32; 2]>,
+    stale: Vec<u32>,
 }
 
-/// All intersecting triangle pairs between `a` and `b`, with counters. Refits (lazily) the
-/// nodes it tests.
+impl Default for Workspace {
+    fn default() -> Self {
+        Self::with_grain(DEFAULT_GRAIN)
+    }
+}
+
+impl Workspace {
+    /// A workspace whose parallel tasks take `grain` node pairs each (at least 1). Small
+    /// grains force splits everywhere (tests); large ones cut scheduling overhead.
+    pub fn with_grain(grain: usize) -> Self {
+        Self {
+            grain: grain.max(1),
+            ia: Vec::new(),
+            ib: Vec::new(),
+            next_a: Vec::new(),
+            next_b: Vec::new(),
+            mask: Vec::new(),
+            leaves: Vec::new(),
+            stale: Vec::new(),
+        }
+    }
+}
+
+/// All intersecting triangle pairs between `a` and `b`, with counters, on the calling
+/// thread. Refits (lazily) the nodes it tests.
 pub fn collide<K: BvKind>(a: &mut Hierarchy<K>, b: &mut Hierarchy<K>) -> Contacts {
-    collide_with(a, b, &mut Workspace::default())
+    collide_with(a, b, &mut Workspace::default(), Par::Seq)
 }
 
-/// [`collide`] with caller-owned scratch.
+/// [`collide`] with caller-owned scratch and a choice of parallelism. The result does not
+/// depend on `par`.
 pub fn collide_with<K: BvKind>(
     a: &mut Hierarchy<K>,
     b: &mut Hierarchy<K>,
     ws: &mut Workspace,
+    par: Par,
+) -> Contacts {
+    par.install(|| run(a, b, ws, par.is_parallel()))
+}
+
+fn run<K: BvKind>(
+    a: &mut Hierarchy<K>,
+    b: &mut Hierarchy<K>,
+    ws: &mut Workspace,
+    parallel: bool,
 ) -> Contacts {
     let mut counters = Counters::default();
+    let grain = ws.grain;
     ws.leaves.clear();
     ws.ia.clear();
     ws.ib.clear();
     ws.ia.push(0);
     ws.ib.push(0);
     while !ws.ia.is_empty() {
-        a.ensure_fitted(&ws.ia);
-        b.ensure_fitted(&ws.ib);
+        a.ensure_fitted(&ws.ia, parallel, &mut ws.stale);
+        b.ensure_fitted(&ws.ib, parallel, &mut ws.stale);
         ws.mask.resize(ws.ia.len(), 0);
-        K::overlap(
-            a.nodes(),
-            a.points(),
-            b.nodes(),
-            b.points(),
-            &ws.ia,
-            &ws.ib,
-            &mut ws.mask,
-        );
         counters.bv_tests += ws.ia.len() as u64;
-        expand(
-            a.tree(),
-            b.tree(),
-            &ws.ia,
-            &ws.ib,
-            &ws.mask,
-            &mut ws.next_a,
-            &mut ws.next_b,
-            &mut ws.leaves,
-        );
+        let (ha, hb) = (&*a, &*b);
+        let test = |ia: &[u32], ib: &[u32], out: &mut [u32]| {
+            K::overlap(
+                ha.nodes(),
+                ha.points(),
+                hb.nodes(),
+                hb.points(),
+                ia,
+                ib,
+                out,
+            );
+        };
+        let (ta, tb) = (&**a.tree(), &**b.tree());
+        if parallel && ws.ia.len() > grain {
+            ws.mask
+                .par_chunks_mut(grain)
+                .zip(ws.ia.par_chunks(grain).zip(ws.ib.par_chunks(grain)))
+                .for_each(|(out, (ia, ib))| test(ia, ib, out));
+            let parts: Vec<Expansion> = ws
+                .ia
+                .par_chunks(grain)
+                .zip(ws.ib.par_chunks(grain).zip(ws.mask.par_chunks(grain)))
+                .map(|(ia, (ib, mask))| {
+                    let mut e = Expansion::default();
+                    e.expand(ta, tb, ia, ib, mask);
+                    e
+                })
+                .collect();
+            ws.next_a.clear();
+            ws.next_b.clear();
+            for e in parts {
+                ws.next_a.extend_from_slice(&e.next_a);
+                ws.next_b.extend_from_slice(&e.next_b);
+                ws.leaves.extend_from_slice(&e.leaves);
+            }
+        } else {
+            test(&ws.ia, &ws.ib, &mut ws.mask);
+            let mut e = Expansion {
+                next_a: std::mem::take(&mut ws.next_a),
+                next_b: std::mem::take(&mut ws.next_b),
+                leaves: std::mem::take(&mut ws.leaves),
+            };
+            e.next_a.clear();
+            e.next_b.clear();
+            e.expand(ta, tb, &ws.ia, &ws.ib, &ws.mask);
+            (ws.next_a, ws.next_b, ws.leaves) = (e.next_a, e.next_b, e.leaves);
+        }
         std::mem::swap(&mut ws.ia, &mut ws.next_a);
         std::mem::swap(&mut ws.ib, &mut ws.next_b);
     }
     counters.bv_updates = a.take_updates() + b.take_updates();
 
+    let (ha, hb) = (&*a, &*b);
+    let leaf_grain = (grain / 64).max(1);
     let mut pairs = Vec::new();
-    for &[la, lb] in &ws.leaves {
-        counters.prim_tests += narrow_leaf_pair(a, b, la as usize, lb as usize, &mut pairs);
+    if parallel && ws.leaves.len() > leaf_grain {
+        let parts: Vec<(Vec<[u32; 2]>, u64)> = ws
+            .leaves
+            .par_chunks(leaf_grain)
+            .map(|chunk| {
+                let mut out = Vec::new();
+                let tested = chunk
+                    .iter()
+                    .map(|&[la, lb]| narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut out))
+                    .sum::<u64>();
+                (out, tested)
+            })
+            .collect();
+        for (out, tested) in parts {
+            pairs.extend_from_slice(&out);
+            counters.prim_tests += tested;
+        }
+    } else {
+        for &[la, lb] in &ws.leaves {
+            counters.prim_tests += narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut pairs);
+        }
     }
     pairs.sort_unstable();
     counters.contacts = pairs.len() as u64;
     Contacts { pairs, counters }
 }
 
-/// Expands the overlapping pairs of one frontier into the next frontier and the leaf pairs.
-#[allow(clippy::too_many_arguments)]
-fn expand(
-    ta: &RegionTree,
-    tb: &RegionTree,
-    ia: &[u32],
-    ib: &[u32],
-    mask: &[u32],
-    next_a: &mut Vec<u32>,
-    next_b: &mut Vec<u32>,
-    leaves: &mut Vec<[u32; 2]>,
-) {
-    next_a.clear();
-    next_b.clear();
-    for k in 0..ia.len() {
-        if mask[k] == 0 {
-            continue;
-        }
-        let (x, y) = (ia[k] as usize, ib[k] as usize);
-        match (ta.is_leaf(x), tb.is_leaf(y)) {
-            (true, true) => leaves.push([x as u32, y as u32]),
-            (true, false) => {
-                for c in tb.children(y) {
-                    next_a.push(x as u32);
-                    next_b.push(c as u32);
-                }
+/// The output of expanding one chunk of a frontier.
+#[derive(Default)]
+struct Expansion {
+    next_a: Vec<u32>,
+    next_b: Vec<u32>,
+    leaves: Vec<[u32; 2]>,
+}
+
+impl Expansion {
+    /// Appends the children pairs of the overlapping pairs (`mask[k] != 0`) and the leaf pairs.
+    fn expand(&mut self, ta: &RegionTree, tb: &RegionTree, ia: &[u32], ib: &[u32], mask: &[u32]) {
+        for k in 0..ia.len() {
+            if mask[k] == 0 {
+                continue;
             }
-            (false, true) => {
-                for c in ta.children(x) {
-                    next_a.push(c as u32);
-                    next_b.push(y as u32);
+            let (x, y) = (ia[k] as usize, ib[k] as usize);
+            match (ta.is_leaf(x), tb.is_leaf(y)) {
+                (true, true) => self.leaves.push([x as u32, y as u32]),
+                (true, false) => {
+                    for c in tb.children(y) {
+                        self.next_a.push(x as u32);
+                        self.next_b.push(c as u32);
+                    }
                 }
-            }
-            (false, false) => {
-                for cx in ta.children(x) {
-                    for cy in tb.children(y) {
-                        next_a.push(cx as u32);
-                        next_b.push(cy as u32);
+                (false, true) => {
+                    for c in ta.children(x) {
+                        self.next_a.push(c as u32);
+                        self.next_b.push(y as u32);
+                    }
+                }
+                (false, false) => {
+                    for cx in ta.children(x) {
+                        for cy in tb.children(y) {
+                            self.next_a.push(cx as u32);
+                            self.next_b.push(cy as u32);
+                        }
                     }
                 }
             }

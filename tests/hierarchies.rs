@@ -332,7 +332,7 @@ fn bad_update_is_an_error_and_changes_nothing() {
         let mut ha = dhcd::AnyHierarchy::new(method, &a, Options::default()).unwrap();
         let mut hb = dhcd::AnyHierarchy::new(method, &b, Options::default()).unwrap();
         let mut ws = dhcd::Workspace::default();
-        let before = ha.collide(&mut hb, &mut ws).unwrap().pairs;
+        let before = ha.collide(&mut hb, &mut ws, dhcd::Par::Seq).unwrap().pairs;
         let n = a.vertex_count();
         assert_eq!(
             ha.update_positions(&a.positions()[..n - 1]),
@@ -353,7 +353,10 @@ fn bad_update_is_an_error_and_changes_nothing() {
             ha.update_positions(&inf),
             Err(Error::NonFinite { vertex: 3, .. })
         ));
-        assert_eq!(ha.collide(&mut hb, &mut ws).unwrap().pairs, before);
+        assert_eq!(
+            ha.collide(&mut hb, &mut ws, dhcd::Par::Seq).unwrap().pairs,
+            before
+        );
         ha.validate().unwrap();
         let mut other = dhcd::AnyHierarchy::new(
             Method::ALL[(method as usize + 1) % 3],
@@ -361,7 +364,7 @@ fn bad_update_is_an_error_and_changes_nothing() {
             Options::default(),
         )
         .unwrap();
-        assert!(ha.collide(&mut other, &mut ws).is_err());
+        assert!(ha.collide(&mut other, &mut ws, dhcd::Par::Seq).is_err());
     }
 }
 
@@ -400,4 +403,65 @@ proptest! {
         let b = with_positions(&a, wave(a.positions(), t, amp, [dx, dy, dz]));
         assert_exact(&a, &b, 4);
     }
+}
+
+/// Runs a deforming sequence with the given parallelism and grain; returns every step's
+/// contacts and counters.
+fn sequence_with<K: BvKind>(par: dhcd::Par, grain: usize) -> Vec<dhcd::Contacts> {
+    let a = icosphere(3, 1.0, [0.0, 0.0, 0.0]);
+    let b = icosphere(3, 0.9, [0.0, 0.0, 0.0]);
+    let mut ha = Hierarchy::<K>::new(&a, Options::default()).unwrap();
+    let mut hb = Hierarchy::<K>::new(&b, Options::default()).unwrap();
+    let mut ws = dhcd::Workspace::with_grain(grain);
+    (0..8)
+        .map(|step| {
+            let t = step as f32 * 0.4;
+            ha.update_positions(&wave(a.positions(), t, 0.1, [0.0; 3]))
+                .unwrap();
+            hb.update_positions(&wave(
+                b.positions(),
+                -t,
+                0.1,
+                [1.7 - 0.05 * step as f32, 0.2, 0.0],
+            ))
+            .unwrap();
+            let c = dhcd::collide_with(&mut ha, &mut hb, &mut ws, par);
+            ha.validate().unwrap();
+            hb.validate().unwrap();
+            c
+        })
+        .collect()
+}
+
+fn parallel_equals_sequential_for<K: BvKind>() {
+    let seq = sequence_with::<K>(dhcd::Par::Seq, 1024);
+    assert!(seq.iter().any(|c| !c.pairs.is_empty()));
+    for threads in [1, 2, 3] {
+        // Grain 1 splits every frontier and every leaf pair list into single-pair tasks.
+        for grain in [1, 5, 64, 1024] {
+            let par = sequence_with::<K>(dhcd::Par::Rayon(threads), grain);
+            assert_eq!(
+                par,
+                seq,
+                "{:?}: {threads} threads, grain {grain}",
+                K::METHOD
+            );
+        }
+    }
+    assert_eq!(sequence_with::<K>(dhcd::Par::Rayon(0), 3), seq);
+}
+
+#[test]
+fn parallel_equals_sequential_dh() {
+    parallel_equals_sequential_for::<Dh>();
+}
+
+#[test]
+fn parallel_equals_sequential_sphere() {
+    parallel_equals_sequential_for::<Sphere>();
+}
+
+#[test]
+fn parallel_equals_sequential_aabb() {
+    parallel_equals_sequential_for::<Aabb>();
 }

@@ -31,7 +31,7 @@ pub fn run(args: CollideArgs) -> dhcd::Result<()> {
     let mesh_b = dhcd::io::load(&args.b)?;
     let mut a = AnyHierarchy::new(args.method, &mesh_a, options)?;
     let mut b = AnyHierarchy::new(args.method, &mesh_b, options)?;
-    let contacts = a.collide(&mut b, &mut Workspace::default())?;
+    let contacts = a.collide(&mut b, &mut Workspace::default(), dhcd::Par::Seq)?;
     if args.json {
         println!(
             "{}",
