@@ -43,7 +43,9 @@ pub fn parse_stl(bytes: &[u8], path: &Path) -> Result<Mesh> {
         return parse_binary(bytes, path);
     }
     if starts_with_solid(bytes) {
-        return parse_ascii(bytes, path).map_err(|e| match (e, declared_facets(bytes)) {
+        // Only worth mentioning binary when the contents are not text.
+        let binary_hint = bytes.contains(&0).then(|| declared_facets(bytes)).flatten();
+        return parse_ascii(bytes, path).map_err(|e| match (e, binary_hint) {
             (
                 Error::Parse {
                     path,
