@@ -859,3 +859,41 @@ fn seeds_are_valid() {
         io::parse(s, format, &p("seed")).unwrap_or_else(|e| panic!("seed {i}: {e}"));
     }
 }
+
+#[test]
+fn obj_with_byte_order_mark_loads() {
+    let m = io::parse_obj(
+        "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        &p("bom.obj"),
+    )
+    .unwrap();
+    assert_eq!(m.triangles(), &[[0, 1, 2]]);
+    assert_eq!(
+        Format::sniff("\u{feff}# c\nv 0 0 0\n".as_bytes()),
+        Some(Format::Obj)
+    );
+}
+
+#[test]
+fn huge_declared_counts_fail_fast_without_allocating() {
+    let text =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n\
+                property float y\nproperty float z\nelement face 4000000000\n\
+                property list uint uint vertex_indices\nend_header\n\x00\x00\x00\x00";
+    let err = io::parse_ply(text.as_bytes(), &p("huge.ply")).unwrap_err();
+    assert!(err.to_string().contains("truncated"), "{err}");
+    let mut stl = vec![0u8; 84];
+    stl[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
+    let err = io::parse_stl(&stl, &p("huge.stl")).unwrap_err();
+    assert!(
+        err.to_string().contains("declares 4294967295 facets"),
+        "{err}"
+    );
+}
+
+#[test]
+fn loading_a_directory_is_an_io_error() {
+    let dir = tmp("a_directory.obj");
+    std::fs::create_dir_all(&dir).unwrap();
+    assert!(matches!(io::load(&dir), Err(Error::Io { .. })));
+}

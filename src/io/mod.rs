@@ -156,6 +156,13 @@ pub(crate) fn build(
     positions: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
 ) -> Result<Mesh> {
+    if positions.is_empty() && triangles.is_empty() {
+        return Err(parse_error(
+            path,
+            0,
+            "file contains no vertices and no triangles (empty mesh)",
+        ));
+    }
     if positions.is_empty() {
         return Err(parse_error(path, 0, "file contains no vertices"));
     }

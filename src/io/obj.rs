@@ -73,6 +73,7 @@ pub fn parse_obj_bytes(bytes: &[u8], path: &Path) -> Result<Mesh> {
 /// positive (1-based) or negative (relative to the vertices defined so far) and may carry
 /// texture/normal indices (`i/t`, `i//n`, `i/t/n`), which are ignored.
 pub fn parse_obj(text: &str, path: &Path) -> Result<Mesh> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut positions: Vec<[f32; 3]> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut corners: Vec<u32> = Vec::new();
@@ -262,6 +263,7 @@ pub(crate) fn looks_like_obj(bytes: &[u8]) -> bool {
         Ok(t) => t,
         Err(e) => std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or(""),
     };
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for line in text.lines().take(1000) {
         let line = match line.find('#') {
             Some(i) => &line[..i],

@@ -119,6 +119,8 @@ struct Header {
     elements: Vec<Element>,
     /// Byte offset of the data section.
     data_start: usize,
+    /// Length of the whole file.
+    data_end: usize,
     /// Number of header lines (the data section starts on the next line).
     lines: usize,
 }
@@ -266,6 +268,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
         encoding,
         elements,
         data_start: pos,
+        data_end: bytes.len(),
         lines: line_no,
     })
 }
@@ -563,6 +566,8 @@ fn roles(header: &Header, path: &Path) -> Result<(usize, Vec<Role>, usize, Vec<R
 }
 
 fn read_body(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh> {
+    // Every row of a used element takes at least one byte: never reserve beyond the data.
+    let data_len = (header.data_end - header.data_start) as u64;
     let (v_elem, vertex_roles, f_elem, face_roles) = roles(header, path)?;
     let mut positions: Vec<[f32; 3]> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
@@ -577,10 +582,10 @@ fn read_body(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh
         }
         let no_roles = Vec::new();
         let roles = if e == v_elem {
-            positions.reserve(element.count.min(1 << 20) as usize);
+            positions.reserve(element.count.min(data_len) as usize);
             &vertex_roles
         } else if e == f_elem {
-            triangles.reserve(element.count.min(1 << 20) as usize);
+            triangles.reserve(element.count.min(data_len) as usize);
             &face_roles
         } else {
             &no_roles
@@ -657,7 +662,11 @@ fn read_body(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh
                 if !p.iter().all(|x| x.is_finite()) {
                     return Err(at(
                         src.line(),
-                        format!("non-finite vertex coordinate ({} {} {})", p[0], p[1], p[2]),
+                        format!(
+                            "non-finite vertex coordinate ({} {} {}): NaN, infinite or beyond the \
+                             f32 range",
+                            p[0], p[1], p[2]
+                        ),
                     ));
                 }
                 positions.push(p);
