@@ -897,3 +897,31 @@ fn loading_a_directory_is_an_io_error() {
     std::fs::create_dir_all(&dir).unwrap();
     assert!(matches!(io::load(&dir), Err(Error::Io { .. })));
 }
+
+#[test]
+fn ply_sized_type_names_and_int_list_counts() {
+    let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float32 x\n\
+        property float32 y\nproperty float32 z\nproperty int8 tag\nelement face 1\n\
+        property list int32 int32 vertex_indices\nend_header\n"
+        .to_vec();
+    for (i, v) in [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.5],
+    ]
+    .iter()
+    .enumerate()
+    {
+        for x in v {
+            bytes.extend_from_slice(&x.to_le_bytes());
+        }
+        bytes.push(i as u8);
+    }
+    for i in [4i32, 3, 2, 1, 0] {
+        bytes.extend_from_slice(&i.to_le_bytes());
+    }
+    let m = io::parse_ply(&bytes, &p("sized.ply")).unwrap();
+    assert_eq!(m.triangles(), &[[3, 2, 1], [3, 1, 0]]);
+    assert_eq!(m.positions()[3], [0.0, 1.0, 0.5]);
+}
