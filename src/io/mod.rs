@@ -1,1 +1,193 @@
-//! Mesh file formats.
+//! Mesh file formats: Wavefront OBJ, STL (ASCII and binary) and PLY (ASCII, binary little-
+//! and big-endian).
+//!
+//! All parsers are hand-written so the index semantics are exactly the ones the rest of the
+//! crate (and its users) rely on:
+//!
+//! - Triangles come out in file order of faces, with 0-based vertex indices. A face with
+//!   `k > 3` corners is split as a fan, in order: `(v0,v1,v2), (v0,v2,v3), …`.
+//! - OBJ: vertex identity is the `v` index. All `v` lines of the file, in order, form one
+//!   position array regardless of `o`/`g` groups; texture/normal indices never duplicate a
+//!   vertex.
+//! - STL: corners whose coordinates are bit-identical f32s (with `-0.0 == 0.0`) are welded into
+//!   one vertex, in first-appearance order, so shared edges are recognised.
+//! - PLY: `vertex` element with `x`, `y`, `z`; `face` element with a `vertex_indices` (or
+//!   `vertex_index`) list; every other element and property is skipped.
+//!
+//! Every malformed input yields an [`Error::Parse`] (or [`Error::Io`] when the file cannot be
+//! read) whose one-line message names the file and, for text formats, the line. No byte input
+//! makes a parser panic.
+
+mod obj;
+mod ply;
+mod stl;
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+
+pub use obj::{parse_obj, parse_obj_bytes, write_obj};
+pub use ply::parse_ply;
+pub use stl::parse_stl;
+
+/// The mesh file formats `dhcd` reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// Wavefront OBJ (text).
+    Obj,
+    /// STL, ASCII or binary (detected from the contents).
+    Stl,
+    /// PLY, ASCII or binary of either endianness (declared in the header).
+    Ply,
+}
+
+impl Format {
+    /// The format named by `path`'s extension (case-insensitive), if any.
+    pub fn from_extension(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "obj" => Some(Format::Obj),
+            "stl" => Some(Format::Stl),
+            "ply" => Some(Format::Ply),
+            _ => None,
+        }
+    }
+
+    /// Guesses the format from the first bytes of a file, if they are recognisable.
+    pub fn sniff(bytes: &[u8]) -> Option<Format> {
+        if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r") {
+            return Some(Format::Ply);
+        }
+        if stl::is_binary(bytes) {
+            return Some(Format::Stl);
+        }
+        let trimmed = trim_ascii_start(bytes);
+        if trimmed.len() >= 5 && trimmed[..5].eq_ignore_ascii_case(b"solid") {
+            return Some(Format::Stl);
+        }
+        if obj::looks_like_obj(bytes) {
+            return Some(Format::Obj);
+        }
+        None
+    }
+
+    /// Lower-case name, as used in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Obj => "OBJ",
+            Format::Stl => "STL",
+            Format::Ply => "PLY",
+        }
+    }
+}
+
+/// Loads a mesh, choosing the format from the extension (case-insensitive) or, failing that,
+/// from the contents.
+pub fn load(path: &Path) -> Result<Mesh> {
+    let bytes = read(path)?;
+    let format = match Format::from_extension(path).or_else(|| Format::sniff(&bytes)) {
+        Some(format) => format,
+        None => {
+            return Err(Error::Parse {
+                path: path.to_path_buf(),
+                line: 0,
+                message: "unknown mesh format: the extension is not .obj, .stl or .ply and the \
+                          contents look like none of them"
+                    .to_string(),
+            })
+        }
+    };
+    parse(&bytes, format, path)
+}
+
+/// Parses `bytes` as `format`; `path` is only used in error messages.
+pub fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<Mesh> {
+    match format {
+        Format::Obj => parse_obj_bytes(bytes, path),
+        Format::Stl => parse_stl(bytes, path),
+        Format::Ply => parse_ply(bytes, path),
+    }
+}
+
+/// Loads a Wavefront OBJ file.
+pub fn load_obj(path: &Path) -> Result<Mesh> {
+    parse_obj_bytes(&read(path)?, path)
+}
+
+/// Loads an STL file (ASCII or binary, detected from the contents).
+pub fn load_stl(path: &Path) -> Result<Mesh> {
+    parse_stl(&read(path)?, path)
+}
+
+/// Loads a PLY file (ASCII, binary little- or big-endian).
+pub fn load_ply(path: &Path) -> Result<Mesh> {
+    parse_ply(&read(path)?, path)
+}
+
+fn read(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        message: format!("cannot read mesh file: {e}"),
+    })
+}
+
+fn trim_ascii_start(bytes: &[u8]) -> &[u8] {
+    let start = bytes
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+        .unwrap_or(bytes.len());
+    &bytes[start..]
+}
+
+/// A parse error at `line` (0 when not applicable).
+pub(crate) fn parse_error(path: &Path, line: usize, message: impl Into<String>) -> Error {
+    Error::Parse {
+        path: path.to_path_buf(),
+        line,
+        message: message.into(),
+    }
+}
+
+/// Builds the mesh; any validation error the parser did not already report with a line number
+/// is reported against the file.
+pub(crate) fn build(
+    path: &Path,
+    positions: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+) -> Result<Mesh> {
+    if positions.is_empty() && triangles.is_empty() {
+        return Err(parse_error(
+            path,
+            0,
+            "file contains no vertices and no triangles (empty mesh)",
+        ));
+    }
+    if positions.is_empty() {
+        return Err(parse_error(path, 0, "file contains no vertices"));
+    }
+    if triangles.is_empty() {
+        return Err(parse_error(path, 0, "file contains no triangles"));
+    }
+    Mesh::new(positions, triangles).map_err(|e| match e {
+        Error::Io { .. } | Error::Parse { .. } => e,
+        other => parse_error(path, 0, format!("invalid mesh: {other}")),
+    })
+}
+
+/// Splits a polygon as a fan `(v0,v1,v2), (v0,v2,v3), …`, appending to `out`. Returns the
+/// first fan triangle that repeats a vertex index (which a [`Mesh`] rejects), if any; nothing
+/// is appended then.
+pub(crate) fn fan(corners: &[u32], out: &mut Vec<[u32; 3]>) -> std::result::Result<(), [u32; 3]> {
+    let Some((&v0, rest)) = corners.split_first() else {
+        return Ok(());
+    };
+    for pair in rest.windows(2) {
+        let t = [v0, pair[0], pair[1]];
+        if t[0] == t[1] || t[0] == t[2] || t[1] == t[2] {
+            return Err(t);
+        }
+    }
+    out.extend(rest.windows(2).map(|pair| [v0, pair[0], pair[1]]));
+    Ok(())
+}
