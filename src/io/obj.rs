@@ -9,7 +9,8 @@ use super::{build, fan, parse_error};
 use crate::error::Result;
 use crate::mesh::Mesh;
 
-/// Statements that are legal OBJ but carry nothing a triangle mesh needs.
+/// Statements that are legal OBJ but carry nothing a triangle mesh needs (also used to
+/// recognise an OBJ file by its first statement).
 const IGNORED: &[&str] = &[
     "vt",
     "vn",
@@ -159,14 +160,10 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<Mesh> {
                     )
                 })?;
             }
-            k if IGNORED.contains(&k) => {}
-            other => {
-                return Err(parse_error(
-                    path,
-                    line_no,
-                    format!("unknown OBJ statement '{}'", truncate(other)),
-                ))
-            }
+            // Everything else (groups, materials, texture coordinates, normals, free-form
+            // geometry, vendor extensions) does not change positions or faces: ignored, so
+            // real-world files load.
+            _ => {}
         }
     }
     if !continued.is_empty() {
