@@ -1,1 +1,746 @@
-//! Tests of `dhcd::narrow` (suite being written).
+//! Tests of `dhcd::narrow`: hand-built cases for every (degenerate) configuration, exact
+//! touching and one-ulp perturbations, and property tests against an independent exact
+//! reference (Minkowski difference + Caratheodory in `i128`).
+
+use dhcd::narrow::{
+    brute_force_pairs, brute_force_self_pairs, intersection_segment, triangles_intersect,
+};
+use dhcd::Mesh;
+use proptest::prelude::*;
+
+type Tri = [[f32; 3]; 3];
+
+// ---------------------------------------------------------------------------------------
+// Independent reference: A and B intersect iff 0 is in conv{a_i - b_j}; by Caratheodory,
+// iff 0 lies in a simplex of affinely independent difference vectors (point, segment,
+// triangle or tetrahedron). Exact in i128 for integer coordinates up to 2^26.
+// ---------------------------------------------------------------------------------------
+
+type V = [i128; 3];
+
+fn sub(a: V, b: V) -> V {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: V, b: V) -> V {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn dot(a: V, b: V) -> i128 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn det(a: V, b: V, c: V) -> i128 {
+    dot(a, cross(b, c))
+}
+/// Signed volume of the tetrahedron `p q r s` (times 6).
+fn vol(p: V, q: V, r: V, s: V) -> i128 {
+    det(sub(q, p), sub(r, p), sub(s, p))
+}
+
+fn origin_in_hull(s: &[V]) -> bool {
+    let o = [0; 3];
+    let n = s.len();
+    if s.contains(&o) {
+        return true;
+    }
+    for i in 0..n {
+        for j in i + 1..n {
+            let (u, v) = (s[i], s[j]);
+            if cross(u, v) == o && dot(u, v) < 0 {
+                return true;
+            }
+            for k in j + 1..n {
+                let w = s[k];
+                let nrm = cross(sub(v, u), sub(w, u));
+                if nrm != o
+                    && det(u, v, w) == 0
+                    && dot(nrm, cross(u, v)) >= 0
+                    && dot(nrm, cross(v, w)) >= 0
+                    && dot(nrm, cross(w, u)) >= 0
+                {
+                    return true;
+                }
+                for l in k + 1..n {
+                    let x = s[l];
+                    let d = vol(u, v, w, x);
+                    if d == 0 {
+                        continue;
+                    }
+                    let l0 = vol(o, v, w, x);
+                    let l1 = vol(u, o, w, x);
+                    let l2 = vol(u, v, o, x);
+                    let l3 = vol(u, v, w, o);
+                    if [l0, l1, l2, l3].iter().all(|&li| li == 0 || (li > 0) == (d > 0)) {
+                        return true;
+                    }
+                }
+            }
+        }
+    }
+    false
+}
+
+/// Exact reference on coordinates that are integers after scaling by `2^scale`.
+fn reference_scaled(a: &Tri, b: &Tri, scale: i32) -> bool {
+    let f = 2f64.powi(scale);
+    let conv = |p: &[f32; 3]| -> V {
+        p.map(|c| {
+            let x = f64::from(c) * f;
+            assert!(x == x.trunc() && x.abs() <= 67_108_864.0, "not a grid point: {c}");
+            x as i128
+        })
+    };
+    let mut s = Vec::with_capacity(9);
+    for p in a {
+        for q in b {
+            s.push(sub(conv(p), conv(q)));
+        }
+    }
+    origin_in_hull(&s)
+}
+
+fn reference(a: &Tri, b: &Tri) -> bool {
+    reference_scaled(a, b, 0)
+}
+
+// ---------------------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------------------
+
+const PERMS: [[usize; 3]; 6] = [
+    [0, 1, 2],
+    [1, 2, 0],
+    [2, 0, 1],
+    [0, 2, 1],
+    [2, 1, 0],
+    [1, 0, 2],
+];
+
+fn permute(t: &Tri, p: [usize; 3]) -> Tri {
+    [t[p[0]], t[p[1]], t[p[2]]]
+}
+
+fn dist_point_segment(x: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let ax = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
+    let l2: f64 = ab.iter().map(|c| c * c).sum();
+    let t = if l2 > 0.0 {
+        ((0..3).map(|k| ab[k] * ax[k]).sum::<f64>() / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (0..3)
+        .map(|k| (x[k] - a[k] - t * ab[k]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Distance (f64, approximate) from `x` to the closed triangle `t` (possibly degenerate).
+fn dist_point_tri(x: [f32; 3], t: &Tri) -> f64 {
+    let x = x.map(f64::from);
+    let [a, b, c] = t.map(|p| p.map(f64::from));
+    let e = dist_point_segment(x, a, b)
+        .min(dist_point_segment(x, b, c))
+        .min(dist_point_segment(x, c, a));
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let w = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let nn: f64 = n.iter().map(|c| c * c).sum();
+    if nn == 0.0 {
+        return e;
+    }
+    let trip = |p: [f64; 3], q: [f64; 3]| {
+        let cr = [
+            p[1] * q[2] - p[2] * q[1],
+            p[2] * q[0] - p[0] * q[2],
+            p[0] * q[1] - p[1] * q[0],
+        ];
+        (0..3).map(|k| cr[k] * n[k]).sum::<f64>()
+    };
+    // Barycentric coordinates of the projection of x onto the plane.
+    let l1 = trip(w, v) / nn;
+    let l2 = trip(u, w) / nn;
+    if l1 >= 0.0 && l2 >= 0.0 && l1 + l2 <= 1.0 {
+        let d: f64 = (0..3).map(|k| w[k] * n[k]).sum();
+        (d.abs() / nn.sqrt()).min(e)
+    } else {
+        e
+    }
+}
+
+fn scale_of(t: &Tri) -> f64 {
+    t.iter()
+        .flatten()
+        .fold(1.0f64, |m, &c| m.max(f64::from(c).abs()))
+}
+
+/// Checks the contact segment of an (ordered) pair: Some iff intersect, points on both.
+fn check_segment(a: &Tri, b: &Tri, hit: bool) {
+    let seg = intersection_segment(a, b);
+    assert_eq!(seg.is_some(), hit, "segment presence for {a:?} {b:?}");
+    if let Some(seg) = seg {
+        let tol = 1e-5 * scale_of(a).max(scale_of(b));
+        for p in seg {
+            assert!(
+                dist_point_tri(p, a) <= tol && dist_point_tri(p, b) <= tol,
+                "segment point {p:?} not on both {a:?} {b:?}"
+            );
+        }
+    }
+}
+
+/// Asserts `expected` for both argument orders and all 36 corner permutations, for the
+/// decision and the segment's presence; also checks the exact reference when `scale` is
+/// given (coordinates integral after scaling by `2^scale`).
+fn check_scaled(a: Tri, b: Tri, expected: bool, scale: Option<i32>) {
+    if let Some(s) = scale {
+        assert_eq!(
+            reference_scaled(&a, &b, s),
+            expected,
+            "reference disagrees with the hand-written expectation for {a:?} {b:?}"
+        );
+    }
+    for pa in PERMS {
+        for pb in PERMS {
+            let (x, y) = (permute(&a, pa), permute(&b, pb));
+            assert_eq!(triangles_intersect(&x, &y), expected, "{x:?} vs {y:?}");
+            assert_eq!(triangles_intersect(&y, &x), expected, "{y:?} vs {x:?}");
+            check_segment(&x, &y, expected);
+            check_segment(&y, &x, expected);
+        }
+    }
+}
+
+/// Hand-built cases use multiples of 1/4.
+fn check(a: Tri, b: Tri, expected: bool) {
+    check_scaled(a, b, expected, Some(2));
+}
+
+fn up(x: f32) -> f32 {
+    x.next_up()
+}
+fn down(x: f32) -> f32 {
+    x.next_down()
+}
+
+/// Base triangle in the plane z = 0.
+const A: Tri = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+
+// ---------------------------------------------------------------------------------------
+// General position
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn crossing_triangles_intersect() {
+    check(A, [[1.0, 1.0, -1.0], [3.0, 1.0, -1.0], [1.0, 1.0, 1.0]], true);
+    check(A, [[1.0, 1.0, -2.0], [2.0, 1.0, 2.0], [1.0, 2.0, 2.0]], true);
+}
+
+#[test]
+fn separated_triangles_do_not_intersect() {
+    // Far apart (AABB reject).
+    check(A, [[10.0, 10.0, 10.0], [11.0, 10.0, 10.0], [10.0, 11.0, 10.0]], false);
+    // Boxes overlap, strictly above the plane.
+    check(A, [[1.0, 1.0, 1.0], [3.0, 1.0, 2.0], [1.0, 1.0, 3.0]], false);
+    // Crosses the plane outside the triangle (beyond the hypotenuse).
+    check(A, [[3.0, 3.0, -1.0], [4.0, 3.0, 1.0], [3.0, 4.0, 1.0]], false);
+    // Both straddle each other's plane but miss (interlocked ring-like near miss).
+    check(
+        [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, 0.0, 4.0]],
+        [[2.0, -1.0, 6.0], [2.0, 1.0, 6.0], [2.0, 0.0, 4.5]],
+        false,
+    );
+}
+
+#[test]
+fn plane_of_b_misses_a() {
+    // b crosses a's plane beside a; a lies strictly on one side of b's plane.
+    check(
+        [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+        [[3.0, 0.0, -1.0], [3.0, 0.0, 1.0], [1.0, 3.0, 0.0]],
+        false,
+    );
+}
+
+// ---------------------------------------------------------------------------------------
+// Touching (exactly representable)
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn vertex_touches_face_edge_and_vertex() {
+    // Vertex on the face interior.
+    check(A, [[1.0, 1.0, 0.0], [2.0, 1.0, 2.0], [1.0, 2.0, 2.0]], true);
+    // Vertex on an edge.
+    check(A, [[2.0, 0.0, 0.0], [2.0, 1.0, 2.0], [2.0, -1.0, 2.0]], true);
+    // Vertex on a vertex.
+    check(A, [[4.0, 0.0, 0.0], [5.0, 1.0, 2.0], [5.0, -1.0, 2.0]], true);
+    // Vertex just outside an edge in the plane (no touch).
+    check(A, [[2.0, -1.0, 0.0], [2.0, 1.0, 2.0], [2.0, -1.0, 2.0]], false);
+}
+
+#[test]
+fn skew_edges_touch_at_a_point() {
+    // b (in the plane x = 2) has an edge lying in a's plane, overlapping a.
+    check(A, [[2.0, -1.0, 0.0], [2.0, 1.0, 0.0], [2.0, 0.0, -3.0]], true);
+    // Same but b's edge lifted to z = 1: misses.
+    check(A, [[2.0, -1.0, 1.0], [2.0, 1.0, 1.0], [2.0, 0.0, 3.0]], false);
+    // Edge-edge touching from outside the plane on both sides.
+    check(A, [[2.0, -1.0, 0.0], [2.0, -0.5, 1.0], [2.0, -0.5, -1.0]], false);
+    check(A, [[2.0, -1.0, 0.0], [2.0, 0.0, 1.0], [2.0, 0.0, -1.0]], true);
+    check(A, [[2.0, -1.0, 1.0], [2.0, 1.0, -1.0], [2.0, -3.0, 0.0]], true);
+}
+
+#[test]
+fn shared_vertex_and_shared_edge() {
+    // Shared vertex position, fanning out of the plane.
+    check(A, [[0.0, 0.0, 0.0], [-1.0, -1.0, 2.0], [-2.0, 0.0, 1.0]], true);
+    // Shared edge, folded.
+    check(A, [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, -2.0, 3.0]], true);
+    // Shared edge, coplanar, on the other side.
+    check(A, [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, -2.0, 0.0]], true);
+}
+
+#[test]
+fn identical_triangles() {
+    check(A, A, true);
+    let t = [[1.0, 2.0, 3.0], [-1.0, 0.5, 2.0], [3.0, -2.0, -1.0]];
+    for p in PERMS {
+        assert!(triangles_intersect(&t, &permute(&t, p)));
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Coplanar
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn coplanar_cases() {
+    // Overlap (edges cross, no vertex inside the other).
+    check(A, [[-1.0, 1.0, 0.0], [3.0, 1.0, 0.0], [1.0, -1.0, 0.0]], true);
+    // Containment (b inside a, and a contains b).
+    check(A, [[1.0, 1.0, 0.0], [2.0, 1.0, 0.0], [1.0, 2.0, 0.0]], true);
+    // Disjoint, boxes overlap.
+    check(A, [[3.0, 3.0, 0.0], [4.0, 4.0, 0.0], [3.0, 4.0, 0.0]], false);
+    // Vertex on edge (hypotenuse x + y = 4).
+    check(A, [[2.0, 2.0, 0.0], [4.0, 4.0, 0.0], [3.0, 5.0, 0.0]], true);
+    // Collinear edges overlapping, triangles on opposite sides.
+    check(A, [[2.0, 0.0, 0.0], [6.0, 0.0, 0.0], [4.0, -2.0, 0.0]], true);
+    // Collinear edges touching at an endpoint only.
+    check(A, [[4.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, -2.0, 0.0]], true);
+    // Collinear edges, a gap between.
+    check(A, [[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, -2.0, 0.0]], false);
+    // Star of David: two triangles, no vertex inside the other.
+    check(
+        [[0.0, 0.0, 0.0], [6.0, 0.0, 0.0], [3.0, 6.0, 0.0]],
+        [[0.0, 4.0, 0.0], [6.0, 4.0, 0.0], [3.0, -2.0, 0.0]],
+        true,
+    );
+    // Coplanar in a tilted plane x + y + z = 4.
+    check(
+        [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]],
+        [[2.0, 2.0, 0.0], [2.0, 0.0, 2.0], [0.0, 2.0, 2.0]],
+        true,
+    );
+    check(
+        [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]],
+        [[3.0, 3.0, -2.0], [5.0, 3.0, -4.0], [3.0, 5.0, -4.0]],
+        false,
+    );
+}
+
+// ---------------------------------------------------------------------------------------
+// Degenerate triangles
+// ---------------------------------------------------------------------------------------
+
+/// Segment `p q` as a degenerate triangle with its midpoint (collinear corners) and as one
+/// with a repeated endpoint position.
+fn seg_tris(p: [f32; 3], q: [f32; 3]) -> [Tri; 2] {
+    let m = [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0, (p[2] + q[2]) / 2.0];
+    [[p, m, q], [p, q, q]]
+}
+
+fn point_tri(p: [f32; 3]) -> Tri {
+    [p, p, p]
+}
+
+fn check_seg(p: [f32; 3], q: [f32; 3], b: Tri, expected: bool) {
+    for s in seg_tris(p, q) {
+        check(s, b, expected);
+    }
+}
+
+#[test]
+fn segment_vs_triangle() {
+    // Pierces the face.
+    check_seg([1.0, 1.0, -2.0], [1.0, 1.0, 2.0], A, true);
+    // Ends on the face.
+    check_seg([1.0, 1.0, 0.0], [1.0, 1.0, 2.0], A, true);
+    // Stops short of the face.
+    check_seg([1.0, 1.0, 2.0], [1.0, 1.0, 4.0], A, false);
+    // Passes beside the triangle.
+    check_seg([4.0, 4.0, -2.0], [4.0, 4.0, 2.0], A, false);
+    // Through a vertex and through an edge.
+    check_seg([4.0, 0.0, -2.0], [4.0, 0.0, 2.0], A, true);
+    check_seg([2.0, 2.0, -2.0], [2.0, 2.0, 2.0], A, true);
+    // Parallel above the plane.
+    check_seg([0.0, 0.0, 1.0], [4.0, 4.0, 1.0], A, false);
+    // In the plane: inside, crossing, outside, along an edge, touching a vertex.
+    check_seg([1.0, 1.0, 0.0], [2.0, 1.0, 0.0], A, true);
+    check_seg([-2.0, 2.0, 0.0], [6.0, 2.0, 0.0], A, true);
+    check_seg([5.0, 0.0, 0.0], [0.0, 5.0, 0.0], A, false);
+    check_seg([-2.0, 0.0, 0.0], [6.0, 0.0, 0.0], A, true);
+    check_seg([4.0, 0.0, 0.0], [6.0, 2.0, 0.0], A, true);
+    check_seg([5.0, 0.0, 0.0], [6.0, 2.0, 0.0], A, false);
+}
+
+#[test]
+fn point_vs_triangle() {
+    check(point_tri([1.0, 1.0, 0.0]), A, true);
+    check(point_tri([2.0, 0.0, 0.0]), A, true);
+    check(point_tri([0.0, 4.0, 0.0]), A, true);
+    check(point_tri([1.0, 1.0, 1.0]), A, false);
+    check(point_tri([3.0, 3.0, 0.0]), A, false);
+    check(point_tri([-1.0, 0.0, 0.0]), A, false);
+}
+
+#[test]
+fn segment_vs_segment() {
+    let s = seg_tris([0.0, 0.0, 0.0], [4.0, 4.0, 0.0]);
+    let check_ss = |p: [f32; 3], q: [f32; 3], expected: bool| {
+        for a in s {
+            for b in seg_tris(p, q) {
+                check(a, b, expected);
+            }
+        }
+    };
+    // Crossing in a plane, touching at an end, T-junction, missing.
+    check_ss([0.0, 4.0, 0.0], [4.0, 0.0, 0.0], true);
+    check_ss([4.0, 4.0, 0.0], [6.0, 0.0, 0.0], true);
+    check_ss([2.0, 2.0, 0.0], [4.0, 0.0, 0.0], true);
+    check_ss([3.0, 1.0, 0.0], [4.0, 0.0, 0.0], false);
+    // Skew (non-coplanar), crossing above.
+    check_ss([0.0, 4.0, 1.0], [4.0, 0.0, 1.0], false);
+    // Non-coplanar but the lines meet: crossing in a vertical plane.
+    check_ss([2.0, 2.0, -1.0], [2.0, 2.0, 1.0], true);
+    // Collinear: overlapping, touching, disjoint, containing.
+    check_ss([3.0, 3.0, 0.0], [6.0, 6.0, 0.0], true);
+    check_ss([4.0, 4.0, 0.0], [6.0, 6.0, 0.0], true);
+    check_ss([5.0, 5.0, 0.0], [6.0, 6.0, 0.0], false);
+    check_ss([-1.0, -1.0, 0.0], [6.0, 6.0, 0.0], true);
+    // Parallel, distinct lines.
+    check_ss([0.0, 1.0, 0.0], [4.0, 5.0, 0.0], false);
+    // Collinear along a line with dx = 0 (lexicographic order on y, z).
+    check(
+        seg_tris([1.0, 0.0, 0.0], [1.0, 2.0, 2.0])[0],
+        seg_tris([1.0, 1.0, 1.0], [1.0, 3.0, 3.0])[0],
+        true,
+    );
+    check(
+        seg_tris([1.0, 0.0, 0.0], [1.0, 2.0, 2.0])[0],
+        seg_tris([1.0, 3.0, 3.0], [1.0, 4.0, 4.0])[0],
+        false,
+    );
+}
+
+#[test]
+fn point_vs_segment_and_point() {
+    let s = seg_tris([0.0, 0.0, 0.0], [4.0, 2.0, 2.0]);
+    for a in s {
+        check(a, point_tri([2.0, 1.0, 1.0]), true);
+        check(a, point_tri([4.0, 2.0, 2.0]), true);
+        check(a, point_tri([6.0, 3.0, 3.0]), false);
+        check(a, point_tri([2.0, 1.0, 2.0]), false);
+    }
+    check(point_tri([1.0, 2.0, 3.0]), point_tri([1.0, 2.0, 3.0]), true);
+    check(point_tri([1.0, 2.0, 3.0]), point_tri([1.0, 2.0, 4.0]), false);
+    // A point-triangle with a repeated corner vs a collinear one.
+    check(
+        [[1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [3.0, 3.0, 3.0]],
+        point_tri([2.0, 2.0, 2.0]),
+        true,
+    );
+}
+
+#[test]
+fn negative_zero_is_zero() {
+    let b = [[-0.0, -0.0, -0.0], [-1.0, 0.0, 1.0], [0.0, -1.0, 1.0]];
+    check(A, b, true);
+    check(point_tri([-0.0, 0.0, -0.0]), A, true);
+}
+
+// ---------------------------------------------------------------------------------------
+// One-ulp perturbations
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn ulp_perturbations_separate_and_merge() {
+    // Vertex on the face; one ulp up separates, one ulp down pierces.
+    let b = |z: f32| [[1.0, 1.0, z], [2.0, 1.0, 2.0], [1.0, 2.0, 2.0]];
+    check_scaled(A, b(0.0), true, Some(2));
+    check_scaled(A, b(up(0.0)), false, None);
+    check_scaled(A, b(down(0.0)), true, None);
+    // Vertex on the face at a non-zero height plane z = 1.
+    let a1 = A.map(|p| [p[0], p[1], 1.0]);
+    let b1 = |z: f32| [[1.0, 1.0, z], [2.0, 1.0, 3.0], [1.0, 2.0, 3.0]];
+    check_scaled(a1, b1(1.0), true, Some(2));
+    check_scaled(a1, b1(up(1.0)), false, Some(23));
+    check_scaled(a1, b1(down(1.0)), true, Some(24));
+    // Coplanar vertex on the hypotenuse x + y = 4; nudge outward / inward.
+    let c = |x: f32| [[x, 2.0, 0.0], [4.0, 4.0, 0.0], [3.0, 5.0, 0.0]];
+    check_scaled(A, c(2.0), true, Some(2));
+    check_scaled(A, c(up(2.0)), false, Some(22));
+    check_scaled(A, c(down(2.0)), true, Some(23));
+    // Segment parallel to the face, one ulp above / on.
+    let s = |z: f32| [[1.0, 1.0, z], [1.5, 1.5, z], [2.0, 2.0, z]];
+    check_scaled(A, s(0.0), true, Some(2));
+    check_scaled(A, s(up(0.0)), false, None);
+    // Skew edges: one ulp apart in z at the crossing point.
+    let e = |z: f32| [[2.0, -1.0, z], [2.0, 1.0, z], [2.0, 0.0, 3.0]];
+    check_scaled(A, e(0.0), true, Some(2));
+    check_scaled(A, e(up(0.0)), false, None);
+    // Collinear segments touching at an endpoint; nudge apart by one ulp.
+    let p = |x: f32| point_tri([x, 0.0, 0.0]);
+    check_scaled(A, p(4.0), true, Some(2));
+    check_scaled(A, p(up(4.0)), false, Some(21));
+    check_scaled(A, p(down(4.0)), true, Some(22));
+}
+
+// ---------------------------------------------------------------------------------------
+// intersection_segment
+// ---------------------------------------------------------------------------------------
+
+fn same_segment(s: [[f32; 3]; 2], p: [f32; 3], q: [f32; 3]) -> bool {
+    (s[0] == p && s[1] == q) || (s[0] == q && s[1] == p)
+}
+
+#[test]
+fn segment_of_crossing_triangles_is_exact_here() {
+    let b = [[1.0, 1.0, -1.0], [3.0, 1.0, -1.0], [1.0, 1.0, 1.0]];
+    let s = intersection_segment(&A, &b).expect("they cross");
+    assert!(same_segment(s, [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]), "{s:?}");
+    let s = intersection_segment(&b, &A).expect("they cross");
+    assert!(same_segment(s, [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]), "{s:?}");
+}
+
+#[test]
+fn segment_of_single_point_contact_is_a_point() {
+    let b = [[1.0, 1.0, 0.0], [2.0, 1.0, 2.0], [1.0, 2.0, 2.0]];
+    let s = intersection_segment(&A, &b).expect("touch");
+    assert_eq!(s, [[1.0, 1.0, 0.0]; 2]);
+    let b = [[4.0, 0.0, 0.0], [5.0, 1.0, 2.0], [5.0, -1.0, 2.0]];
+    assert_eq!(intersection_segment(&b, &A), Some([[4.0, 0.0, 0.0]; 2]));
+}
+
+#[test]
+fn segment_of_coplanar_overlap_is_a_diameter() {
+    // Identical: the longest edge (the hypotenuse).
+    let s = intersection_segment(&A, &A).expect("identical");
+    assert!(same_segment(s, [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]), "{s:?}");
+    // Collinear shared edge overlap [2, 4] on the x axis.
+    let b = [[2.0, 0.0, 0.0], [6.0, 0.0, 0.0], [4.0, -2.0, 0.0]];
+    let s = intersection_segment(&A, &b).expect("edge overlap");
+    assert!(same_segment(s, [2.0, 0.0, 0.0], [4.0, 0.0, 0.0]), "{s:?}");
+    // Segment vs segment collinear overlap.
+    let s = intersection_segment(
+        &seg_tris([0.0, 0.0, 0.0], [4.0, 4.0, 4.0])[0],
+        &seg_tris([2.0, 2.0, 2.0], [6.0, 6.0, 6.0])[1],
+    )
+    .expect("overlap");
+    assert!(same_segment(s, [2.0, 2.0, 2.0], [4.0, 4.0, 4.0]), "{s:?}");
+    assert_eq!(
+        intersection_segment(&A, &[[9.0, 9.0, 9.0], [9.0, 9.0, 9.0], [9.0, 9.0, 9.0]]),
+        None
+    );
+}
+
+// ---------------------------------------------------------------------------------------
+// Brute-force oracles
+// ---------------------------------------------------------------------------------------
+
+/// A grid of `n x n` quads (two triangles each) in the plane z = `z`, spanning [0, n].
+fn grid(n: u32, z: f32, tilt: f32) -> Mesh {
+    let mut pos = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            pos.push([i as f32, j as f32, z + tilt * i as f32]);
+        }
+    }
+    let mut tris = Vec::new();
+    let v = |i: u32, j: u32| j * (n + 1) + i;
+    for j in 0..n {
+        for i in 0..n {
+            tris.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+            tris.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+        }
+    }
+    Mesh::new(pos, tris).expect("valid grid")
+}
+
+fn pairs_by_reference(a: &Mesh, b: &Mesh) -> Vec<[u32; 2]> {
+    let mut out = Vec::new();
+    for i in 0..a.triangle_count() {
+        for j in 0..b.triangle_count() {
+            if reference(&a.corners(i), &b.corners(j)) {
+                out.push([i as u32, j as u32]);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn brute_force_pairs_matches_reference() {
+    let a = grid(3, 0.0, 0.0);
+    // Tilted sheet crossing the flat one along x = 1.
+    let b = grid(3, -1.0, 1.0);
+    let got = brute_force_pairs(&a, &b);
+    assert!(!got.is_empty());
+    assert!(got.windows(2).all(|w| w[0] < w[1]), "sorted and unique");
+    assert_eq!(got, pairs_by_reference(&a, &b));
+    // A sheet lifted by 1 is disjoint from the flat one except nothing.
+    let c = grid(3, 1.0, 0.0);
+    assert!(brute_force_pairs(&a, &c).is_empty());
+    // Identical meshes: every pair that touches (shares a point) is reported.
+    let same = brute_force_pairs(&a, &a);
+    assert_eq!(same, pairs_by_reference(&a, &a));
+    assert!(same.contains(&[0, 0]) && same.contains(&[0, 1]));
+}
+
+#[test]
+fn brute_force_self_pairs_skips_shared_vertices() {
+    // A flat grid touches itself only through shared vertices: no self pairs.
+    let g = grid(3, 0.0, 0.0);
+    assert!(brute_force_self_pairs(&g).is_empty());
+    // Two crossing quads in one mesh (disjoint index sets) plus a fan sharing vertex 0.
+    let pos = vec![
+        [0.0, 0.0, 0.0],
+        [4.0, 0.0, 0.0],
+        [4.0, 4.0, 0.0],
+        [0.0, 4.0, 0.0],
+        [2.0, 2.0, -1.0],
+        [2.0, 2.0, 1.0],
+        [3.0, -1.0, 1.0],
+        // Lies in the plane z = 0 touching triangle 0 at a vertex position only.
+        [-1.0, -1.0, 0.0],
+        [-2.0, 0.0, 0.0],
+    ];
+    let tris = vec![
+        [0, 1, 2],
+        [0, 2, 3],
+        [4, 5, 6],
+        [0, 7, 8], // shares vertex 0 with triangles 0 and 1: skipped
+    ];
+    let m = Mesh::new(pos, tris).expect("valid");
+    let got = brute_force_self_pairs(&m);
+    let mut want = Vec::new();
+    for i in 0..m.triangle_count() {
+        for j in i + 1..m.triangle_count() {
+            let (ti, tj) = (m.triangles()[i], m.triangles()[j]);
+            if ti.iter().any(|v| tj.contains(v)) {
+                continue;
+            }
+            if reference(&m.corners(i), &m.corners(j)) {
+                want.push([i as u32, j as u32]);
+            }
+        }
+    }
+    assert_eq!(got, want);
+    assert!(got.contains(&[0, 2]) || got.contains(&[1, 2]));
+    assert!(!got.iter().any(|p| p[1] == 3));
+}
+
+// ---------------------------------------------------------------------------------------
+// Property tests against the reference
+// ---------------------------------------------------------------------------------------
+
+fn grid_tri(r: i32) -> impl Strategy<Value = Tri> {
+    prop::array::uniform3(prop::array::uniform3((-r..=r).prop_map(|c| c as f32)))
+}
+
+/// Integer coordinates up to 2^24 / 4: `b` is built from `a` with small offsets so that
+/// most pairs are near each other, sharing corners now and then.
+fn near_pair() -> impl Strategy<Value = (Tri, Tri)> {
+    let big = -(1 << 22)..(1 << 22);
+    (
+        prop::array::uniform3(prop::array::uniform3(big.clone())),
+        prop::array::uniform3(prop::array::uniform3(-64i32..=64)),
+        prop::array::uniform3(0usize..4),
+        0u32..6,
+    )
+        .prop_map(|(a, off, pick, shift)| {
+            let a: Tri = a.map(|p| p.map(|c| c as f32));
+            let centroid = |k: usize| (a[0][k] + a[1][k] + a[2][k]) / 3.0;
+            let mut b = [[0.0f32; 3]; 3];
+            for i in 0..3 {
+                for k in 0..3 {
+                    let base = if pick[i] < 3 {
+                        a[pick[i]][k]
+                    } else {
+                        centroid(k).round()
+                    };
+                    b[i][k] = base + (off[i][k] << shift) as f32;
+                }
+            }
+            (a, b)
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+
+    #[test]
+    fn small_grid_matches_reference(a in grid_tri(2), b in grid_tri(2)) {
+        let want = reference(&a, &b);
+        prop_assert_eq!(triangles_intersect(&a, &b), want);
+        prop_assert_eq!(triangles_intersect(&b, &a), want);
+        check_segment(&a, &b, want);
+        for p in PERMS {
+            prop_assert_eq!(triangles_intersect(&permute(&a, p), &b), want);
+            prop_assert_eq!(triangles_intersect(&a, &permute(&b, p)), want);
+        }
+    }
+
+    #[test]
+    fn flat_grid_matches_reference(a in grid_tri(3), b in grid_tri(3), ka in 0usize..3, kb in 0usize..3) {
+        // Flatten onto coordinate planes to force coplanar and degenerate cases.
+        let (mut a, mut b) = (a, b);
+        for p in &mut a { p[ka] = 0.0; }
+        for p in &mut b { p[kb] = 0.0; }
+        let want = reference(&a, &b);
+        prop_assert_eq!(triangles_intersect(&a, &b), want);
+        prop_assert_eq!(triangles_intersect(&b, &a), want);
+        check_segment(&a, &b, want);
+    }
+
+    #[test]
+    fn near_pairs_match_reference((a, b) in near_pair()) {
+        let want = reference(&a, &b);
+        prop_assert_eq!(triangles_intersect(&a, &b), want);
+        prop_assert_eq!(triangles_intersect(&b, &a), want);
+        prop_assert_eq!(intersection_segment(&a, &b).is_some(), want);
+    }
+
+    #[test]
+    fn random_floats_are_symmetric_and_permutation_invariant(
+        a in prop::array::uniform3(prop::array::uniform3(-1.0f32..1.0)),
+        b in prop::array::uniform3(prop::array::uniform3(-1.0f32..1.0)),
+    ) {
+        let want = triangles_intersect(&a, &b);
+        prop_assert_eq!(triangles_intersect(&b, &a), want);
+        for p in PERMS {
+            prop_assert_eq!(triangles_intersect(&permute(&a, p), &permute(&b, p)), want);
+        }
+        check_segment(&a, &b, want);
+        // The reference needs integral coordinates after scaling: compare on a 2^-20 grid.
+        let snap = |t: Tri| t.map(|p| p.map(|c| (c * 1_048_576.0).round() / 1_048_576.0));
+        let (sa, sb) = (snap(a), snap(b));
+        prop_assert_eq!(triangles_intersect(&sa, &sb), reference_scaled(&sa, &sb, 20));
+    }
+}

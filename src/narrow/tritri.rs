@@ -1,0 +1,375 @@
+//! The exact closed triangle-triangle test, written once and used both to decide
+//! intersection (early exit) and to collect the points of the intersection region.
+//!
+//! Formulation: two closed triangles (possibly degenerate) intersect iff some edge of one
+//! meets the other closed triangle. A degenerate triangle (collinear or coincident corners)
+//! *is* the segment between its lexicographically smallest and largest corners, and is
+//! tested as that segment (or point).
+
+use super::predicates::{
+    keep, lerp, lex_le, orient2d, orient3d, projection_axis, sign, Tri, P3,
+};
+
+/// Receives the candidate points of the intersection region. With `COLLECT = false` the
+/// test stops at the first hit and computes no points.
+pub(crate) trait Sink {
+    const COLLECT: bool;
+    fn push(&mut self, p: [f64; 3]);
+}
+
+/// Decision only.
+pub(crate) struct Decide;
+
+impl Sink for Decide {
+    const COLLECT: bool = false;
+    #[inline(always)]
+    fn push(&mut self, _: [f64; 3]) {}
+}
+
+/// Candidate points (a superset of the vertices of the convex intersection region, each
+/// lying on it up to `f64` rounding).
+pub(crate) struct Points {
+    pub(crate) pts: [[f64; 3]; Points::CAP],
+    pub(crate) len: usize,
+}
+
+impl Points {
+    /// Upper bound on pushes: 6 edges x (2 endpoints + 3 edge crossings x up to 4 points).
+    const CAP: usize = 96;
+
+    pub(crate) fn new() -> Self {
+        Self {
+            pts: [[0.0; 3]; Self::CAP],
+            len: 0,
+        }
+    }
+
+    pub(crate) fn as_slice(&self) -> &[[f64; 3]] {
+        &self.pts[..self.len]
+    }
+}
+
+impl Sink for Points {
+    const COLLECT: bool = true;
+    fn push(&mut self, p: [f64; 3]) {
+        if self.pts[..self.len].contains(&p) {
+            return;
+        }
+        debug_assert!(self.len < Self::CAP, "candidate buffer overflow");
+        if self.len < Self::CAP {
+            self.pts[self.len] = p;
+            self.len += 1;
+        }
+    }
+}
+
+#[inline(always)]
+fn to64(p: &P3) -> [f64; 3] {
+    p.map(f64::from)
+}
+
+/// Closed axis-aligned boxes of the corners overlap (comparisons only: exact).
+#[inline(always)]
+fn aabb_overlap(a: &Tri, b: &Tri) -> bool {
+    for k in 0..3 {
+        let amin = a[0][k].min(a[1][k]).min(a[2][k]);
+        let amax = a[0][k].max(a[1][k]).max(a[2][k]);
+        let bmin = b[0][k].min(b[1][k]).min(b[2][k]);
+        let bmax = b[0][k].max(b[1][k]).max(b[2][k]);
+        if amax < bmin || bmax < amin {
+            return false;
+        }
+    }
+    true
+}
+
+/// All three strictly on the same side.
+#[inline(always)]
+fn one_side(d: &[f64; 3]) -> bool {
+    (d[0] > 0.0 && d[1] > 0.0 && d[2] > 0.0) || (d[0] < 0.0 && d[1] < 0.0 && d[2] < 0.0)
+}
+
+/// The segment a degenerate triangle is: its lexicographically extreme corners (indices).
+#[inline]
+fn extreme_corners(t: &Tri) -> (usize, usize) {
+    let (mut lo, mut hi) = (0, 0);
+    for i in 1..3 {
+        if !lex_le(&t[lo], &t[i]) {
+            lo = i;
+        }
+        if lex_le(&t[hi], &t[i]) {
+            hi = i;
+        }
+    }
+    (lo, hi)
+}
+
+/// The core test. Returns whether the closed triangles intersect; with a collecting sink,
+/// also pushes candidate points of the intersection (at least one iff `true`).
+#[inline]
+pub(crate) fn tri_tri<S: Sink>(a: &Tri, b: &Tri, sink: &mut S) -> bool {
+    if !aabb_overlap(a, b) {
+        return false;
+    }
+    // Corners of `b` against the plane of `a` (all zero if `a` is degenerate).
+    let db = [
+        orient3d(&a[0], &a[1], &a[2], &b[0]),
+        orient3d(&a[0], &a[1], &a[2], &b[1]),
+        orient3d(&a[0], &a[1], &a[2], &b[2]),
+    ];
+    if one_side(&db) {
+        return false;
+    }
+    let da = [
+        orient3d(&b[0], &b[1], &b[2], &a[0]),
+        orient3d(&b[0], &b[1], &b[2], &a[1]),
+        orient3d(&b[0], &b[1], &b[2], &a[2]),
+    ];
+    if one_side(&da) {
+        return false;
+    }
+    tri_tri_full(a, &da, b, &db, sink)
+}
+
+/// Everything after the cheap filters (kept out of line so the filters inline well).
+#[inline(never)]
+fn tri_tri_full<S: Sink>(a: &Tri, da: &[f64; 3], b: &Tri, db: &[f64; 3], sink: &mut S) -> bool {
+    // A nonzero orient3d against a's plane proves a non-degenerate.
+    let a_axis = if db.iter().all(|&d| d == 0.0) {
+        projection_axis(&a[0], &a[1], &a[2])
+    } else {
+        Some(usize::MAX)
+    };
+    let b_axis = if da.iter().all(|&d| d == 0.0) {
+        projection_axis(&b[0], &b[1], &b[2])
+    } else {
+        Some(usize::MAX)
+    };
+    match (a_axis, b_axis) {
+        (Some(ka), Some(kb)) => {
+            let hit = edges_vs_tri(a, da, b, kb, sink);
+            if hit && !S::COLLECT {
+                return true;
+            }
+            edges_vs_tri(b, db, a, ka, sink) || hit
+        }
+        (None, Some(kb)) => {
+            let (i, j) = extreme_corners(a);
+            seg_vs_tri(&a[i], &a[j], da[i], da[j], b, kb, sink)
+        }
+        (Some(ka), None) => {
+            let (i, j) = extreme_corners(b);
+            seg_vs_tri(&b[i], &b[j], db[i], db[j], a, ka, sink)
+        }
+        (None, None) => {
+            let (i, j) = extreme_corners(a);
+            let (k, l) = extreme_corners(b);
+            seg_seg_3d(&a[i], &a[j], &b[k], &b[l], sink)
+        }
+    }
+}
+
+/// Edges of `s` against the non-degenerate triangle `t`; `ds[i]` is the orientation of
+/// `s[i]` against the plane of `t`; `axis` is a projection keeping `t` non-degenerate, or
+/// `usize::MAX` meaning "not computed yet".
+#[inline]
+fn edges_vs_tri<S: Sink>(s: &Tri, ds: &[f64; 3], t: &Tri, axis: usize, sink: &mut S) -> bool {
+    let mut hit = false;
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        if seg_vs_tri(&s[i], &s[j], ds[i], ds[j], t, axis, sink) {
+            if !S::COLLECT {
+                return true;
+            }
+            hit = true;
+        }
+    }
+    hit
+}
+
+/// Closed segment `pq` against the non-degenerate closed triangle `t`; `sp`, `sq` are the
+/// orientations of `p`, `q` against the plane of `t`.
+#[inline]
+fn seg_vs_tri<S: Sink>(
+    p: &P3,
+    q: &P3,
+    sp: f64,
+    sq: f64,
+    t: &Tri,
+    axis: usize,
+    sink: &mut S,
+) -> bool {
+    if (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
+        return false;
+    }
+    if sp == 0.0 && sq == 0.0 {
+        let k = if axis == usize::MAX {
+            match projection_axis(&t[0], &t[1], &t[2]) {
+                Some(k) => k,
+                None => unreachable!("seg_vs_tri needs a non-degenerate triangle"),
+            }
+        } else {
+            axis
+        };
+        return coplanar_seg_tri(p, q, t, k, sink);
+    }
+    // The segment meets the plane in exactly one point X; X is in the closed triangle iff
+    // the signs of [p,q,t0,t1], [p,q,t1,t2], [p,q,t2,t0] are not strictly mixed.
+    let s0 = sign(orient3d(p, q, &t[0], &t[1]));
+    let s1 = sign(orient3d(p, q, &t[1], &t[2]));
+    if s0 * s1 < 0 {
+        return false;
+    }
+    let s2 = sign(orient3d(p, q, &t[2], &t[0]));
+    if s0 * s2 < 0 || s1 * s2 < 0 {
+        return false;
+    }
+    if S::COLLECT {
+        let x = if sp == 0.0 {
+            to64(p)
+        } else if sq == 0.0 {
+            to64(q)
+        } else {
+            lerp(p, q, sp / (sp - sq))
+        };
+        sink.push(x);
+    }
+    true
+}
+
+/// Point `x` in the closed triangle `t`, all in the plane, projected along `k` where `t`
+/// is non-degenerate.
+#[inline]
+fn point_in_tri_2d(k: usize, x: &P3, t: &Tri) -> bool {
+    let e0 = sign(orient2d(k, &t[0], &t[1], x));
+    let e1 = sign(orient2d(k, &t[1], &t[2], x));
+    let e2 = sign(orient2d(k, &t[2], &t[0], x));
+    !((e0 < 0 || e1 < 0 || e2 < 0) && (e0 > 0 || e1 > 0 || e2 > 0))
+}
+
+/// Segment `pq` lying in the plane of the non-degenerate triangle `t` (projection `k`).
+fn coplanar_seg_tri<S: Sink>(p: &P3, q: &P3, t: &Tri, k: usize, sink: &mut S) -> bool {
+    let mut hit = false;
+    for x in [p, q] {
+        if point_in_tri_2d(k, x, t) {
+            if !S::COLLECT {
+                return true;
+            }
+            sink.push(to64(x));
+            hit = true;
+        }
+    }
+    // Neither endpoint inside: the segment meets the triangle iff it meets its boundary.
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        if seg_seg_2d(k, p, q, &t[i], &t[j], sink) {
+            if !S::COLLECT {
+                return true;
+            }
+            hit = true;
+        }
+    }
+    hit
+}
+
+/// Closed segments `pq` and `rs` (either may be a point) whose affine hull the projection
+/// along `k` maps injectively.
+fn seg_seg_2d<S: Sink>(k: usize, p: &P3, q: &P3, r: &P3, s: &P3, sink: &mut S) -> bool {
+    let o1 = sign(orient2d(k, p, q, r));
+    let o2 = sign(orient2d(k, p, q, s));
+    if o1 * o2 > 0 {
+        return false;
+    }
+    let o3 = orient2d(k, r, s, p);
+    let o4 = orient2d(k, r, s, q);
+    if sign(o3) * sign(o4) > 0 {
+        return false;
+    }
+    if o1 == 0 && o2 == 0 && o3 == 0.0 && o4 == 0.0 {
+        // All four collinear (or points): the projection is injective on their line.
+        let (i, j) = keep(k);
+        return collinear_overlap(p, q, r, s, |v| [v[i], v[j]], sink);
+    }
+    if S::COLLECT {
+        // Not all collinear, so p, q are not both on line rs: o3 != o4.
+        let x = if o3 == 0.0 {
+            to64(p)
+        } else if o4 == 0.0 {
+            to64(q)
+        } else if o3 != o4 {
+            lerp(p, q, o3 / (o3 - o4))
+        } else {
+            to64(p)
+        };
+        sink.push(x);
+    }
+    true
+}
+
+/// Collinear closed segments `pq`, `rs`: overlap decided by lexicographic comparison of
+/// `key` (any coordinates injective on their common line).
+#[inline]
+fn collinear_overlap<S: Sink, K: AsRef<[f32]>>(
+    p: &P3,
+    q: &P3,
+    r: &P3,
+    s: &P3,
+    key: impl Fn(&P3) -> K,
+    sink: &mut S,
+) -> bool {
+    let (kp, kq, kr, ks) = (key(p), key(q), key(r), key(s));
+    let (lo1, hi1) = if lex_le(kp.as_ref(), kq.as_ref()) {
+        (&kp, &kq)
+    } else {
+        (&kq, &kp)
+    };
+    let (lo2, hi2) = if lex_le(kr.as_ref(), ks.as_ref()) {
+        (&kr, &ks)
+    } else {
+        (&ks, &kr)
+    };
+    let hit = lex_le(lo1.as_ref(), hi2.as_ref()) && lex_le(lo2.as_ref(), hi1.as_ref());
+    if S::COLLECT && hit {
+        let within = |x: &K, lo: &K, hi: &K| {
+            lex_le(lo.as_ref(), x.as_ref()) && lex_le(x.as_ref(), hi.as_ref())
+        };
+        for (x, kx) in [(p, &kp), (q, &kq)] {
+            if within(kx, lo2, hi2) {
+                sink.push(to64(x));
+            }
+        }
+        for (x, kx) in [(r, &kr), (s, &ks)] {
+            if within(kx, lo1, hi1) {
+                sink.push(to64(x));
+            }
+        }
+    }
+    hit
+}
+
+/// Closed segments (or points) `pq`, `rs` in 3D.
+fn seg_seg_3d<S: Sink>(p: &P3, q: &P3, r: &P3, s: &P3, sink: &mut S) -> bool {
+    if orient3d(p, q, r, s) != 0.0 {
+        return false;
+    }
+    // Coplanar. If the four points span a plane, some triple spans it and the projection
+    // along its dominant normal axis is injective on it.
+    let mut best = None;
+    let mut best_abs = 0.0;
+    for k in 0..3 {
+        for o in [
+            orient2d(k, p, q, r),
+            orient2d(k, p, q, s),
+            orient2d(k, r, s, p),
+            orient2d(k, r, s, q),
+        ] {
+            if o.abs() > best_abs {
+                best_abs = o.abs();
+                best = Some(k);
+            }
+        }
+    }
+    match best {
+        Some(k) => seg_seg_2d(k, p, q, r, s, sink),
+        // Every projected triple collinear: all four points on one line (3D lex order).
+        None => collinear_overlap(p, q, r, s, |x| *x, sink),
+    }
+}
