@@ -92,6 +92,55 @@ fn run<K: BvKind>(
     ws: &mut Workspace,
     parallel: bool,
 ) -> Contacts {
+    let mut counters = traverse(a, b, ws, parallel);
+    let (pairs, prim_tests) = narrow_phase(a, b, ws, parallel);
+    counters.prim_tests = prim_tests;
+    counters.contacts = pairs.len() as u64;
+    Contacts { pairs, counters }
+}
+
+/// The hierarchy part of a query alone (benchmarks): lazy refit and traversal down to the
+/// overlapping leaf pairs, no triangle tests. Returns the counters of that part (`N_V`,
+/// `N_U`; `prim_tests` is the number of triangle pairs the narrow phase *would* test,
+/// `contacts` is 0) and the leaf pairs (internal node ids, in traversal order).
+#[doc(hidden)]
+pub fn traverse_with<'w, K: BvKind>(
+    a: &mut Hierarchy<K>,
+    b: &mut Hierarchy<K>,
+    ws: &'w mut Workspace,
+    par: Par,
+) -> (Counters, &'w [[u32; 2]]) {
+    let mut counters = par.install(|| traverse(a, b, ws, par.is_parallel()));
+    let (ta, tb) = (a.tree(), b.tree());
+    counters.prim_tests = ws
+        .leaves
+        .iter()
+        .map(|&[la, lb]| (ta.tri_range(la as usize).len() * tb.tri_range(lb as usize).len()) as u64)
+        .sum();
+    (counters, &ws.leaves)
+}
+
+/// The narrow phase alone (benchmarks): exact tests of the leaf pairs the last
+/// [`traverse_with`] on `ws` left there (the hierarchies must not have changed since).
+/// Returns the sorted contacts and `N_P`.
+#[doc(hidden)]
+pub fn narrow_with<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    ws: &mut Workspace,
+    par: Par,
+) -> (Vec<[u32; 2]>, u64) {
+    par.install(|| narrow_phase(a, b, ws, par.is_parallel()))
+}
+
+/// Refit (lazy) and level-synchronous traversal; leaves the overlapping leaf pairs in
+/// `ws.leaves` and returns `N_V` and `N_U`.
+fn traverse<K: BvKind>(
+    a: &mut Hierarchy<K>,
+    b: &mut Hierarchy<K>,
+    ws: &mut Workspace,
+    parallel: bool,
+) -> Counters {
     let mut counters = Counters::default();
     let grain = ws.grain;
     ws.leaves.clear();
@@ -156,7 +205,20 @@ fn run<K: BvKind>(
     }
     counters.bv_updates = a.take_updates() + b.take_updates();
 
-    let (ha, hb) = (&*a, &*b);
+    counters
+}
+
+/// The exact narrow phase on the leaf pairs in `ws.leaves`: the intersecting triangle pairs
+/// (original indices, sorted) and the number of triangle pairs tested (`N_P`).
+fn narrow_phase<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    ws: &mut Workspace,
+    parallel: bool,
+) -> (Vec<[u32; 2]>, u64) {
+    let (ha, hb) = (a, b);
+    let grain = ws.grain;
+    let mut prim_tests = 0u64;
     let leaf_grain = (grain / 64).max(1);
     let mut pairs = Vec::new();
     if parallel && ws.leaves.len() > leaf_grain {
@@ -174,16 +236,15 @@ fn run<K: BvKind>(
             .collect();
         for (out, tested) in parts {
             pairs.extend_from_slice(&out);
-            counters.prim_tests += tested;
+            prim_tests += tested;
         }
     } else {
         for &[la, lb] in &ws.leaves {
-            counters.prim_tests += narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut pairs);
+            prim_tests += narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut pairs);
         }
     }
     pairs.sort_unstable();
-    counters.contacts = pairs.len() as u64;
-    Contacts { pairs, counters }
+    (pairs, prim_tests)
 }
 
 /// The output of expanding one chunk of a frontier.
