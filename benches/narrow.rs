@@ -116,6 +116,15 @@ fn bench(c: &mut Criterion) {
         })
     });
     g.throughput(Throughput::Elements(hitting.len() as u64));
+    g.bench_function("tritri_on_hits", |bch| {
+        bch.iter(|| {
+            let mut n = 0u32;
+            for (a, b) in black_box(&hitting) {
+                n += u32::from(triangles_intersect(a, b));
+            }
+            n
+        })
+    });
     g.bench_function("segment_on_hits", |bch| {
         bch.iter(|| {
             let mut acc = 0.0f32;

@@ -21,9 +21,41 @@ fn c3(p: &P3) -> Coord3D<f64> {
     }
 }
 
-/// Sign-exact orientation of `d` against the plane through `a, b, c` (zero iff coplanar).
+/// Shewchuk's static error bound for the floating-point `orient3d` (same constant as
+/// `robust`): `(7 + 56 eps) eps`, `eps = 2^-53`.
+const O3D_ERRBOUND_A: f64 = (7.0 + 56.0 * EPS) * EPS;
+const EPS: f64 = f64::EPSILON / 2.0;
+
+/// Sign-exact orientation of `d` against the plane through `a, b, c` (zero iff coplanar);
+/// same sign convention as `robust::orient3d`.
+///
+/// PERF: `robust::orient3d` is not inlined across the crate boundary and the call costs
+/// as much as the arithmetic; this is its floating-point stage (Shewchuk's filter, same
+/// formula and bound) inlined here, falling back to `robust::orient3d` (whose adaptive
+/// stages are exact) only when the filter cannot certify the sign.
 #[inline(always)]
 pub(crate) fn orient3d(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
+    let f = f64::from;
+    let (adx, bdx, cdx) = (f(a[0]) - f(d[0]), f(b[0]) - f(d[0]), f(c[0]) - f(d[0]));
+    let (ady, bdy, cdy) = (f(a[1]) - f(d[1]), f(b[1]) - f(d[1]), f(c[1]) - f(d[1]));
+    let (adz, bdz, cdz) = (f(a[2]) - f(d[2]), f(b[2]) - f(d[2]), f(c[2]) - f(d[2]));
+    let (bdxcdy, cdxbdy) = (bdx * cdy, cdx * bdy);
+    let (cdxady, adxcdy) = (cdx * ady, adx * cdy);
+    let (adxbdy, bdxady) = (adx * bdy, bdx * ady);
+    let det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * adz.abs()
+        + (cdxady.abs() + adxcdy.abs()) * bdz.abs()
+        + (adxbdy.abs() + bdxady.abs()) * cdz.abs();
+    let errbound = O3D_ERRBOUND_A * permanent;
+    if det > errbound || -det > errbound {
+        return det;
+    }
+    orient3d_exact(a, b, c, d)
+}
+
+#[cold]
+#[inline(never)]
+fn orient3d_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
     robust::orient3d(c3(a), c3(b), c3(c), c3(d))
 }
 

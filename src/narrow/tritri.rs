@@ -32,7 +32,8 @@ pub(crate) struct Points {
 }
 
 impl Points {
-    /// Upper bound on pushes: 6 edges x (2 endpoints + 3 edge crossings x up to 4 points).
+    /// Upper bound on pushes: 6 edges x (2 endpoints + 3 edge crossings x up to 4 points)
+    /// = 84, plus slack.
     const CAP: usize = 96;
 
     pub(crate) fn new() -> Self {
