@@ -841,3 +841,40 @@ proptest! {
         prop_assert_eq!(triangles_intersect(&sa, &sb), reference_scaled(&sa, &sb, 20));
     }
 }
+
+/// `b`'s corners are points of `a`'s plane (affine combinations of `a`'s corners, some
+/// outside the triangle), snapped to a 2^-20 grid: nearly (rarely exactly) coplanar pairs
+/// whose decisions need the exact stages of the predicates.
+fn nearly_coplanar_pair() -> impl Strategy<Value = (Tri, Tri)> {
+    let coord = (-(1i32 << 20)..(1i32 << 20)).prop_map(|m| m as f32 / 1_048_576.0);
+    (
+        prop::array::uniform3(prop::array::uniform3(coord)),
+        prop::array::uniform3((-0.5f64..1.5, -0.5f64..1.5)),
+        prop::array::uniform3(prop::array::uniform3(-1i32..=1)),
+    )
+        .prop_map(|(a, st, nudge)| {
+            let mut b = [[0.0f32; 3]; 3];
+            for i in 0..3 {
+                let (s, t) = st[i];
+                for k in 0..3 {
+                    let (p, q, r) = (f64::from(a[0][k]), f64::from(a[1][k]), f64::from(a[2][k]));
+                    let x = p + s * (q - p) + t * (r - p);
+                    let g = (x * 1_048_576.0).round() + f64::from(nudge[i][k]);
+                    b[i][k] = (g.clamp(-2_097_151.0, 2_097_151.0) / 1_048_576.0) as f32;
+                }
+            }
+            (a, b)
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+
+    #[test]
+    fn nearly_coplanar_pairs_match_reference((a, b) in nearly_coplanar_pair()) {
+        let want = reference_scaled(&a, &b, 20);
+        prop_assert_eq!(triangles_intersect(&a, &b), want);
+        prop_assert_eq!(triangles_intersect(&b, &a), want);
+        check_segment(&a, &b, want);
+    }
+}

@@ -132,3 +132,41 @@ pub(crate) fn lerp(p: &P3, q: &P3, t: f64) -> [f64; 3] {
     }
     x
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn robust_sign(a: &P3, b: &P3, c: &P3, d: &P3) -> i32 {
+        sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(5000))]
+
+        /// The inlined filter returns robust's sign, also for nearly coplanar `d` (an affine
+        /// combination of `a, b, c` rounded to f32, nudged by a few ulps).
+        #[test]
+        fn inlined_orient3d_matches_robust(
+            p in prop::array::uniform3(prop::array::uniform3(-1e3f32..1e3)),
+            s in -2.0f64..3.0,
+            t in -2.0f64..3.0,
+            nudge in prop::array::uniform3(-2i32..=2),
+        ) {
+            let [a, b, c] = p;
+            let mut d = [0.0f32; 3];
+            for k in 0..3 {
+                let (x, y, z) = (f64::from(a[k]), f64::from(b[k]), f64::from(c[k]));
+                let mut v = (x + s * (y - x) + t * (z - x)) as f32;
+                for _ in 0..nudge[k].unsigned_abs() {
+                    v = if nudge[k] > 0 { v.next_up() } else { v.next_down() };
+                }
+                d[k] = v;
+            }
+            prop_assert_eq!(sign(orient3d(&a, &b, &c, &d)), robust_sign(&a, &b, &c, &d));
+            prop_assert_eq!(sign(orient3d(&a, &b, &c, &c)), 0);
+            prop_assert_eq!(sign(orient3d(&d, &a, &b, &c)), -robust_sign(&a, &b, &c, &d));
+        }
+    }
+}
