@@ -878,3 +878,31 @@ proptest! {
         check_segment(&a, &b, want);
     }
 }
+
+#[test]
+fn non_finite_inputs_do_not_panic() {
+    // Unspecified answer (documented), but no panic, for the decision and the segment.
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        for i in 0..3 {
+            for k in 0..3 {
+                let mut b = [[1.0, 1.0, -1.0], [3.0, 1.0, -1.0], [1.0, 1.0, 1.0]];
+                b[i][k] = bad;
+                let _ = triangles_intersect(&A, &b);
+                let _ = triangles_intersect(&b, &A);
+                let _ = intersection_segment(&A, &b);
+                let _ = intersection_segment(&b, &b);
+                let _ = triangles_intersect(&b, &b);
+            }
+        }
+    }
+    // A degenerate (collinear) triangle against one with a NaN corner.
+    let seg = [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 2.0, 0.0]];
+    for i in 0..3 {
+        let mut a = A;
+        a[i][2] = f32::NAN;
+        let _ = triangles_intersect(&a, &seg);
+        let _ = triangles_intersect(&seg, &a);
+        let _ = intersection_segment(&a, &seg);
+        let _ = intersection_segment(&seg, &a);
+    }
+}

@@ -204,7 +204,9 @@ fn seg_vs_tri<S: Sink>(
         let k = if axis == usize::MAX {
             match projection_axis(&t[0], &t[1], &t[2]) {
                 Some(k) => k,
-                None => unreachable!("seg_vs_tri needs a non-degenerate triangle"),
+                // Only reachable with non-finite input (finite: a nonzero orientation
+                // against t's plane proved t non-degenerate); the answer is unspecified.
+                None => return false,
             }
         } else {
             axis
