@@ -48,8 +48,8 @@ pub fn intersection_segment(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> Option<[[f3
     }
     let pts = pts.as_slice();
     debug_assert!(
-        !pts.is_empty(),
-        "an intersecting pair yields a candidate point"
+        !pts.is_empty() || a.iter().chain(b).flatten().any(|c| !c.is_finite()),
+        "an intersecting pair of finite triangles yields a candidate point"
     );
     let first = *pts.first()?;
     let (mut p, mut q, mut best) = (first, first, -1.0);
