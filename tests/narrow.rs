@@ -805,11 +805,20 @@ proptest! {
     }
 
     #[test]
-    fn flat_grid_matches_reference(a in grid_tri(3), b in grid_tri(3), ka in 0usize..3, kb in 0usize..3) {
+    fn flat_grid_matches_reference(
+        a in grid_tri(3),
+        b in grid_tri(3),
+        ka in 0usize..3,
+        kb in 0usize..3,
+    ) {
         // Flatten onto coordinate planes to force coplanar and degenerate cases.
         let (mut a, mut b) = (a, b);
-        for p in &mut a { p[ka] = 0.0; }
-        for p in &mut b { p[kb] = 0.0; }
+        for p in &mut a {
+            p[ka] = 0.0;
+        }
+        for p in &mut b {
+            p[kb] = 0.0;
+        }
         let want = reference(&a, &b);
         prop_assert_eq!(triangles_intersect(&a, &b), want);
         prop_assert_eq!(triangles_intersect(&b, &a), want);
