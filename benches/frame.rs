@@ -320,8 +320,12 @@ fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
 }
 
 fn frame(c: &mut Criterion) {
+    // DHCD_BENCH_NO_CHECK=1 skips the brute-force checks (profiling runs only).
+    let checks = std::env::var_os("DHCD_BENCH_NO_CHECK").is_none();
     for scene in &scenes() {
-        check(scene);
+        if checks {
+            check(scene);
+        }
         bench_kind::<Dh>(c, scene, "dhcd-dh", Par::Seq);
         bench_kind::<Sphere>(c, scene, "dhcd-sphere", Par::Seq);
         bench_kind::<Aabb>(c, scene, "dhcd-aabb", Par::Seq);
@@ -361,7 +365,8 @@ fn frame(c: &mut Criterion) {
                     w.hier(scene, f);
                     let start = Instant::now();
                     for (k, &(i, j)) in scene.pairs.iter().enumerate() {
-                        let r = narrow_with(&w.hs[i], &w.hs[j], &mut w.ws[k], Par::Seq);
+                        let (a, b) = two_mut(&mut w.hs, i, j);
+                        let r = narrow_with(a, b, &mut w.ws[k], Par::Seq);
                         black_box(r);
                     }
                     t += start.elapsed();

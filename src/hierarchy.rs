@@ -77,6 +77,46 @@ pub struct Hierarchy<K: BvKind> {
     refit: Refit,
     /// BV updates done since the last query took them (see [`Hierarchy::take_updates`]).
     updates: u64,
+    /// Triangle corners and boxes in the current pose, refreshed lazily per leaf.
+    tris: TriCache,
+}
+
+/// Every triangle's corners and closed box in the current pose (internal triangle order),
+/// refreshed lazily, one leaf at a time, by the narrow phase: a leaf meets many leaves of
+/// the other object, so its triangles are gathered once per step instead of once per leaf
+/// pair. Boxes are SoA so the box filter over a leaf's run is one vectorizable loop.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct TriCache {
+    pub(crate) corners: Vec<[[f32; 3]; 3]>,
+    pub(crate) lo: [Vec<f32>; 3],
+    pub(crate) hi: [Vec<f32>; 3],
+    /// `stamp[leaf] == epoch` iff the leaf's triangles are current.
+    stamp: Vec<u32>,
+}
+
+impl TriCache {
+    fn new(tree: &RegionTree, points: &Points) -> Self {
+        let t = tree.triangle_total();
+        let mut c = Self {
+            corners: vec![[[0.0; 3]; 3]; t],
+            lo: std::array::from_fn(|_| vec![0.0; t]),
+            hi: std::array::from_fn(|_| vec![0.0; t]),
+            stamp: vec![0; tree.node_count()],
+        };
+        c.fill(tree, points, 0..t);
+        c
+    }
+
+    fn fill(&mut self, tree: &RegionTree, p: &Points, range: std::ops::Range<usize>) {
+        for i in range {
+            let c = tree.triangles()[i].map(|v| p.get(v as usize));
+            self.corners[i] = c;
+            for k in 0..3 {
+                self.lo[k][i] = c[0][k].min(c[1][k]).min(c[2][k]);
+                self.hi[k][i] = c[0][k].max(c[1][k]).max(c[2][k]);
+            }
+        }
+    }
 }
 
 impl<K: BvKind> Hierarchy<K> {
@@ -104,7 +144,9 @@ impl<K: BvKind> Hierarchy<K> {
         let points = Points::gather(mesh.positions(), tree.vert_order());
         let nodes = K::build(&tree, &points);
         let stamp = vec![0; tree.node_count()];
+        let tris = TriCache::new(&tree, &points);
         Ok(Self {
+            tris,
             tree,
             points,
             nodes,
@@ -123,6 +165,7 @@ impl<K: BvKind> Hierarchy<K> {
         self.points.gather_from(positions, self.tree.vert_order());
         if self.epoch == u32::MAX {
             self.stamp.fill(0);
+            self.tris.stamp.fill(0);
             self.epoch = 1;
         } else {
             self.epoch += 1;
@@ -192,6 +235,22 @@ impl<K: BvKind> Hierarchy<K> {
                 K::set(&mut self.nodes, n as usize, r);
             }
         }
+    }
+
+    /// Brings leaf `leaf`'s entries of the triangle cache to the current pose (once per step).
+    #[inline]
+    pub(crate) fn ensure_leaf_tris(&mut self, leaf: usize) {
+        if self.tris.stamp[leaf] != self.epoch {
+            self.tris.stamp[leaf] = self.epoch;
+            self.tris
+                .fill(&self.tree, &self.points, self.tree.tri_range(leaf));
+        }
+    }
+
+    /// The triangle cache (current only for leaves passed to `ensure_leaf_tris` this step).
+    #[inline]
+    pub(crate) fn tri_cache(&self) -> &TriCache {
+        &self.tris
     }
 
     /// The BV updates done since the last call (queries add them to their `bv_updates`).

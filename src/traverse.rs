@@ -18,7 +18,6 @@ use crate::counters::Counters;
 use crate::hierarchy::Hierarchy;
 use crate::narrow;
 use crate::par::Par;
-use crate::points::Points;
 use crate::tree::RegionTree;
 
 /// Result of a query: contacts as `[triangle of A, triangle of B]` in the caller's original
@@ -44,7 +43,6 @@ pub struct Workspace {
     mask: Vec<u32>,
     leaves: Vec<[u32; 2]>,
     stale: Vec<u32>,
-    tris: LeafTris,
 }
 
 impl Default for Workspace {
@@ -66,7 +64,6 @@ impl Workspace {
             mask: Vec::new(),
             leaves: Vec::new(),
             stale: Vec::new(),
-            tris: LeafTris::default(),
         }
     }
 }
@@ -127,8 +124,8 @@ pub fn traverse_with<'w, K: BvKind>(
 /// Returns the sorted contacts and `N_P`.
 #[doc(hidden)]
 pub fn narrow_with<K: BvKind>(
-    a: &Hierarchy<K>,
-    b: &Hierarchy<K>,
+    a: &mut Hierarchy<K>,
+    b: &mut Hierarchy<K>,
     ws: &mut Workspace,
     par: Par,
 ) -> (Vec<[u32; 2]>, u64) {
@@ -213,12 +210,16 @@ fn traverse<K: BvKind>(
 /// The exact narrow phase on the leaf pairs in `ws.leaves`: the intersecting triangle pairs
 /// (original indices, sorted) and the number of triangle pairs tested (`N_P`).
 fn narrow_phase<K: BvKind>(
-    a: &Hierarchy<K>,
-    b: &Hierarchy<K>,
+    a: &mut Hierarchy<K>,
+    b: &mut Hierarchy<K>,
     ws: &mut Workspace,
     parallel: bool,
 ) -> (Vec<[u32; 2]>, u64) {
-    let (ha, hb) = (a, b);
+    for &[la, lb] in &ws.leaves {
+        a.ensure_leaf_tris(la as usize);
+        b.ensure_leaf_tris(lb as usize);
+    }
+    let (ha, hb) = (&*a, &*b);
     let grain = ws.grain;
     let mut prim_tests = 0u64;
     let leaf_grain = (grain / 64).max(1);
@@ -227,13 +228,11 @@ fn narrow_phase<K: BvKind>(
         let parts: Vec<(Vec<[u32; 2]>, u64)> = ws
             .leaves
             .par_chunks(leaf_grain)
-            .map_init(LeafTris::default, |leaf, chunk| {
+            .map(|chunk| {
                 let mut out = Vec::new();
                 let tested = chunk
                     .iter()
-                    .map(|&[la, lb]| {
-                        narrow_leaf_pair(ha, hb, la as usize, lb as usize, leaf, &mut out)
-                    })
+                    .map(|&[la, lb]| narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut out))
                     .sum::<u64>();
                 (out, tested)
             })
@@ -244,8 +243,7 @@ fn narrow_phase<K: BvKind>(
         }
     } else {
         for &[la, lb] in &ws.leaves {
-            prim_tests +=
-                narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut ws.tris, &mut pairs);
+            prim_tests += narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut pairs);
         }
     }
     pairs.sort_unstable();
@@ -295,80 +293,49 @@ impl Expansion {
     }
 }
 
-#[inline]
-pub(crate) fn corners(p: &Points, tri: [u32; 3]) -> [[f32; 3]; 3] {
-    tri.map(|v| p.get(v as usize))
-}
-
-/// The triangles of one leaf, gathered once per leaf pair: corners and closed boxes (SoA,
-/// so the box filter over a whole leaf is one vectorizable loop).
-#[derive(Clone, Debug, Default)]
-pub(crate) struct LeafTris {
-    corners: Vec<[[f32; 3]; 3]>,
-    lo: [Vec<f32>; 3],
-    hi: [Vec<f32>; 3],
-    hits: Vec<u8>,
-}
-
-impl LeafTris {
-    fn load(&mut self, p: &Points, tris: &[[u32; 3]]) {
-        self.corners.clear();
-        self.corners.extend(tris.iter().map(|&t| corners(p, t)));
-        for k in 0..3 {
-            self.lo[k].clear();
-            self.hi[k].clear();
-            self.lo[k].extend(self.corners.iter().map(|c| c[0][k].min(c[1][k]).min(c[2][k])));
-            self.hi[k].extend(self.corners.iter().map(|c| c[0][k].max(c[1][k]).max(c[2][k])));
-        }
-        self.hits.clear();
-        self.hits.resize(tris.len(), 0);
-    }
-
-    /// `hits[j] = 1` iff triangle `j`'s closed box overlaps `[lo, hi]` (exact comparisons).
-    #[inline]
-    fn filter(&mut self, lo: [f32; 3], hi: [f32; 3]) {
-        let n = self.hits.len();
-        let (lx, ly, lz) = (&self.lo[0][..n], &self.lo[1][..n], &self.lo[2][..n]);
-        let (hx, hy, hz) = (&self.hi[0][..n], &self.hi[1][..n], &self.hi[2][..n]);
-        for (j, h) in self.hits.iter_mut().enumerate() {
+/// Exact tests of every triangle pair of leaves `la` x `lb`; pushes the intersecting ones
+/// (original indices) and returns the number of pairs tested (`N_P`: all of them).
+///
+/// PERF: corners and boxes come from the hierarchies' triangle caches (gathered once per
+/// leaf per step); each triangle of `la` is box-checked against `lb`'s run of boxes and
+/// only the pairs whose closed boxes overlap reach the exact test. That box test is the
+/// exact test's own first filter (closed boxes, comparisons only): contacts are unchanged.
+fn narrow_leaf_pair<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    la: usize,
+    lb: usize,
+    out: &mut Vec<[u32; 2]>,
+) -> u64 {
+    let (ta, tb) = (a.tree(), b.tree());
+    let (ca, cb) = (a.tri_cache(), b.tri_cache());
+    let ra = ta.tri_range(la);
+    let rb = tb.tri_range(lb);
+    let n = rb.len();
+    let (lx, ly, lz) = (
+        &cb.lo[0][rb.clone()],
+        &cb.lo[1][rb.clone()],
+        &cb.lo[2][rb.clone()],
+    );
+    let (hx, hy, hz) = (
+        &cb.hi[0][rb.clone()],
+        &cb.hi[1][rb.clone()],
+        &cb.hi[2][rb.clone()],
+    );
+    let corners_b = &cb.corners[rb.clone()];
+    let order_b = &tb.tri_order()[rb.clone()];
+    for i in ra.clone() {
+        let tri_a = &ca.corners[i];
+        let lo = [ca.lo[0][i], ca.lo[1][i], ca.lo[2][i]];
+        let hi = [ca.hi[0][i], ca.hi[1][i], ca.hi[2][i]];
+        for j in 0..n {
             let ov = (hx[j] >= lo[0])
                 & (lx[j] <= hi[0])
                 & (hy[j] >= lo[1])
                 & (ly[j] <= hi[1])
                 & (hz[j] >= lo[2])
                 & (lz[j] <= hi[2]);
-            *h = ov as u8;
-        }
-    }
-}
-
-/// Exact tests of every triangle pair of leaves `la` x `lb`; pushes the intersecting ones
-/// (original indices) and returns the number of pairs tested (`N_P`: all of them).
-///
-/// PERF: leaf `lb`'s corners and boxes are gathered once per leaf pair; each triangle of
-/// `la` is checked against all of `lb`'s boxes in one branch-free pass, and only the pairs
-/// whose closed boxes overlap reach the exact test. The box test is the exact test's own
-/// first filter (closed boxes, comparisons only), so the contacts are unchanged.
-fn narrow_leaf_pair<K: BvKind>(
-    a: &Hierarchy<K>,
-    b: &Hierarchy<K>,
-    la: usize,
-    lb: usize,
-    leaf: &mut LeafTris,
-    out: &mut Vec<[u32; 2]>,
-) -> u64 {
-    let (ta, tb) = (a.tree(), b.tree());
-    let ra = ta.tri_range(la);
-    let rb = tb.tri_range(lb);
-    leaf.load(b.points(), &tb.triangles()[rb.clone()]);
-    let order_b = &tb.tri_order()[rb.clone()];
-    for i in ra.clone() {
-        let tri_a = corners(a.points(), ta.triangles()[i]);
-        let lo = [0, 1, 2].map(|k| tri_a[0][k].min(tri_a[1][k]).min(tri_a[2][k]));
-        let hi = [0, 1, 2].map(|k| tri_a[0][k].max(tri_a[1][k]).max(tri_a[2][k]));
-        leaf.filter(lo, hi);
-        for (j, &h) in leaf.hits.iter().enumerate() {
-            if h != 0 && narrow::triangles_intersect(&tri_a, &leaf.corners[j]) {
+            if ov && narrow::triangles_intersect(tri_a, &corners_b[j]) {
                 out.push([ta.tri_order()[i], order_b[j]]);
             }
         }
