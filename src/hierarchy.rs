@@ -210,7 +210,14 @@ impl<K: BvKind> Hierarchy<K> {
     /// same either way.
     pub(crate) fn ensure_fitted(&mut self, ids: &[u32], parallel: bool, stale: &mut Vec<u32>) {
         stale.clear();
+        // PERF: frontiers repeat a node in runs (a parent's child against all of the other
+        // parent's children); a repeat of the previous id is already fitted.
+        let mut last = u32::MAX;
         for &n in ids {
+            if n == last {
+                continue;
+            }
+            last = n;
             let slot = &mut self.stamp[n as usize];
             if *slot != self.epoch {
                 *slot = self.epoch;

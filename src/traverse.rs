@@ -43,6 +43,7 @@ pub struct Workspace {
     mask: Vec<u32>,
     leaves: Vec<[u32; 2]>,
     stale: Vec<u32>,
+    sel: Vec<u32>,
 }
 
 impl Default for Workspace {
@@ -64,6 +65,7 @@ impl Workspace {
             mask: Vec::new(),
             leaves: Vec::new(),
             stale: Vec::new(),
+            sel: Vec::new(),
         }
     }
 }
@@ -193,11 +195,12 @@ fn traverse<K: BvKind>(
                 next_a: std::mem::take(&mut ws.next_a),
                 next_b: std::mem::take(&mut ws.next_b),
                 leaves: std::mem::take(&mut ws.leaves),
+                sel: std::mem::take(&mut ws.sel),
             };
             e.next_a.clear();
             e.next_b.clear();
             e.expand(ta, tb, &ws.ia, &ws.ib, &ws.mask);
-            (ws.next_a, ws.next_b, ws.leaves) = (e.next_a, e.next_b, e.leaves);
+            (ws.next_a, ws.next_b, ws.leaves, ws.sel) = (e.next_a, e.next_b, e.leaves, e.sel);
         }
         std::mem::swap(&mut ws.ia, &mut ws.next_a);
         std::mem::swap(&mut ws.ib, &mut ws.next_b);
@@ -256,36 +259,42 @@ struct Expansion {
     next_a: Vec<u32>,
     next_b: Vec<u32>,
     leaves: Vec<[u32; 2]>,
+    /// Scratch: positions of the overlapping pairs.
+    sel: Vec<u32>,
 }
 
 impl Expansion {
     /// Appends the children pairs of the overlapping pairs (`mask[k] != 0`) and the leaf pairs.
+    ///
+    /// PERF: most tested pairs do not overlap and the mask is unpredictable, so the overlapping
+    /// positions are first compacted without branches (`sel`), then expanded; children runs
+    /// are appended with `extend` (one capacity check per run, not per pair).
     fn expand(&mut self, ta: &RegionTree, tb: &RegionTree, ia: &[u32], ib: &[u32], mask: &[u32]) {
-        for k in 0..ia.len() {
-            if mask[k] == 0 {
-                continue;
-            }
-            let (x, y) = (ia[k] as usize, ib[k] as usize);
-            match (ta.is_leaf(x), tb.is_leaf(y)) {
+        let sel = &mut self.sel;
+        sel.clear();
+        sel.resize(ia.len(), 0);
+        let mut hits = 0;
+        for (k, &m) in mask[..ia.len()].iter().enumerate() {
+            sel[hits] = k as u32;
+            hits += (m != 0) as usize;
+        }
+        for &k in &sel[..hits] {
+            let (x, y) = (ia[k as usize] as usize, ib[k as usize] as usize);
+            let (cx, cy) = (ta.children(x), tb.children(y));
+            match (cx.is_empty(), cy.is_empty()) {
                 (true, true) => self.leaves.push([x as u32, y as u32]),
                 (true, false) => {
-                    for c in tb.children(y) {
-                        self.next_a.push(x as u32);
-                        self.next_b.push(c as u32);
-                    }
+                    self.next_a.extend(std::iter::repeat_n(x as u32, cy.len()));
+                    self.next_b.extend(cy.map(|c| c as u32));
                 }
                 (false, true) => {
-                    for c in ta.children(x) {
-                        self.next_a.push(c as u32);
-                        self.next_b.push(y as u32);
-                    }
+                    self.next_b.extend(std::iter::repeat_n(y as u32, cx.len()));
+                    self.next_a.extend(cx.map(|c| c as u32));
                 }
                 (false, false) => {
-                    for cx in ta.children(x) {
-                        for cy in tb.children(y) {
-                            self.next_a.push(cx as u32);
-                            self.next_b.push(cy as u32);
-                        }
+                    for c in cx {
+                        self.next_a.extend(std::iter::repeat_n(c as u32, cy.len()));
+                        self.next_b.extend(cy.clone().map(|c| c as u32));
                     }
                 }
             }
