@@ -198,6 +198,7 @@ impl<K: BvKind> Hierarchy<K> {
                     K::merge(&self.nodes, &tree, &self.points, n)
                 };
                 K::set(&mut self.nodes, n, r);
+                K::stage(&mut self.nodes, &self.points, n);
                 self.stamp[n] = self.epoch;
                 self.updates += 1;
             }
@@ -235,11 +236,13 @@ impl<K: BvKind> Hierarchy<K> {
                 .collect();
             for (&n, r) in stale.iter().zip(fitted) {
                 K::set(&mut self.nodes, n as usize, r);
+                K::stage(&mut self.nodes, &self.points, n as usize);
             }
         } else {
             for &n in stale.iter() {
                 let r = K::fit(&self.nodes, &self.tree, &self.points, n as usize);
                 K::set(&mut self.nodes, n as usize, r);
+                K::stage(&mut self.nodes, &self.points, n as usize);
             }
         }
     }

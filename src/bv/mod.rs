@@ -115,6 +115,11 @@ pub trait BvKind:
     fn merge(nodes: &Self::Nodes, tree: &RegionTree, p: &Points, n: usize) -> Self::Record;
     fn get(nodes: &Self::Nodes, n: usize) -> Self::Record;
     fn set(nodes: &mut Self::Nodes, n: usize, r: Self::Record);
+    /// Called right after node `n` is fitted to the current positions `p`: a kind may stage
+    /// data its overlap test derives from the pose (DH copies its centre's live position, so
+    /// the test reads one array instead of chasing the vertex index). Default: nothing.
+    #[inline]
+    fn stage(_nodes: &mut Self::Nodes, _p: &Points, _n: usize) {}
     /// Batch overlap test of node pairs `(ia[k], ib[k])`; writes `out[k]` (1 = overlap) and
     /// returns the number of overlapping pairs.
     #[allow(clippy::too_many_arguments)]
