@@ -3,6 +3,17 @@
 //! Each entry tests pairs `(ia[k], ib[k])` for `k in 0..ia.len()`, writes `out[k] = 1` when
 //! the two volumes overlap (closed volumes: touching counts) and `0` otherwise, and returns
 //! the number of overlapping pairs. Node data is read by index (a gather).
+//!
+//! SIMD: pulp's portable `Simd` has no gather, so each block of `F32_LANES` pairs is staged:
+//! the gathered fields are copied into small stack arrays (one per field, lane width) and
+//! loaded as vectors; the test itself, the 0/1 mask store and the hit count are vector code.
+//! Tail lanes are staged as NaN, which never overlaps, and are neither stored nor counted.
+//! Masks are bit-identical to the `*_scalar` references on every backend (no fma, same
+//! operation order).
+
+use crate::lanes::{load, store_u32, u32_array};
+use crate::MAX_LANES;
+use pulp::{Simd, WithSimd};
 
 /// Sphere nodes (the SBV hierarchy) in SoA form.
 #[derive(Clone, Copy, Debug)]
@@ -43,7 +54,7 @@ fn spheres_overlap(a: [f32; 3], ra: f32, b: [f32; 3], rb: f32) -> bool {
     d2 <= rs * rs
 }
 
-fn check_lengths(ia: &[u32], ib: &[u32], out: &[u32]) {
+pub(crate) fn check_lengths(ia: &[u32], ib: &[u32], out: &[u32]) {
     assert_eq!(ia.len(), ib.len(), "overlap: ia and ib differ in length");
     assert!(out.len() >= ia.len(), "overlap: out is shorter than the pair list");
 }
@@ -72,9 +83,136 @@ pub fn sphere_pairs_scalar(
     hits
 }
 
-/// Sphere-sphere overlap `|c_a - c_b|^2 <= (r_a + r_b)^2` for each pair.
+/// Sphere-sphere overlap `|c_a - c_b|^2 <= (r_a + r_b)^2` for each pair
+/// (computed as `(dx*dx + dy*dy) + dz*dz <= (ra + rb)*(ra + rb)`, no fma).
 pub fn sphere_pairs(a: SphereSoa, b: SphereSoa, ia: &[u32], ib: &[u32], out: &mut [u32]) -> usize {
-    sphere_pairs_scalar(a, b, ia, ib, out)
+    crate::arch().dispatch(SpherePairs { a, b, ia, ib, out })
+}
+
+/// [`sphere_pairs`] on the backend `simd`.
+pub fn sphere_pairs_with<S: Simd>(
+    simd: S,
+    a: SphereSoa,
+    b: SphereSoa,
+    ia: &[u32],
+    ib: &[u32],
+    out: &mut [u32],
+) -> usize {
+    simd.vectorize(SpherePairs { a, b, ia, ib, out })
+}
+
+struct SpherePairs<'a> {
+    a: SphereSoa<'a>,
+    b: SphereSoa<'a>,
+    ia: &'a [u32],
+    ib: &'a [u32],
+    out: &'a mut [u32],
+}
+
+impl WithSimd for SpherePairs<'_> {
+    type Output = usize;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> usize {
+        sphere_pairs_simd(simd, self.a, self.b, self.ia, self.ib, self.out)
+    }
+}
+
+#[inline(always)]
+fn sphere_pairs_simd<S: Simd>(
+    simd: S,
+    a: SphereSoa,
+    b: SphereSoa,
+    ia: &[u32],
+    ib: &[u32],
+    out: &mut [u32],
+) -> usize {
+    check_lengths(ia, ib, out);
+    pairs_simd::<S, 8>(
+        simd,
+        ia.len(),
+        out,
+        |k| {
+            let (i, j) = (ia[k] as usize, ib[k] as usize);
+            [a.cx[i], a.cy[i], a.cz[i], a.r[i], b.cx[j], b.cy[j], b.cz[j], b.r[j]]
+        },
+        |v| spheres_overlap_simd(simd, v),
+    )
+}
+
+/// The lane-wise [`spheres_overlap`]: `v = [ax, ay, az, ar, bx, by, bz, br]`.
+#[inline(always)]
+fn spheres_overlap_simd<S: Simd>(simd: S, v: &[S::f32s; 8]) -> S::m32s {
+    let dx = simd.sub_f32s(v[0], v[4]);
+    let dy = simd.sub_f32s(v[1], v[5]);
+    let dz = simd.sub_f32s(v[2], v[6]);
+    let d2 = simd.add_f32s(
+        simd.add_f32s(simd.mul_f32s(dx, dx), simd.mul_f32s(dy, dy)),
+        simd.mul_f32s(dz, dz),
+    );
+    let rs = simd.add_f32s(v[3], v[7]);
+    simd.less_than_or_equal_f32s(d2, simd.mul_f32s(rs, rs))
+}
+
+/// The lane-wise box test: `v = [a.min xyz, a.max xyz, b.min xyz, b.max xyz]`.
+#[inline(always)]
+pub(crate) fn aabbs_overlap_simd<S: Simd>(simd: S, v: &[S::f32s; 12]) -> S::m32s {
+    let mut m = simd.less_than_or_equal_f32s(v[0], v[9]);
+    m = simd.and_m32s(m, simd.less_than_or_equal_f32s(v[6], v[3]));
+    m = simd.and_m32s(m, simd.less_than_or_equal_f32s(v[1], v[10]));
+    m = simd.and_m32s(m, simd.less_than_or_equal_f32s(v[7], v[4]));
+    m = simd.and_m32s(m, simd.less_than_or_equal_f32s(v[2], v[11]));
+    simd.and_m32s(m, simd.less_than_or_equal_f32s(v[8], v[5]))
+}
+
+/// The shared driver of the pair kernels: for each block of `S::F32_LANES` pairs, stages the
+/// `N` gathered fields of every pair (`stage(k)`) into lane-width stack arrays, loads them,
+/// runs `test`, stores the 0/1 mask into `out` and counts the hits. Tail lanes hold NaN (never
+/// a hit) and are not stored.
+#[inline(always)]
+pub(crate) fn pairs_simd<S: Simd, const N: usize>(
+    simd: S,
+    n: usize,
+    out: &mut [u32],
+    mut stage: impl FnMut(usize) -> [f32; N],
+    test: impl Fn(&[S::f32s; N]) -> S::m32s,
+) -> usize {
+    let lanes = S::F32_LANES;
+    assert!(lanes <= MAX_LANES);
+    let one = simd.splat_u32s(1);
+    let zero = simd.splat_u32s(0);
+    let mut count = zero;
+    let mut buf = [[0.0f32; MAX_LANES]; N];
+    let block = |buf: &[[f32; MAX_LANES]; N]| {
+        let v: [S::f32s; N] = core::array::from_fn(|f| load::<S>(&buf[f]));
+        simd.select_u32s(test(&v), one, zero)
+    };
+    let full = n - n % lanes;
+    let mut k = 0;
+    while k < full {
+        for l in 0..lanes {
+            let vals = stage(k + l);
+            for f in 0..N {
+                buf[f][l] = vals[f];
+            }
+        }
+        let hit = block(&buf);
+        store_u32::<S>(&mut out[k..k + lanes], hit);
+        count = simd.add_u32s(count, hit);
+        k += lanes;
+    }
+    if k < n {
+        buf = [[f32::NAN; MAX_LANES]; N];
+        for l in 0..n - k {
+            let vals = stage(k + l);
+            for f in 0..N {
+                buf[f][l] = vals[f];
+            }
+        }
+        let hit = block(&buf);
+        simd.partial_store_u32s(&mut out[k..n], hit);
+        count = simd.add_u32s(count, hit);
+    }
+    u32_array::<S>(&count).iter().map(|&c| c as usize).sum()
 }
 
 /// Scalar reference of [`dh_pairs`].
@@ -95,7 +233,59 @@ pub fn dh_pairs_scalar(a: DhSoa, b: DhSoa, ia: &[u32], ib: &[u32], out: &mut [u3
 /// Distance-hierarchy overlap: the sphere test with centres read from the live vertex
 /// positions, `|P_a[c_a] - P_b[c_b]|^2 <= (r_a + r_b)^2`.
 pub fn dh_pairs(a: DhSoa, b: DhSoa, ia: &[u32], ib: &[u32], out: &mut [u32]) -> usize {
-    dh_pairs_scalar(a, b, ia, ib, out)
+    crate::arch().dispatch(DhPairs { a, b, ia, ib, out })
+}
+
+/// [`dh_pairs`] on the backend `simd`.
+pub fn dh_pairs_with<S: Simd>(
+    simd: S,
+    a: DhSoa,
+    b: DhSoa,
+    ia: &[u32],
+    ib: &[u32],
+    out: &mut [u32],
+) -> usize {
+    simd.vectorize(DhPairs { a, b, ia, ib, out })
+}
+
+struct DhPairs<'a> {
+    a: DhSoa<'a>,
+    b: DhSoa<'a>,
+    ia: &'a [u32],
+    ib: &'a [u32],
+    out: &'a mut [u32],
+}
+
+impl WithSimd for DhPairs<'_> {
+    type Output = usize;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> usize {
+        dh_pairs_simd(simd, self.a, self.b, self.ia, self.ib, self.out)
+    }
+}
+
+#[inline(always)]
+fn dh_pairs_simd<S: Simd>(
+    simd: S,
+    a: DhSoa,
+    b: DhSoa,
+    ia: &[u32],
+    ib: &[u32],
+    out: &mut [u32],
+) -> usize {
+    check_lengths(ia, ib, out);
+    let (pa, pb) = (a.points, b.points);
+    pairs_simd::<S, 8>(
+        simd,
+        ia.len(),
+        out,
+        |k| {
+            let (i, j) = (ia[k] as usize, ib[k] as usize);
+            let (va, vb) = (a.vertex[i] as usize, b.vertex[j] as usize);
+            [pa.x[va], pa.y[va], pa.z[va], a.r[i], pb.x[vb], pb.y[vb], pb.z[vb], b.r[j]]
+        },
+        |v| spheres_overlap_simd(simd, v),
+    )
 }
 
 /// Scalar reference of [`aabb_pairs`].
@@ -118,5 +308,58 @@ pub fn aabb_pairs_scalar(a: AabbSoa, b: AabbSoa, ia: &[u32], ib: &[u32], out: &m
 
 /// Box-box overlap: six interval comparisons per pair.
 pub fn aabb_pairs(a: AabbSoa, b: AabbSoa, ia: &[u32], ib: &[u32], out: &mut [u32]) -> usize {
-    aabb_pairs_scalar(a, b, ia, ib, out)
+    crate::arch().dispatch(AabbPairs { a, b, ia, ib, out })
+}
+
+/// [`aabb_pairs`] on the backend `simd`.
+pub fn aabb_pairs_with<S: Simd>(
+    simd: S,
+    a: AabbSoa,
+    b: AabbSoa,
+    ia: &[u32],
+    ib: &[u32],
+    out: &mut [u32],
+) -> usize {
+    simd.vectorize(AabbPairs { a, b, ia, ib, out })
+}
+
+pub(crate) struct AabbPairs<'a> {
+    pub(crate) a: AabbSoa<'a>,
+    pub(crate) b: AabbSoa<'a>,
+    pub(crate) ia: &'a [u32],
+    pub(crate) ib: &'a [u32],
+    pub(crate) out: &'a mut [u32],
+}
+
+impl WithSimd for AabbPairs<'_> {
+    type Output = usize;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> usize {
+        aabb_pairs_simd(simd, self.a, self.b, self.ia, self.ib, self.out)
+    }
+}
+
+#[inline(always)]
+fn aabb_pairs_simd<S: Simd>(
+    simd: S,
+    a: AabbSoa,
+    b: AabbSoa,
+    ia: &[u32],
+    ib: &[u32],
+    out: &mut [u32],
+) -> usize {
+    check_lengths(ia, ib, out);
+    pairs_simd::<S, 12>(
+        simd,
+        ia.len(),
+        out,
+        |k| {
+            let (i, j) = (ia[k] as usize, ib[k] as usize);
+            [
+                a.min_x[i], a.min_y[i], a.min_z[i], a.max_x[i], a.max_y[i], a.max_z[i],
+                b.min_x[j], b.min_y[j], b.min_z[j], b.max_x[j], b.max_y[j], b.max_z[j],
+            ]
+        },
+        |v| aabbs_overlap_simd(simd, v),
+    )
 }
