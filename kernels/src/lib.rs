@@ -139,7 +139,10 @@ pub struct Soa3<'a> {
 
 impl<'a> Soa3<'a> {
     pub fn new(x: &'a [f32], y: &'a [f32], z: &'a [f32]) -> Self {
-        assert!(x.len() == y.len() && y.len() == z.len(), "Soa3: ragged arrays");
+        assert!(
+            x.len() == y.len() && y.len() == z.len(),
+            "Soa3: ragged arrays"
+        );
         Self { x, y, z }
     }
 

@@ -67,7 +67,10 @@ impl AabbSoaMut<'_> {
 
 /// Scalar reference of [`triangle_bounds`].
 pub fn triangle_bounds_scalar(points: Soa3, tris: &[[u32; 3]], out: AabbSoaMut) {
-    assert!(out.len() >= tris.len(), "triangle_bounds: out is shorter than tris");
+    assert!(
+        out.len() >= tris.len(),
+        "triangle_bounds: out is shorter than tris"
+    );
     for (t, tri) in tris.iter().enumerate() {
         let (mut lo, mut hi) = crate::refit::EMPTY_BOUNDS;
         for &v in tri {
@@ -123,11 +126,16 @@ impl WithSimd for TriangleBounds<'_> {
 
 #[inline(always)]
 fn triangle_bounds_simd<S: Simd>(simd: S, p: Soa3, tris: &[[u32; 3]], out: AabbSoaMut) {
-    assert!(out.len() >= tris.len(), "triangle_bounds: out is shorter than tris");
+    assert!(
+        out.len() >= tris.len(),
+        "triangle_bounds: out is shorter than tris"
+    );
     let lanes = S::F32_LANES;
     assert!(lanes <= MAX_LANES);
     let n = tris.len();
-    let mut outs = [out.min_x, out.min_y, out.min_z, out.max_x, out.max_y, out.max_z];
+    let outs = [
+        out.min_x, out.min_y, out.min_z, out.max_x, out.max_y, out.max_z,
+    ];
     let mut k = 0;
     while k < n {
         let m = lanes.min(n - k);
@@ -197,7 +205,13 @@ pub fn tri_aabb_overlap_pairs_with<S: Simd>(
     tb: &[u32],
     out: &mut [u32],
 ) -> usize {
-    simd.vectorize(AabbPairs { a, b, ia: ta, ib: tb, out })
+    simd.vectorize(AabbPairs {
+        a,
+        b,
+        ia: ta,
+        ib: tb,
+        out,
+    })
 }
 
 // ---------------------------------------------------------------------------------------
@@ -224,12 +238,21 @@ pub fn tri_aabb_overlap_row_scalar(a: ([f32; 3], [f32; 3]), b: AabbSoa, out: &mu
 fn row_len(b: AabbSoa, out: &[u32]) -> usize {
     let n = b.min_x.len();
     assert!(
-        [b.min_y.len(), b.min_z.len(), b.max_x.len(), b.max_y.len(), b.max_z.len()]
-            .iter()
-            .all(|&l| l == n),
+        [
+            b.min_y.len(),
+            b.min_z.len(),
+            b.max_x.len(),
+            b.max_y.len(),
+            b.max_z.len()
+        ]
+        .iter()
+        .all(|&l| l == n),
         "tri_aabb_overlap_row: ragged box arrays"
     );
-    assert!(out.len() >= n, "tri_aabb_overlap_row: out is shorter than b");
+    assert!(
+        out.len() >= n,
+        "tri_aabb_overlap_row: out is shorter than b"
+    );
     n
 }
 
@@ -274,12 +297,17 @@ fn tri_aabb_overlap_row_simd<S: Simd>(
 ) -> usize {
     let n = row_len(b, out);
     let lanes = S::F32_LANES;
-    let av: [S::f32s; 6] = core::array::from_fn(|f| {
-        simd.splat_f32s(if f < 3 { a.0[f] } else { a.1[f - 3] })
-    });
+    let av: [S::f32s; 6] =
+        core::array::from_fn(|f| simd.splat_f32s(if f < 3 { a.0[f] } else { a.1[f - 3] }));
     let test = |bv: [S::f32s; 6]| {
-        let v = [av[0], av[1], av[2], av[3], av[4], av[5], bv[0], bv[1], bv[2], bv[3], bv[4], bv[5]];
-        simd.select_u32s(aabbs_overlap_simd(simd, &v), simd.splat_u32s(1), simd.splat_u32s(0))
+        let v = [
+            av[0], av[1], av[2], av[3], av[4], av[5], bv[0], bv[1], bv[2], bv[3], bv[4], bv[5],
+        ];
+        simd.select_u32s(
+            aabbs_overlap_simd(simd, &v),
+            simd.splat_u32s(1),
+            simd.splat_u32s(0),
+        )
     };
     let cols = [b.min_x, b.min_y, b.min_z, b.max_x, b.max_y, b.max_z];
     let mut count = simd.splat_u32s(0);

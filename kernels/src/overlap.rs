@@ -56,7 +56,10 @@ fn spheres_overlap(a: [f32; 3], ra: f32, b: [f32; 3], rb: f32) -> bool {
 
 pub(crate) fn check_lengths(ia: &[u32], ib: &[u32], out: &[u32]) {
     assert_eq!(ia.len(), ib.len(), "overlap: ia and ib differ in length");
-    assert!(out.len() >= ia.len(), "overlap: out is shorter than the pair list");
+    assert!(
+        out.len() >= ia.len(),
+        "overlap: out is shorter than the pair list"
+    );
 }
 
 /// Scalar reference of [`sphere_pairs`].
@@ -133,7 +136,9 @@ fn sphere_pairs_simd<S: Simd>(
         out,
         |k| {
             let (i, j) = (ia[k] as usize, ib[k] as usize);
-            [a.cx[i], a.cy[i], a.cz[i], a.r[i], b.cx[j], b.cy[j], b.cz[j], b.r[j]]
+            [
+                a.cx[i], a.cy[i], a.cz[i], a.r[i], b.cx[j], b.cy[j], b.cz[j], b.r[j],
+            ]
         },
         |v| spheres_overlap_simd(simd, v),
     )
@@ -282,7 +287,9 @@ fn dh_pairs_simd<S: Simd>(
         |k| {
             let (i, j) = (ia[k] as usize, ib[k] as usize);
             let (va, vb) = (a.vertex[i] as usize, b.vertex[j] as usize);
-            [pa.x[va], pa.y[va], pa.z[va], a.r[i], pb.x[vb], pb.y[vb], pb.z[vb], b.r[j]]
+            [
+                pa.x[va], pa.y[va], pa.z[va], a.r[i], pb.x[vb], pb.y[vb], pb.z[vb], b.r[j],
+            ]
         },
         |v| spheres_overlap_simd(simd, v),
     )
@@ -356,8 +363,8 @@ fn aabb_pairs_simd<S: Simd>(
         |k| {
             let (i, j) = (ia[k] as usize, ib[k] as usize);
             [
-                a.min_x[i], a.min_y[i], a.min_z[i], a.max_x[i], a.max_y[i], a.max_z[i],
-                b.min_x[j], b.min_y[j], b.min_z[j], b.max_x[j], b.max_y[j], b.max_z[j],
+                a.min_x[i], a.min_y[i], a.min_z[i], a.max_x[i], a.max_y[i], a.max_z[i], b.min_x[j],
+                b.min_y[j], b.min_z[j], b.max_x[j], b.max_y[j], b.max_z[j],
             ]
         },
         |v| aabbs_overlap_simd(simd, v),

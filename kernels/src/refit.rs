@@ -14,7 +14,9 @@
 //! widen the box on that axis; a NaN squared distance is ignored), and among `+0`/`-0` ties the
 //! first in lane order stays. Squared distances are never `-0`, so [`max_dist_sq`] has no
 //! sign ambiguity. `±inf` coordinates are ordinary values (`inf - inf` is NaN and skipped).
-//! Sums follow IEEE addition: NaN propagates, `inf + -inf` is NaN.
+//! Sums follow IEEE addition: NaN propagates, `inf + -inf` is NaN (NaN payloads and signs
+//! are unspecified and may differ between backends). Sums start at `+0`; tail lanes are
+//! padded with `-0`, which leaves any sum unchanged bit for bit.
 
 use crate::lanes::{f32_array, fold_max, fold_min, fold_sum, load};
 use crate::{Soa3, MAX_LANES};
@@ -84,7 +86,7 @@ fn bounds_ref(points: impl Iterator<Item = [f32; 3]>, lanes: usize) -> ([f32; 3]
     )
 }
 
-fn run(p: Soa3) -> impl Iterator<Item = [f32; 3]> + '_ {
+fn run(p: Soa3<'_>) -> impl Iterator<Item = [f32; 3]> + '_ {
     (0..p.len()).map(move |i| p.get(i))
 }
 
@@ -145,8 +147,15 @@ fn for_each_indexed<S: Simd>(p: Soa3, idx: &[u32], pad: f32, mut f: impl FnMut([
 // max_dist_sq
 
 #[inline(always)]
-fn max_dist_sq_acc<S: Simd>(simd: S, c: [f32; 3]) -> (S::f32s, impl FnMut(&mut S::f32s, [S::f32s; 3])) {
-    let c = [simd.splat_f32s(c[0]), simd.splat_f32s(c[1]), simd.splat_f32s(c[2])];
+fn max_dist_sq_acc<S: Simd>(
+    simd: S,
+    c: [f32; 3],
+) -> (S::f32s, impl FnMut(&mut S::f32s, [S::f32s; 3])) {
+    let c = [
+        simd.splat_f32s(c[0]),
+        simd.splat_f32s(c[1]),
+        simd.splat_f32s(c[2]),
+    ];
     let step = move |acc: &mut S::f32s, q: [S::f32s; 3]| {
         let dx = simd.sub_f32s(q[0], c[0]);
         let dy = simd.sub_f32s(q[1], c[1]);
@@ -224,12 +233,20 @@ pub fn max_dist_sq_indexed_scalar_lanes(p: Soa3, idx: &[u32], c: [f32; 3], lanes
 
 /// Largest squared distance from `c` to the points `p[idx[k]]` (0 for no points).
 pub fn max_dist_sq_indexed(p: Soa3, idx: &[u32], c: [f32; 3]) -> f32 {
-    crate::arch().dispatch(MaxDistSq { p, idx: Some(idx), c })
+    crate::arch().dispatch(MaxDistSq {
+        p,
+        idx: Some(idx),
+        c,
+    })
 }
 
 /// [`max_dist_sq_indexed`] on the backend `simd`.
 pub fn max_dist_sq_indexed_with<S: Simd>(simd: S, p: Soa3, idx: &[u32], c: [f32; 3]) -> f32 {
-    simd.vectorize(MaxDistSq { p, idx: Some(idx), c })
+    simd.vectorize(MaxDistSq {
+        p,
+        idx: Some(idx),
+        c,
+    })
 }
 
 // ---------------------------------------------------------------------------------------
