@@ -297,24 +297,21 @@ fn tri_aabb_overlap_row_simd<S: Simd>(
 ) -> usize {
     let n = row_len(b, out);
     let lanes = S::F32_LANES;
-    let av: [S::f32s; 6] =
-        core::array::from_fn(|f| simd.splat_f32s(if f < 3 { a.0[f] } else { a.1[f - 3] }));
-    let test = |bv: [S::f32s; 6]| {
-        let v = [
-            av[0], av[1], av[2], av[3], av[4], av[5], bv[0], bv[1], bv[2], bv[3], bv[4], bv[5],
-        ];
-        simd.select_u32s(
-            aabbs_overlap_simd(simd, &v),
-            simd.splat_u32s(1),
-            simd.splat_u32s(0),
-        )
-    };
+    let mut v = [simd.splat_f32s(0.0); 12];
+    for f in 0..3 {
+        v[f] = simd.splat_f32s(a.0[f]);
+        v[3 + f] = simd.splat_f32s(a.1[f]);
+    }
+    let (one, zero) = (simd.splat_u32s(1), simd.splat_u32s(0));
     let cols = [b.min_x, b.min_y, b.min_z, b.max_x, b.max_y, b.max_z];
-    let mut count = simd.splat_u32s(0);
+    let mut count = zero;
     let full = n - n % lanes;
     let mut k = 0;
     while k < full {
-        let hit = test(core::array::from_fn(|f| load::<S>(&cols[f][k..])));
+        for f in 0..6 {
+            v[6 + f] = load::<S>(&cols[f][k..]);
+        }
+        let hit = simd.select_u32s(aabbs_overlap_simd(simd, &v), one, zero);
         store_u32::<S>(&mut out[k..k + lanes], hit);
         count = simd.add_u32s(count, hit);
         k += lanes;
@@ -323,10 +320,15 @@ fn tri_aabb_overlap_row_simd<S: Simd>(
         let mut buf = [[f32::NAN; MAX_LANES]; 6];
         for f in 0..6 {
             buf[f][..n - k].copy_from_slice(&cols[f][k..n]);
+            v[6 + f] = load::<S>(&buf[f]);
         }
-        let hit = test(core::array::from_fn(|f| load::<S>(&buf[f])));
+        let hit = simd.select_u32s(aabbs_overlap_simd(simd, &v), one, zero);
         simd.partial_store_u32s(&mut out[k..n], hit);
         count = simd.add_u32s(count, hit);
     }
-    u32_array::<S>(&count).iter().map(|&c| c as usize).sum()
+    let mut total = 0;
+    for &c in u32_array::<S>(&count) {
+        total += c as usize;
+    }
+    total
 }

@@ -130,18 +130,35 @@ fn sphere_pairs_simd<S: Simd>(
     out: &mut [u32],
 ) -> usize {
     check_lengths(ia, ib, out);
-    pairs_simd::<S, 8>(
-        simd,
-        ia.len(),
-        out,
-        |k| {
-            let (i, j) = (ia[k] as usize, ib[k] as usize);
-            [
-                a.cx[i], a.cy[i], a.cz[i], a.r[i], b.cx[j], b.cy[j], b.cz[j], b.r[j],
-            ]
-        },
-        |v| spheres_overlap_simd(simd, v),
-    )
+    pairs_simd(simd, &SphereStage { a, b, ia, ib }, out)
+}
+
+struct SphereStage<'a> {
+    a: SphereSoa<'a>,
+    b: SphereSoa<'a>,
+    ia: &'a [u32],
+    ib: &'a [u32],
+}
+
+impl PairStage<8> for SphereStage<'_> {
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.ia.len()
+    }
+
+    #[inline(always)]
+    fn stage(&self, k: usize) -> [f32; 8] {
+        let (a, b) = (&self.a, &self.b);
+        let (i, j) = (self.ia[k] as usize, self.ib[k] as usize);
+        [
+            a.cx[i], a.cy[i], a.cz[i], a.r[i], b.cx[j], b.cy[j], b.cz[j], b.r[j],
+        ]
+    }
+
+    #[inline(always)]
+    fn test<S: Simd>(simd: S, v: &[S::f32s; 8]) -> S::m32s {
+        spheres_overlap_simd(simd, v)
+    }
 }
 
 /// The lane-wise [`spheres_overlap`]: `v = [ax, ay, az, ar, bx, by, bz, br]`.
@@ -169,38 +186,45 @@ pub(crate) fn aabbs_overlap_simd<S: Simd>(simd: S, v: &[S::f32s; 12]) -> S::m32s
     simd.and_m32s(m, simd.less_than_or_equal_f32s(v[8], v[5]))
 }
 
+/// The gathered inputs and the lane-wise test of one pair kernel. A trait rather than
+/// closures: closures do not inherit the target features of the dispatched body and may be
+/// compiled out of line, turning every intrinsic into a call (measured: 4x slower than scalar).
+pub(crate) trait PairStage<const N: usize> {
+    /// Number of pairs.
+    fn len(&self) -> usize;
+    /// The `N` fields of pair `k` (the gather).
+    fn stage(&self, k: usize) -> [f32; N];
+    /// The lane-wise overlap test on the staged fields.
+    fn test<S: Simd>(simd: S, v: &[S::f32s; N]) -> S::m32s;
+}
+
 /// The shared driver of the pair kernels: for each block of `S::F32_LANES` pairs, stages the
-/// `N` gathered fields of every pair (`stage(k)`) into lane-width stack arrays, loads them,
-/// runs `test`, stores the 0/1 mask into `out` and counts the hits. Tail lanes hold NaN (never
-/// a hit) and are not stored.
+/// `N` gathered fields of every pair into lane-width stack arrays, loads them, runs the test,
+/// stores the 0/1 mask into `out` and counts the hits. Tail lanes hold NaN (never a hit) and
+/// are not stored.
 #[inline(always)]
-pub(crate) fn pairs_simd<S: Simd, const N: usize>(
+pub(crate) fn pairs_simd<S: Simd, const N: usize, P: PairStage<N>>(
     simd: S,
-    n: usize,
+    pairs: &P,
     out: &mut [u32],
-    mut stage: impl FnMut(usize) -> [f32; N],
-    test: impl Fn(&[S::f32s; N]) -> S::m32s,
 ) -> usize {
+    let n = pairs.len();
     let lanes = S::F32_LANES;
     assert!(lanes <= MAX_LANES);
     let one = simd.splat_u32s(1);
     let zero = simd.splat_u32s(0);
     let mut count = zero;
     let mut buf = [[0.0f32; MAX_LANES]; N];
-    let block = |buf: &[[f32; MAX_LANES]; N]| {
-        let v: [S::f32s; N] = core::array::from_fn(|f| load::<S>(&buf[f]));
-        simd.select_u32s(test(&v), one, zero)
-    };
     let full = n - n % lanes;
     let mut k = 0;
     while k < full {
         for l in 0..lanes {
-            let vals = stage(k + l);
+            let vals = pairs.stage(k + l);
             for f in 0..N {
                 buf[f][l] = vals[f];
             }
         }
-        let hit = block(&buf);
+        let hit = simd.select_u32s(P::test(simd, &load_rows::<S, N>(&buf)), one, zero);
         store_u32::<S>(&mut out[k..k + lanes], hit);
         count = simd.add_u32s(count, hit);
         k += lanes;
@@ -208,16 +232,30 @@ pub(crate) fn pairs_simd<S: Simd, const N: usize>(
     if k < n {
         buf = [[f32::NAN; MAX_LANES]; N];
         for l in 0..n - k {
-            let vals = stage(k + l);
+            let vals = pairs.stage(k + l);
             for f in 0..N {
                 buf[f][l] = vals[f];
             }
         }
-        let hit = block(&buf);
+        let hit = simd.select_u32s(P::test(simd, &load_rows::<S, N>(&buf)), one, zero);
         simd.partial_store_u32s(&mut out[k..n], hit);
         count = simd.add_u32s(count, hit);
     }
-    u32_array::<S>(&count).iter().map(|&c| c as usize).sum()
+    let mut total = 0;
+    for &c in u32_array::<S>(&count) {
+        total += c as usize;
+    }
+    total
+}
+
+/// Loads row `f` of `buf` into vector `f`.
+#[inline(always)]
+pub(crate) fn load_rows<S: Simd, const N: usize>(buf: &[[f32; MAX_LANES]; N]) -> [S::f32s; N] {
+    let mut v = [load::<S>(&buf[0]); N];
+    for f in 1..N {
+        v[f] = load::<S>(&buf[f]);
+    }
+    v
 }
 
 /// Scalar reference of [`dh_pairs`].
@@ -279,20 +317,37 @@ fn dh_pairs_simd<S: Simd>(
     out: &mut [u32],
 ) -> usize {
     check_lengths(ia, ib, out);
-    let (pa, pb) = (a.points, b.points);
-    pairs_simd::<S, 8>(
-        simd,
-        ia.len(),
-        out,
-        |k| {
-            let (i, j) = (ia[k] as usize, ib[k] as usize);
-            let (va, vb) = (a.vertex[i] as usize, b.vertex[j] as usize);
-            [
-                pa.x[va], pa.y[va], pa.z[va], a.r[i], pb.x[vb], pb.y[vb], pb.z[vb], b.r[j],
-            ]
-        },
-        |v| spheres_overlap_simd(simd, v),
-    )
+    pairs_simd(simd, &DhStage { a, b, ia, ib }, out)
+}
+
+struct DhStage<'a> {
+    a: DhSoa<'a>,
+    b: DhSoa<'a>,
+    ia: &'a [u32],
+    ib: &'a [u32],
+}
+
+impl PairStage<8> for DhStage<'_> {
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.ia.len()
+    }
+
+    #[inline(always)]
+    fn stage(&self, k: usize) -> [f32; 8] {
+        let (a, b) = (&self.a, &self.b);
+        let (pa, pb) = (&a.points, &b.points);
+        let (i, j) = (self.ia[k] as usize, self.ib[k] as usize);
+        let (va, vb) = (a.vertex[i] as usize, b.vertex[j] as usize);
+        [
+            pa.x[va], pa.y[va], pa.z[va], a.r[i], pb.x[vb], pb.y[vb], pb.z[vb], b.r[j],
+        ]
+    }
+
+    #[inline(always)]
+    fn test<S: Simd>(simd: S, v: &[S::f32s; 8]) -> S::m32s {
+        spheres_overlap_simd(simd, v)
+    }
 }
 
 /// Scalar reference of [`aabb_pairs`].
@@ -356,17 +411,34 @@ fn aabb_pairs_simd<S: Simd>(
     out: &mut [u32],
 ) -> usize {
     check_lengths(ia, ib, out);
-    pairs_simd::<S, 12>(
-        simd,
-        ia.len(),
-        out,
-        |k| {
-            let (i, j) = (ia[k] as usize, ib[k] as usize);
-            [
-                a.min_x[i], a.min_y[i], a.min_z[i], a.max_x[i], a.max_y[i], a.max_z[i], b.min_x[j],
-                b.min_y[j], b.min_z[j], b.max_x[j], b.max_y[j], b.max_z[j],
-            ]
-        },
-        |v| aabbs_overlap_simd(simd, v),
-    )
+    pairs_simd(simd, &AabbStage { a, b, ia, ib }, out)
+}
+
+struct AabbStage<'a> {
+    a: AabbSoa<'a>,
+    b: AabbSoa<'a>,
+    ia: &'a [u32],
+    ib: &'a [u32],
+}
+
+impl PairStage<12> for AabbStage<'_> {
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.ia.len()
+    }
+
+    #[inline(always)]
+    fn stage(&self, k: usize) -> [f32; 12] {
+        let (a, b) = (&self.a, &self.b);
+        let (i, j) = (self.ia[k] as usize, self.ib[k] as usize);
+        [
+            a.min_x[i], a.min_y[i], a.min_z[i], a.max_x[i], a.max_y[i], a.max_z[i], b.min_x[j],
+            b.min_y[j], b.min_z[j], b.max_x[j], b.max_y[j], b.max_z[j],
+        ]
+    }
+
+    #[inline(always)]
+    fn test<S: Simd>(simd: S, v: &[S::f32s; 12]) -> S::m32s {
+        aabbs_overlap_simd(simd, v)
+    }
 }

@@ -119,44 +119,62 @@ fn tail3<S: Simd>(x: &[f32], y: &[f32], z: &[f32], pad: f32) -> [S::f32s; 3] {
     [load::<S>(&buf[0]), load::<S>(&buf[1]), load::<S>(&buf[2])]
 }
 
-/// Visits the points of `p` a vector at a time; the tail is padded with `pad`.
+/// One lane-wise reduction step. A trait rather than closures: closures do not inherit the
+/// target features of the dispatched body and may be compiled out of line, turning every
+/// intrinsic into a call (measured: several times slower than scalar).
+trait Reduce<S: Simd> {
+    /// Padding for tail lanes that leaves the reduction unchanged.
+    const PAD: f32;
+    fn step(&mut self, simd: S, q: [S::f32s; 3]);
+}
+
+/// Feeds the points of `p` to `r` a vector at a time; the tail is padded with `R::PAD`.
 #[inline(always)]
-fn for_each_run<S: Simd>(p: Soa3, pad: f32, mut f: impl FnMut([S::f32s; 3])) {
+fn reduce_run<S: Simd, R: Reduce<S>>(simd: S, p: Soa3, r: &mut R) {
     let (xs, xt) = S::as_simd_f32s(p.x);
     let (ys, yt) = S::as_simd_f32s(p.y);
     let (zs, zt) = S::as_simd_f32s(p.z);
     for ((&x, &y), &z) in xs.iter().zip(ys).zip(zs) {
-        f([x, y, z]);
+        r.step(simd, [x, y, z]);
     }
     if !xt.is_empty() {
-        f(tail3::<S>(xt, yt, zt, pad));
+        r.step(simd, tail3::<S>(xt, yt, zt, R::PAD));
     }
 }
 
-/// Visits the points `p[idx[k]]` a vector at a time (staged gather); the tail is padded
-/// with `pad`.
+/// Feeds the points `p[idx[k]]` to `r` a vector at a time (staged gather); the tail is padded
+/// with `R::PAD`.
 #[inline(always)]
-fn for_each_indexed<S: Simd>(p: Soa3, idx: &[u32], pad: f32, mut f: impl FnMut([S::f32s; 3])) {
+fn reduce_indexed<S: Simd, R: Reduce<S>>(simd: S, p: Soa3, idx: &[u32], r: &mut R) {
     assert!(S::F32_LANES <= MAX_LANES);
     for block in idx.chunks(S::F32_LANES) {
-        f(gather3::<S>(p, block, pad));
+        r.step(simd, gather3::<S>(p, block, R::PAD));
+    }
+}
+
+#[inline(always)]
+fn reduce<S: Simd, R: Reduce<S>>(simd: S, p: Soa3, idx: Option<&[u32]>, r: &mut R) {
+    match idx {
+        None => reduce_run(simd, p, r),
+        Some(idx) => reduce_indexed(simd, p, idx, r),
     }
 }
 
 // ---------------------------------------------------------------------------------------
 // max_dist_sq
 
-#[inline(always)]
-fn max_dist_sq_acc<S: Simd>(
-    simd: S,
-    c: [f32; 3],
-) -> (S::f32s, impl FnMut(&mut S::f32s, [S::f32s; 3])) {
-    let c = [
-        simd.splat_f32s(c[0]),
-        simd.splat_f32s(c[1]),
-        simd.splat_f32s(c[2]),
-    ];
-    let step = move |acc: &mut S::f32s, q: [S::f32s; 3]| {
+struct MaxDistSqAcc<S: Simd> {
+    c: [S::f32s; 3],
+    acc: S::f32s,
+}
+
+impl<S: Simd> Reduce<S> for MaxDistSqAcc<S> {
+    /// NaN coordinates give a NaN distance, which never replaces the maximum.
+    const PAD: f32 = f32::NAN;
+
+    #[inline(always)]
+    fn step(&mut self, simd: S, q: [S::f32s; 3]) {
+        let c = self.c;
         let dx = simd.sub_f32s(q[0], c[0]);
         let dy = simd.sub_f32s(q[1], c[1]);
         let dz = simd.sub_f32s(q[2], c[2]);
@@ -164,23 +182,22 @@ fn max_dist_sq_acc<S: Simd>(
             simd.add_f32s(simd.mul_f32s(dx, dx), simd.mul_f32s(dy, dy)),
             simd.mul_f32s(dz, dz),
         );
-        *acc = simd.select_f32s(simd.greater_than_f32s(d2, *acc), d2, *acc);
+        self.acc = simd.select_f32s(simd.greater_than_f32s(d2, self.acc), d2, self.acc);
+    }
+}
+
+#[inline(always)]
+fn max_dist_sq_simd<S: Simd>(simd: S, p: Soa3, idx: Option<&[u32]>, c: [f32; 3]) -> f32 {
+    let mut r = MaxDistSqAcc::<S> {
+        c: [
+            simd.splat_f32s(c[0]),
+            simd.splat_f32s(c[1]),
+            simd.splat_f32s(c[2]),
+        ],
+        acc: simd.splat_f32s(0.0),
     };
-    (simd.splat_f32s(0.0), step)
-}
-
-#[inline(always)]
-fn max_dist_sq_simd<S: Simd>(simd: S, p: Soa3, c: [f32; 3]) -> f32 {
-    let (mut acc, mut step) = max_dist_sq_acc(simd, c);
-    for_each_run::<S>(p, f32::NAN, |q| step(&mut acc, q));
-    fold_max(f32_array::<S>(&acc))
-}
-
-#[inline(always)]
-fn max_dist_sq_indexed_simd<S: Simd>(simd: S, p: Soa3, idx: &[u32], c: [f32; 3]) -> f32 {
-    let (mut acc, mut step) = max_dist_sq_acc(simd, c);
-    for_each_indexed::<S>(p, idx, f32::NAN, |q| step(&mut acc, q));
-    fold_max(f32_array::<S>(&acc))
+    reduce(simd, p, idx, &mut r);
+    fold_max(f32_array::<S>(&r.acc))
 }
 
 struct MaxDistSq<'a> {
@@ -193,13 +210,9 @@ impl WithSimd for MaxDistSq<'_> {
     type Output = f32;
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) -> f32 {
-        match self.idx {
-            None => max_dist_sq_simd(simd, self.p, self.c),
-            Some(idx) => max_dist_sq_indexed_simd(simd, self.p, idx, self.c),
-        }
+        max_dist_sq_simd(simd, self.p, self.idx, self.c)
     }
 }
-
 /// Scalar reference of [`max_dist_sq`] (sequential: [`max_dist_sq_scalar_lanes`] with 1 lane).
 pub fn max_dist_sq_scalar(p: Soa3, c: [f32; 3]) -> f32 {
     max_dist_sq_scalar_lanes(p, c, 1)
@@ -255,24 +268,32 @@ pub fn max_dist_sq_indexed_with<S: Simd>(simd: S, p: Soa3, idx: &[u32], c: [f32;
 /// Padding that leaves a sum unchanged bit for bit (`x + -0.0 == x`, also for `x = -0.0`).
 const SUM_PAD: f32 = -0.0;
 
-#[inline(always)]
-fn sum_finish<S: Simd>(acc: &[S::f32s; 3]) -> [f32; 3] {
-    core::array::from_fn(|a| fold_sum(f32_array::<S>(&acc[a])))
+struct SumAcc<S: Simd> {
+    acc: [S::f32s; 3],
+}
+
+impl<S: Simd> Reduce<S> for SumAcc<S> {
+    const PAD: f32 = SUM_PAD;
+
+    #[inline(always)]
+    fn step(&mut self, simd: S, q: [S::f32s; 3]) {
+        for a in 0..3 {
+            self.acc[a] = simd.add_f32s(self.acc[a], q[a]);
+        }
+    }
 }
 
 #[inline(always)]
 fn sum_simd<S: Simd>(simd: S, p: Soa3, idx: Option<&[u32]>) -> [f32; 3] {
-    let mut acc = [simd.splat_f32s(0.0); 3];
-    let step = |acc: &mut [S::f32s; 3], q: [S::f32s; 3]| {
-        for a in 0..3 {
-            acc[a] = simd.add_f32s(acc[a], q[a]);
-        }
+    let mut r = SumAcc::<S> {
+        acc: [simd.splat_f32s(0.0); 3],
     };
-    match idx {
-        None => for_each_run::<S>(p, SUM_PAD, |q| step(&mut acc, q)),
-        Some(idx) => for_each_indexed::<S>(p, idx, SUM_PAD, |q| step(&mut acc, q)),
+    reduce(simd, p, idx, &mut r);
+    let mut s = [0.0f32; 3];
+    for a in 0..3 {
+        s[a] = fold_sum(f32_array::<S>(&r.acc[a]));
     }
-    sum_finish::<S>(&acc)
+    s
 }
 
 struct Sum<'a> {
@@ -353,23 +374,36 @@ pub(crate) fn widen_simd<S: Simd>(simd: S, lo: &mut S::f32s, hi: &mut S::f32s, v
     *hi = simd.select_f32s(simd.greater_than_f32s(v, *hi), v, *hi);
 }
 
+struct BoundsAcc<S: Simd> {
+    lo: [S::f32s; 3],
+    hi: [S::f32s; 3],
+}
+
+impl<S: Simd> Reduce<S> for BoundsAcc<S> {
+    /// NaN never widens a box.
+    const PAD: f32 = f32::NAN;
+
+    #[inline(always)]
+    fn step(&mut self, simd: S, q: [S::f32s; 3]) {
+        for a in 0..3 {
+            widen_simd(simd, &mut self.lo[a], &mut self.hi[a], q[a]);
+        }
+    }
+}
+
 #[inline(always)]
 fn bounds_simd<S: Simd>(simd: S, p: Soa3, idx: Option<&[u32]>) -> ([f32; 3], [f32; 3]) {
-    let mut lo = [simd.splat_f32s(f32::INFINITY); 3];
-    let mut hi = [simd.splat_f32s(f32::NEG_INFINITY); 3];
-    let step = |lo: &mut [S::f32s; 3], hi: &mut [S::f32s; 3], q: [S::f32s; 3]| {
-        for a in 0..3 {
-            widen_simd(simd, &mut lo[a], &mut hi[a], q[a]);
-        }
+    let mut r = BoundsAcc::<S> {
+        lo: [simd.splat_f32s(f32::INFINITY); 3],
+        hi: [simd.splat_f32s(f32::NEG_INFINITY); 3],
     };
-    match idx {
-        None => for_each_run::<S>(p, f32::NAN, |q| step(&mut lo, &mut hi, q)),
-        Some(idx) => for_each_indexed::<S>(p, idx, f32::NAN, |q| step(&mut lo, &mut hi, q)),
+    reduce(simd, p, idx, &mut r);
+    let (mut lo, mut hi) = EMPTY_BOUNDS;
+    for a in 0..3 {
+        lo[a] = fold_min(f32_array::<S>(&r.lo[a]));
+        hi[a] = fold_max(f32_array::<S>(&r.hi[a]));
     }
-    (
-        core::array::from_fn(|a| fold_min(f32_array::<S>(&lo[a]))),
-        core::array::from_fn(|a| fold_max(f32_array::<S>(&hi[a]))),
-    )
+    (lo, hi)
 }
 
 struct Bounds<'a> {
