@@ -159,6 +159,24 @@ impl PairStage<8> for SphereStage<'_> {
     fn test<S: Simd>(simd: S, v: &[S::f32s; 8]) -> S::m32s {
         spheres_overlap_simd(simd, v)
     }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn gather16(&self, v4: pulp::x86::V4, k: usize) -> [pulp::f32x16; 8] {
+        use gather_v4::{gather, load_idx};
+        let (a, b) = (&self.a, &self.b);
+        let (i, j) = (load_idx(v4, self.ia, k), load_idx(v4, self.ib, k));
+        [
+            gather(v4, i, a.cx),
+            gather(v4, i, a.cy),
+            gather(v4, i, a.cz),
+            gather(v4, i, a.r),
+            gather(v4, j, b.cx),
+            gather(v4, j, b.cy),
+            gather(v4, j, b.cz),
+            gather(v4, j, b.r),
+        ]
+    }
 }
 
 /// The lane-wise [`spheres_overlap`]: `v = [ax, ay, az, ar, bx, by, bz, br]`.
@@ -196,6 +214,9 @@ pub(crate) trait PairStage<const N: usize> {
     fn stage(&self, k: usize) -> [f32; N];
     /// The lane-wise overlap test on the staged fields.
     fn test<S: Simd>(simd: S, v: &[S::f32s; N]) -> S::m32s;
+    /// The fields of the 16 pairs `k..k + 16` by hardware gather (AVX-512F only).
+    #[cfg(target_arch = "x86_64")]
+    fn gather16(&self, v4: pulp::x86::V4, k: usize) -> [pulp::f32x16; N];
 }
 
 /// The shared driver of the pair kernels: for each block of `S::F32_LANES` pairs, stages the
@@ -217,6 +238,13 @@ pub(crate) fn pairs_simd<S: Simd, const N: usize, P: PairStage<N>>(
     let mut buf = [[0.0f32; MAX_LANES]; N];
     let full = n - n % lanes;
     let mut k = 0;
+    let mut total = 0;
+    // PERF: on AVX-512 the full blocks use hardware gathers (`vgatherdps`) instead of staging
+    // through the stack; the tail below stays staged.
+    #[cfg(target_arch = "x86_64")]
+    if let Some(&v4) = (&simd as &dyn core::any::Any).downcast_ref::<pulp::x86::V4>() {
+        (k, total) = gather_v4::pairs(v4, pairs, out);
+    }
     while k < full {
         for l in 0..lanes {
             let vals = pairs.stage(k + l);
@@ -241,7 +269,6 @@ pub(crate) fn pairs_simd<S: Simd, const N: usize, P: PairStage<N>>(
         simd.partial_store_u32s(&mut out[k..n], hit);
         count = simd.add_u32s(count, hit);
     }
-    let mut total = 0;
     for &c in u32_array::<S>(&count) {
         total += c as usize;
     }
@@ -348,6 +375,26 @@ impl PairStage<8> for DhStage<'_> {
     fn test<S: Simd>(simd: S, v: &[S::f32s; 8]) -> S::m32s {
         spheres_overlap_simd(simd, v)
     }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn gather16(&self, v4: pulp::x86::V4, k: usize) -> [pulp::f32x16; 8] {
+        use gather_v4::{gather, gather_u32, load_idx};
+        let (a, b) = (&self.a, &self.b);
+        let (i, j) = (load_idx(v4, self.ia, k), load_idx(v4, self.ib, k));
+        let (va, vb) = (gather_u32(v4, i, a.vertex), gather_u32(v4, j, b.vertex));
+        let (pa, pb) = (&a.points, &b.points);
+        [
+            gather(v4, va, pa.x),
+            gather(v4, va, pa.y),
+            gather(v4, va, pa.z),
+            gather(v4, i, a.r),
+            gather(v4, vb, pb.x),
+            gather(v4, vb, pb.y),
+            gather(v4, vb, pb.z),
+            gather(v4, j, b.r),
+        ]
+    }
 }
 
 /// Scalar reference of [`aabb_pairs`].
@@ -440,5 +487,118 @@ impl PairStage<12> for AabbStage<'_> {
     #[inline(always)]
     fn test<S: Simd>(simd: S, v: &[S::f32s; 12]) -> S::m32s {
         aabbs_overlap_simd(simd, v)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn gather16(&self, v4: pulp::x86::V4, k: usize) -> [pulp::f32x16; 12] {
+        use gather_v4::{gather, load_idx};
+        let (a, b) = (&self.a, &self.b);
+        let (i, j) = (load_idx(v4, self.ia, k), load_idx(v4, self.ib, k));
+        [
+            gather(v4, i, a.min_x),
+            gather(v4, i, a.min_y),
+            gather(v4, i, a.min_z),
+            gather(v4, i, a.max_x),
+            gather(v4, i, a.max_y),
+            gather(v4, i, a.max_z),
+            gather(v4, j, b.min_x),
+            gather(v4, j, b.min_y),
+            gather(v4, j, b.min_z),
+            gather(v4, j, b.max_x),
+            gather(v4, j, b.max_y),
+            gather(v4, j, b.max_z),
+        ]
+    }
+}
+
+/// Hardware gathers for the AVX-512 backend (`pulp::x86::V4`). pulp's portable `Simd` has no
+/// gather; these helpers are only reached from bodies dispatched on `V4`, whose token proves
+/// AVX-512F is available and whose `vectorize` enables it for the inlined body.
+#[cfg(target_arch = "x86_64")]
+mod gather_v4 {
+    use super::PairStage;
+    use core::arch::x86_64::{
+        __m512, __m512i, _mm512_cmpge_epu32_mask, _mm512_i32gather_epi32, _mm512_i32gather_ps,
+        _mm512_set1_epi32,
+    };
+    use pulp::x86::V4;
+    use pulp::{f32x16, u32x16, Simd};
+
+    /// The full 16-pair blocks of `pairs` with gathered fields; returns the first pair not
+    /// done and the number of hits.
+    #[inline(always)]
+    pub(super) fn pairs<const N: usize, P: PairStage<N>>(
+        v4: V4,
+        pairs: &P,
+        out: &mut [u32],
+    ) -> (usize, usize) {
+        let n = pairs.len();
+        let full = n - n % 16;
+        let (one, zero) = (v4.splat_u32s(1), v4.splat_u32s(0));
+        let mut count = zero;
+        let mut k = 0;
+        while k < full {
+            let v = pairs.gather16(v4, k);
+            let hit = v4.select_u32s(P::test(v4, &v), one, zero);
+            V4::as_mut_simd_u32s(&mut out[k..k + 16]).0[0] = hit;
+            count = v4.add_u32s(count, hit);
+            k += 16;
+        }
+        let c: [u32; 16] = bytemuck::cast(count);
+        (k, c.iter().map(|&c| c as usize).sum())
+    }
+
+    /// The 16 indices `idx[k..k + 16]`.
+    #[inline(always)]
+    pub(super) fn load_idx(_v4: V4, idx: &[u32], k: usize) -> u32x16 {
+        V4::as_simd_u32s(&idx[k..k + 16]).0[0]
+    }
+
+    fn to_m512i(v: u32x16) -> __m512i {
+        // SAFETY: both are 64 bytes of plain integer data; every bit pattern is valid.
+        unsafe { core::mem::transmute::<u32x16, __m512i>(v) }
+    }
+
+    /// Panics (like slice indexing) unless every lane of `idx` is `< len`; returns the
+    /// indices as a vector register. Requires `len <= i32::MAX` (gather offsets are signed).
+    #[inline(always)]
+    fn checked(_v4: V4, idx: u32x16, len: usize) -> __m512i {
+        debug_assert!(len <= i32::MAX as usize);
+        let idx = to_m512i(idx);
+        // SAFETY: AVX-512F is available: the `V4` token exists only if it was detected.
+        let oob = unsafe { _mm512_cmpge_epu32_mask(idx, _mm512_set1_epi32(len as i32)) };
+        assert!(oob == 0, "overlap: index out of range");
+        idx
+    }
+
+    /// `data[idx[l]]` for the 16 lanes.
+    #[inline(always)]
+    pub(super) fn gather(v4: V4, idx: u32x16, data: &[f32]) -> f32x16 {
+        if data.len() > i32::MAX as usize {
+            let i: [u32; 16] = bytemuck::cast(idx);
+            return bytemuck::cast(i.map(|i| data[i as usize]));
+        }
+        let idx = checked(v4, idx, data.len());
+        // SAFETY: AVX-512F is available (the `V4` token), and `checked` proved every lane
+        // index is `< data.len() <= i32::MAX`, so all 16 addresses `data.as_ptr() + 4 * idx`
+        // lie inside `data`.
+        let g: __m512 = unsafe { _mm512_i32gather_ps::<4>(idx, data.as_ptr()) };
+        // SAFETY: both are 64 bytes of 16 `f32`; every bit pattern is valid.
+        unsafe { core::mem::transmute::<__m512, f32x16>(g) }
+    }
+
+    /// `data[idx[l]]` for the 16 lanes.
+    #[inline(always)]
+    pub(super) fn gather_u32(v4: V4, idx: u32x16, data: &[u32]) -> u32x16 {
+        if data.len() > i32::MAX as usize {
+            let i: [u32; 16] = bytemuck::cast(idx);
+            return bytemuck::cast(i.map(|i| data[i as usize]));
+        }
+        let idx = checked(v4, idx, data.len());
+        // SAFETY: as in `gather`: AVX-512F is available and every lane index is in bounds.
+        let g: __m512i = unsafe { _mm512_i32gather_epi32::<4>(idx, data.as_ptr().cast()) };
+        // SAFETY: both are 64 bytes of plain integer data; every bit pattern is valid.
+        unsafe { core::mem::transmute::<__m512i, u32x16>(g) }
     }
 }
