@@ -160,7 +160,7 @@ impl PairStage<8> for SphereStage<'_> {
         spheres_overlap_simd(simd, v)
     }
 
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", feature = "hw-gather"))]
     #[inline(always)]
     fn gather16(&self, v4: pulp::x86::V4, k: usize) -> [pulp::f32x16; 8] {
         use gather_v4::{gather, load_idx};
@@ -215,7 +215,7 @@ pub(crate) trait PairStage<const N: usize> {
     /// The lane-wise overlap test on the staged fields.
     fn test<S: Simd>(simd: S, v: &[S::f32s; N]) -> S::m32s;
     /// The fields of the 16 pairs `k..k + 16` by hardware gather (AVX-512F only).
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", feature = "hw-gather"))]
     fn gather16(&self, v4: pulp::x86::V4, k: usize) -> [pulp::f32x16; N];
 }
 
@@ -239,9 +239,11 @@ pub(crate) fn pairs_simd<S: Simd, const N: usize, P: PairStage<N>>(
     let full = n - n % lanes;
     let mut k = 0;
     let mut total = 0;
-    // PERF: on AVX-512 the full blocks use hardware gathers (`vgatherdps`) instead of staging
-    // through the stack; the tail below stays staged.
-    #[cfg(target_arch = "x86_64")]
+    // PERF: with the `hw-gather` feature, the full blocks on AVX-512 use hardware gathers
+    // (`vgatherdps`) instead of staging through the stack; the tail stays staged. Off by
+    // default: on the AMD EPYC (Zen 4) development machine it measured no faster than staging
+    // (both bound by the random loads; see the crate README / bench notes).
+    #[cfg(all(target_arch = "x86_64", feature = "hw-gather"))]
     if let Some(&v4) = (&simd as &dyn core::any::Any).downcast_ref::<pulp::x86::V4>() {
         (k, total) = gather_v4::pairs(v4, pairs, out);
     }
@@ -376,7 +378,7 @@ impl PairStage<8> for DhStage<'_> {
         spheres_overlap_simd(simd, v)
     }
 
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", feature = "hw-gather"))]
     #[inline(always)]
     fn gather16(&self, v4: pulp::x86::V4, k: usize) -> [pulp::f32x16; 8] {
         use gather_v4::{gather, gather_u32, load_idx};
@@ -489,7 +491,7 @@ impl PairStage<12> for AabbStage<'_> {
         aabbs_overlap_simd(simd, v)
     }
 
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", feature = "hw-gather"))]
     #[inline(always)]
     fn gather16(&self, v4: pulp::x86::V4, k: usize) -> [pulp::f32x16; 12] {
         use gather_v4::{gather, load_idx};
@@ -515,7 +517,7 @@ impl PairStage<12> for AabbStage<'_> {
 /// Hardware gathers for the AVX-512 backend (`pulp::x86::V4`). pulp's portable `Simd` has no
 /// gather; these helpers are only reached from bodies dispatched on `V4`, whose token proves
 /// AVX-512F is available and whose `vectorize` enables it for the inlined body.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(target_arch = "x86_64", feature = "hw-gather"))]
 mod gather_v4 {
     use super::PairStage;
     use core::arch::x86_64::{

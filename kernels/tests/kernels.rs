@@ -405,7 +405,9 @@ fn check_overlap_special_values<S: Simd>(simd: S) {
     let inf = f32::INFINITY;
     let nan = f32::NAN;
     // (centre a, ra, centre b, rb, overlaps)
-    let cases: &[([f32; 3], f32, [f32; 3], f32, u32)] = &[
+    /// (centre a, ra, centre b, rb, overlaps)
+    type Case = ([f32; 3], f32, [f32; 3], f32, u32);
+    let cases: &[Case] = &[
         ([0.0, 0.0, 0.0], 1.0, [3.0, 0.0, 0.0], 2.0, 1), // exactly touching
         ([0.0, 0.0, 0.0], 1.0, [3.0, 0.0, 0.0], 1.75, 0), // just apart
         ([1.0, 2.0, 3.0], 0.0, [1.0, 2.0, 3.0], 0.0, 1), // zero radius, same centre
