@@ -163,6 +163,18 @@ impl<K: BvKind> Hierarchy<K> {
     pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {
         check_positions(positions, self.tree.vertex_total())?;
         self.points.gather_from(positions, self.tree.vert_order());
+        self.invalidate();
+        match self.refit {
+            Refit::Lazy => {}
+            Refit::Eager => self.refit_all(),
+            Refit::EagerBottomUp => self.refit_bottom_up(),
+        }
+        Ok(())
+    }
+
+    /// Marks every bounding volume stale without moving anything (the next query refits
+    /// what it tests). Used by calibration and benchmarks to repeat a step's refit work.
+    pub fn invalidate(&mut self) {
         if self.epoch == u32::MAX {
             self.stamp.fill(0);
             self.tris.stamp.fill(0);
@@ -170,12 +182,21 @@ impl<K: BvKind> Hierarchy<K> {
         } else {
             self.epoch += 1;
         }
-        match self.refit {
-            Refit::Lazy => {}
-            Refit::Eager => self.refit_all(),
-            Refit::EagerBottomUp => self.refit_bottom_up(),
-        }
-        Ok(())
+    }
+
+    /// Refits exactly the stale nodes among `ids` (each once), as the lazy traversal does,
+    /// counting them as updates.
+    pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) {
+        let mut stale = Vec::new();
+        par.install(|| self.ensure_fitted(ids, par.is_parallel(), &mut stale));
+    }
+
+    /// The nodes fitted to the current positions (after a lazy query: the nodes it refitted
+    /// or found fresh), in increasing order.
+    pub fn fitted_nodes(&self) -> Vec<u32> {
+        (0..self.node_count() as u32)
+            .filter(|&n| self.stamp[n as usize] == self.epoch)
+            .collect()
     }
 
     /// Refits every stale node exactly.
@@ -255,6 +276,12 @@ impl<K: BvKind> Hierarchy<K> {
             self.tris
                 .fill(&self.tree, &self.points, self.tree.tri_range(leaf));
         }
+    }
+
+    /// Whether leaf `leaf`'s entries of the triangle cache are current.
+    #[inline]
+    pub(crate) fn leaf_tris_current(&self, leaf: usize) -> bool {
+        self.tris.stamp[leaf] == self.epoch
     }
 
     /// The triangle cache (current only for leaves passed to `ensure_leaf_tris` this step).

@@ -44,5 +44,5 @@ pub use error::{Error, Result};
 pub use hierarchy::{Hierarchy, InvariantError, Options, Refit};
 pub use mesh::Mesh;
 pub use par::Par;
-pub use traverse::{collide, collide_with, Contacts, Workspace};
+pub use traverse::{broad_phase, collide, collide_with, narrow_phase, Contacts, Workspace};
 pub use tree::RegionTree;

@@ -18,6 +18,7 @@ use crate::counters::Counters;
 use crate::hierarchy::Hierarchy;
 use crate::narrow;
 use crate::par::Par;
+use crate::points::Points;
 use crate::tree::RegionTree;
 
 /// Result of a query: contacts as `[triangle of A, triangle of B]` in the caller's original
@@ -93,50 +94,49 @@ fn run<K: BvKind>(
     ws: &mut Workspace,
     parallel: bool,
 ) -> Contacts {
-    let mut counters = traverse(a, b, ws, parallel);
-    let (pairs, prim_tests) = narrow_phase(a, b, ws, parallel);
-    counters.prim_tests = prim_tests;
-    counters.contacts = pairs.len() as u64;
-    Contacts { pairs, counters }
+    let mut counters = broad(a, b, ws, parallel);
+    let narrow = narrow(a, b, &ws.leaves, ws.grain, parallel);
+    debug_assert_eq!(narrow.counters.prim_tests, counters.prim_tests);
+    counters.contacts = narrow.counters.contacts;
+    Contacts {
+        pairs: narrow.pairs,
+        counters,
+    }
 }
 
-/// The hierarchy part of a query alone (benchmarks): lazy refit and traversal down to the
-/// overlapping leaf pairs, no triangle tests. Returns the counters of that part (`N_V`,
-/// `N_U`; `prim_tests` is the number of triangle pairs the narrow phase *would* test,
-/// `contacts` is 0) and the leaf pairs (internal node ids, in traversal order).
-#[doc(hidden)]
-pub fn traverse_with<'w, K: BvKind>(
-    a: &mut Hierarchy<K>,
-    b: &mut Hierarchy<K>,
-    ws: &'w mut Workspace,
-    par: Par,
-) -> (Counters, &'w [[u32; 2]]) {
-    let mut counters = par.install(|| traverse(a, b, ws, par.is_parallel()));
-    let (ta, tb) = (a.tree(), b.tree());
-    counters.prim_tests = ws
-        .leaves
-        .iter()
-        .map(|&[la, lb]| (ta.tri_range(la as usize).len() * tb.tri_range(lb as usize).len()) as u64)
-        .sum();
-    (counters, &ws.leaves)
-}
-
-/// The narrow phase alone (benchmarks): exact tests of the leaf pairs the last
-/// [`traverse_with`] on `ws` left there (the hierarchies must not have changed since).
-/// Returns the sorted contacts and `N_P`.
-#[doc(hidden)]
-pub fn narrow_with<K: BvKind>(
+/// The broad phase alone: lazy refit and traversal down to the overlapping leaf pairs, which
+/// stay in `ws` ([`Workspace::leaf_pairs`]). Its counters have `bv_tests`, `bv_updates` and
+/// `prim_tests` (the triangle pairs the narrow phase will test) as [`collide_with`] counts
+/// them; `contacts` is 0. With [`narrow_phase`] it is [`collide_with`] split in two, for
+/// benchmarks and cost-model calibration.
+pub fn broad_phase<K: BvKind>(
     a: &mut Hierarchy<K>,
     b: &mut Hierarchy<K>,
     ws: &mut Workspace,
     par: Par,
-) -> (Vec<[u32; 2]>, u64) {
-    par.install(|| narrow_phase(a, b, ws, par.is_parallel()))
+) -> Counters {
+    par.install(|| broad(a, b, ws, par.is_parallel()))
 }
 
-/// Refit (lazy) and level-synchronous traversal; leaves the overlapping leaf pairs in
-/// `ws.leaves` and returns `N_V` and `N_U`.
-fn traverse<K: BvKind>(
+/// The narrow phase alone: exact tests of every triangle pair of the given leaf pairs (node
+/// ids, as left in a [`Workspace`] by [`broad_phase`]). Counts `prim_tests` and `contacts`.
+pub fn narrow_phase<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    leaves: &[[u32; 2]],
+    par: Par,
+) -> Contacts {
+    par.install(|| narrow(a, b, leaves, DEFAULT_GRAIN, par.is_parallel()))
+}
+
+impl Workspace {
+    /// The overlapping leaf pairs (node ids) found by the last query or [`broad_phase`].
+    pub fn leaf_pairs(&self) -> &[[u32; 2]] {
+        &self.leaves
+    }
+}
+
+fn broad<K: BvKind>(
     a: &mut Hierarchy<K>,
     b: &mut Hierarchy<K>,
     ws: &mut Workspace,
@@ -206,51 +206,54 @@ fn traverse<K: BvKind>(
         std::mem::swap(&mut ws.ib, &mut ws.next_b);
     }
     counters.bv_updates = a.take_updates() + b.take_updates();
-
-    counters
-}
-
-/// The exact narrow phase on the leaf pairs in `ws.leaves`: the intersecting triangle pairs
-/// (original indices, sorted) and the number of triangle pairs tested (`N_P`).
-fn narrow_phase<K: BvKind>(
-    a: &mut Hierarchy<K>,
-    b: &mut Hierarchy<K>,
-    ws: &mut Workspace,
-    parallel: bool,
-) -> (Vec<[u32; 2]>, u64) {
+    // The narrow phase's triangle cache: each leaf met by a leaf pair, once per step.
     for &[la, lb] in &ws.leaves {
         a.ensure_leaf_tris(la as usize);
         b.ensure_leaf_tris(lb as usize);
     }
-    let (ha, hb) = (&*a, &*b);
-    let grain = ws.grain;
-    let mut prim_tests = 0u64;
+    let (ta, tb) = (a.tree(), b.tree());
+    counters.prim_tests = ws
+        .leaves
+        .iter()
+        .map(|&[x, y]| (ta.tri_range(x as usize).len() * tb.tri_range(y as usize).len()) as u64)
+        .sum();
+    counters
+}
+
+fn narrow<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    leaves: &[[u32; 2]],
+    grain: usize,
+    parallel: bool,
+) -> Contacts {
+    let mut counters = Counters::default();
     let leaf_grain = (grain / 64).max(1);
     let mut pairs = Vec::new();
-    if parallel && ws.leaves.len() > leaf_grain {
-        let parts: Vec<(Vec<[u32; 2]>, u64)> = ws
-            .leaves
+    if parallel && leaves.len() > leaf_grain {
+        let parts: Vec<(Vec<[u32; 2]>, u64)> = leaves
             .par_chunks(leaf_grain)
             .map(|chunk| {
                 let mut out = Vec::new();
                 let tested = chunk
                     .iter()
-                    .map(|&[la, lb]| narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut out))
+                    .map(|&[la, lb]| narrow_leaf_pair(a, b, la as usize, lb as usize, &mut out))
                     .sum::<u64>();
                 (out, tested)
             })
             .collect();
         for (out, tested) in parts {
             pairs.extend_from_slice(&out);
-            prim_tests += tested;
+            counters.prim_tests += tested;
         }
     } else {
-        for &[la, lb] in &ws.leaves {
-            prim_tests += narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut pairs);
+        for &[la, lb] in leaves {
+            counters.prim_tests += narrow_leaf_pair(a, b, la as usize, lb as usize, &mut pairs);
         }
     }
     pairs.sort_unstable();
-    (pairs, prim_tests)
+    counters.contacts = pairs.len() as u64;
+    Contacts { pairs, counters }
 }
 
 /// The output of expanding one chunk of a frontier.
@@ -302,6 +305,11 @@ impl Expansion {
     }
 }
 
+#[inline]
+pub(crate) fn corners(p: &Points, tri: [u32; 3]) -> [[f32; 3]; 3] {
+    tri.map(|v| p.get(v as usize))
+}
+
 /// Exact tests of every triangle pair of leaves `la` x `lb`; pushes the intersecting ones
 /// (original indices) and returns the number of pairs tested (`N_P`: all of them).
 ///
@@ -316,6 +324,9 @@ fn narrow_leaf_pair<K: BvKind>(
     lb: usize,
     out: &mut Vec<[u32; 2]>,
 ) -> u64 {
+    if !(a.leaf_tris_current(la) && b.leaf_tris_current(lb)) {
+        return narrow_leaf_pair_gather(a, b, la, lb, out);
+    }
     let (ta, tb) = (a.tree(), b.tree());
     let (ca, cb) = (a.tri_cache(), b.tri_cache());
     let ra = ta.tri_range(la);
@@ -346,6 +357,31 @@ fn narrow_leaf_pair<K: BvKind>(
                 & (lz[j] <= hi[2]);
             if ov && narrow::triangles_intersect(tri_a, &corners_b[j]) {
                 out.push([ta.tri_order()[i], order_b[j]]);
+            }
+        }
+    }
+    (ra.len() * rb.len()) as u64
+}
+
+/// [`narrow_leaf_pair`] for leaves whose cached triangles are stale (a caller's own leaf
+/// pairs, not from [`broad_phase`] this step): gathers the corners directly; pushes the intersecting ones
+/// (original indices) and returns the number of pairs tested.
+fn narrow_leaf_pair_gather<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    la: usize,
+    lb: usize,
+    out: &mut Vec<[u32; 2]>,
+) -> u64 {
+    let (ta, tb) = (a.tree(), b.tree());
+    let ra = ta.tri_range(la);
+    let rb = tb.tri_range(lb);
+    for i in ra.clone() {
+        let tri_a = corners(a.points(), ta.triangles()[i]);
+        for j in rb.clone() {
+            let tri_b = corners(b.points(), tb.triangles()[j]);
+            if narrow::triangles_intersect(&tri_a, &tri_b) {
+                out.push([ta.tri_order()[i], tb.tri_order()[j]]);
             }
         }
     }

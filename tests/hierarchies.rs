@@ -465,3 +465,35 @@ fn parallel_equals_sequential_sphere() {
 fn parallel_equals_sequential_aabb() {
     parallel_equals_sequential_for::<Aabb>();
 }
+
+#[test]
+fn broad_then_narrow_phase_equals_collide() {
+    let a = icosphere(3, 1.0, [0.0; 3]);
+    let b = icosphere(3, 1.0, [1.4, 0.3, 0.0]);
+    let mut ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
+    let mut hb = Hierarchy::<Dh>::new(&b, Options::default()).unwrap();
+    ha.update_positions(&wave(a.positions(), 0.5, 0.1, [0.0; 3]))
+        .unwrap();
+    hb.update_positions(&wave(b.positions(), 0.5, 0.1, [1.4, 0.3, 0.0]))
+        .unwrap();
+    let whole = collide(&mut ha.clone(), &mut hb.clone());
+    let mut ws = dhcd::Workspace::default();
+    let broad = dhcd::broad_phase(&mut ha, &mut hb, &mut ws, dhcd::Par::Seq);
+    let narrow = dhcd::narrow_phase(&ha, &hb, ws.leaf_pairs(), dhcd::Par::Rayon(2));
+    assert_eq!(narrow.pairs, whole.pairs);
+    assert_eq!(broad.bv_tests, whole.counters.bv_tests);
+    assert_eq!(broad.bv_updates, whole.counters.bv_updates);
+    assert_eq!(broad.prim_tests, whole.counters.prim_tests);
+    assert_eq!(narrow.counters.prim_tests, whole.counters.prim_tests);
+    // Replaying the step's refit: invalidate, then refit exactly the nodes the query fitted.
+    let fitted = ha.fitted_nodes();
+    assert_eq!(
+        fitted.len() + hb.fitted_nodes().len(),
+        whole.counters.bv_updates as usize
+    );
+    ha.invalidate();
+    assert_eq!(ha.validate().unwrap(), 0);
+    ha.refit_nodes(&fitted, dhcd::Par::Rayon(2));
+    assert_eq!(ha.take_updates(), fitted.len() as u64);
+    assert_eq!(ha.validate().unwrap(), fitted.len());
+}
