@@ -348,15 +348,26 @@ fn narrow_leaf_pair<K: BvKind>(
         let tri_a = &ca.corners[i];
         let lo = [ca.lo[0][i], ca.lo[1][i], ca.lo[2][i]];
         let hi = [ca.hi[0][i], ca.hi[1][i], ca.hi[2][i]];
-        for j in 0..n {
-            let ov = (hx[j] >= lo[0])
-                & (lx[j] <= hi[0])
-                & (hy[j] >= lo[1])
-                & (ly[j] <= hi[1])
-                & (hz[j] >= lo[2])
-                & (lz[j] <= hi[2]);
-            if ov && narrow::triangles_intersect(tri_a, &corners_b[j]) {
-                out.push([ta.tri_order()[i], order_b[j]]);
+        // Blocks of 64: the box tests become a bit mask without branches (vectorizable),
+        // then only the set bits (overlapping boxes) are visited.
+        for base in (0..n).step_by(64) {
+            let end = (base + 64).min(n);
+            let mut bits = 0u64;
+            for j in base..end {
+                let ov = (hx[j] >= lo[0])
+                    & (lx[j] <= hi[0])
+                    & (hy[j] >= lo[1])
+                    & (ly[j] <= hi[1])
+                    & (hz[j] >= lo[2])
+                    & (lz[j] <= hi[2]);
+                bits |= (ov as u64) << (j - base);
+            }
+            while bits != 0 {
+                let j = base + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if narrow::triangles_intersect(tri_a, &corners_b[j]) {
+                    out.push([ta.tri_order()[i], order_b[j]]);
+                }
             }
         }
     }
