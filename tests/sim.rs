@@ -4,8 +4,7 @@
 use std::collections::HashMap;
 
 use dhcd::sim::{
-    pawn_mesh, pawn_mesh_with, pawn_scene, scene_with_mesh, ObjectContact, SimConfig,
-    Simulation,
+    pawn_mesh, pawn_mesh_with, pawn_scene, scene_with_mesh, ObjectContact, SimConfig, Simulation,
 };
 use dhcd::Mesh;
 use glam::DVec3;
@@ -58,12 +57,17 @@ fn approx_contacts(sim: &Simulation) -> Vec<ObjectContact> {
             let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
             object_boxes.push((lo, hi));
             // A torn triangle would flood the grid; such a scene fails elsewhere anyway.
-            assert!((hi - lo).max_element() < 0.5 * sim.scale(), "triangle {t} torn");
+            assert!(
+                (hi - lo).max_element() < 0.5 * sim.scale(),
+                "triangle {t} torn"
+            );
             let (l, h) = ((lo / cell).floor(), (hi / cell).floor());
             for x in l.x as i64..=h.x as i64 {
                 for y in l.y as i64..=h.y as i64 {
                     for z in l.z as i64..=h.z as i64 {
-                        grid.entry([x, y, z]).or_default().push((o as u32, t as u32));
+                        grid.entry([x, y, z])
+                            .or_default()
+                            .push((o as u32, t as u32));
                     }
                 }
             }
@@ -156,7 +160,10 @@ fn pawn_faces_outward_and_has_pawn_proportions() {
     let width = hi.x - lo.x;
     assert!(width > 0.5 && width < 0.8, "width {width}");
     let cylinder = std::f64::consts::PI * (width / 2.0).powi(2);
-    assert!(volume < 0.6 * cylinder && volume > 0.1 * cylinder, "volume {volume}");
+    assert!(
+        volume < 0.6 * cylinder && volume > 0.1 * cylinder,
+        "volume {volume}"
+    );
 }
 
 #[test]
@@ -231,7 +238,9 @@ fn coarse_scene(config: &SimConfig) -> Simulation {
 fn thousand_frames_stay_finite_and_bounded() {
     let config = SimConfig::default();
     let mut sim = coarse_scene(&config);
-    let vertices: usize = (0..sim.object_count()).map(|o| sim.positions(o).len()).sum();
+    let vertices: usize = (0..sim.object_count())
+        .map(|o| sim.positions(o).len())
+        .sum();
     let mut contacts = Vec::new();
     let mut max_kinetic: f64 = 0.0;
     let mut max_potential: f64 = 0.0;
@@ -255,7 +264,10 @@ fn thousand_frames_stay_finite_and_bounded() {
         max_potential.is_finite() && max_potential < 50.0 * vertices as f64,
         "potential {max_potential}"
     );
-    assert!(touching_frames > 800, "touching in only {touching_frames} frames");
+    assert!(
+        touching_frames > 800,
+        "touching in only {touching_frames} frames"
+    );
     // Objects never fly apart: every centroid stays within two scene widths of the origin.
     for o in 0..sim.object_count() {
         let c = centroid(sim.positions(o));
@@ -300,7 +312,11 @@ fn contacts_push_objects_apart() {
     };
     let pawn = pawn_mesh_with(12, 24, 1.0).unwrap();
     let shifted = |dx: f32| {
-        let p = pawn.positions().iter().map(|p| [p[0] + dx, p[1], p[2]]).collect();
+        let p = pawn
+            .positions()
+            .iter()
+            .map(|p| [p[0] + dx, p[1], p[2]])
+            .collect();
         Mesh::new(p, pawn.triangles().to_vec()).unwrap()
     };
     let make = || Simulation::new(vec![shifted(-0.35), shifted(0.35)], config.clone()).unwrap();

@@ -459,7 +459,9 @@ impl Simulation {
                 continue;
             }
             let behind = |t: &[DVec3; 3], n: DVec3, c: DVec3| {
-                t.iter().map(|&v| (c - v).dot(n).max(0.0)).fold(0.0, f64::max)
+                t.iter()
+                    .map(|&v| (c - v).dot(n).max(0.0))
+                    .fold(0.0, f64::max)
             };
             let depth = (behind(&ta, nb, cb) + behind(&tb, na, ca)).min(max_depth);
             let push = dir * (c.contact_stiffness * (offset + depth));
@@ -555,14 +557,18 @@ impl Body {
             stiffness[s.a as usize] += s.k;
             stiffness[s.b as usize] += s.k;
         }
-        let mass: Vec<f64> = stiffness.iter().map(|&k| (4.0 * h * h * k).max(1.0)).collect();
+        let mass: Vec<f64> = stiffness
+            .iter()
+            .map(|&k| (4.0 * h * h * k).max(1.0))
+            .collect();
         let total_mass: f64 = mass.iter().sum();
         let com = pos.iter().zip(&mass).map(|(p, m)| *p * *m).sum::<DVec3>() / total_mass;
         let rest_offset = pos.iter().map(|p| *p - com).collect();
-        let (lo, hi) = pos.iter().fold(
-            (f64::INFINITY, f64::NEG_INFINITY),
-            |(lo, hi), p| (lo.min(p.y), hi.max(p.y)),
-        );
+        let (lo, hi) = pos
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.y), hi.max(p.y))
+            });
         let height = pos
             .iter()
             .map(|p| if hi > lo { (p.y - lo) / (hi - lo) } else { 0.5 })
