@@ -497,3 +497,63 @@ fn broad_then_narrow_phase_equals_collide() {
     assert_eq!(ha.take_updates(), fitted.len() as u64);
     assert_eq!(ha.validate().unwrap(), fitted.len());
 }
+
+fn scaled(mesh: &Mesh, s: f32, offset: [f32; 3]) -> Mesh {
+    with_positions(
+        mesh,
+        mesh.positions()
+            .iter()
+            .map(|p| {
+                [
+                    p[0] * s + offset[0],
+                    p[1] * s + offset[1],
+                    p[2] * s + offset[2],
+                ]
+            })
+            .collect(),
+    )
+}
+
+#[test]
+fn extreme_magnitudes_stay_exact() {
+    // Squared distances overflow (1e25^2) or underflow (1e-25^2) in f32: the bounds must stay
+    // conservative, and touching triangles must still be found.
+    let a = grid(3, 3, 1.0, [0.0; 3]);
+    let b = Mesh::new(
+        a.positions()
+            .iter()
+            .map(|p| [p[0], 1.5, p[1] - 1.0])
+            .collect(),
+        a.triangles().to_vec(),
+    )
+    .unwrap();
+    for s in [1e25f32, 1e18, 1e-18, 1e-25, 1e-38] {
+        let (sa, sb) = (scaled(&a, s, [0.0; 3]), scaled(&b, s, [0.0; 3]));
+        assert!(!assert_exact(&sa, &sb, 3).is_empty(), "scale {s}");
+    }
+    // Far from the origin: large common offset, small features.
+    let (fa, fb) = (
+        scaled(&a, 1.0, [3e6, -2e6, 1e6]),
+        scaled(&b, 1.0, [3e6, -2e6, 1e6]),
+    );
+    assert!(!assert_exact(&fa, &fb, 3).is_empty());
+}
+
+#[test]
+fn unreferenced_vertices_are_ignored() {
+    let mut positions = vec![[100.0, 100.0, 100.0]];
+    positions.extend_from_slice(icosphere(1, 1.0, [0.0; 3]).positions());
+    positions.push([-50.0, 0.0, 0.0]);
+    let tris = icosphere(1, 1.0, [0.0; 3])
+        .triangles()
+        .iter()
+        .map(|t| t.map(|v| v + 1))
+        .collect();
+    let a = Mesh::new(positions, tris).unwrap();
+    let b = icosphere(1, 1.0, [0.5, 0.0, 0.0]);
+    assert!(!assert_exact(&a, &b, 4).is_empty());
+    let mut h = Hierarchy::<Aabb>::new(&a, Options::default()).unwrap();
+    h.refit_all();
+    // The root box is the sphere's, not stretched to the unreferenced vertices.
+    assert!(h.record(0).max[0] < 2.0 && h.record(0).min[0] > -2.0);
+}
