@@ -111,9 +111,11 @@ impl TriCache {
         for i in range {
             let c = tree.triangles()[i].map(|v| p.get(v as usize));
             self.corners[i] = c;
-            for k in 0..3 {
-                self.lo[k][i] = c[0][k].min(c[1][k]).min(c[2][k]);
-                self.hi[k][i] = c[0][k].max(c[1][k]).max(c[2][k]);
+            let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
+            let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
+            for (k, (l, h)) in lo.into_iter().zip(hi).enumerate() {
+                self.lo[k][i] = l;
+                self.hi[k][i] = h;
             }
         }
     }
