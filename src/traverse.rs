@@ -36,14 +36,14 @@ pub const DEFAULT_GRAIN: usize = 1024;
 /// avoid allocating every step. Also holds the parallel grain.
 #[derive(Clone, Debug)]
 pub struct Workspace {
-    grain: usize,
-    ia: Vec<u32>,
-    ib: Vec<u32>,
-    next_a: Vec<u32>,
-    next_b: Vec<u32>,
-    mask: Vec<u32>,
-    leaves: Vec<[u32; 2]>,
-    stale: Vec<u32>,
+    pub(crate) grain: usize,
+    pub(crate) ia: Vec<u32>,
+    pub(crate) ib: Vec<u32>,
+    pub(crate) next_a: Vec<u32>,
+    pub(crate) next_b: Vec<u32>,
+    pub(crate) mask: Vec<u32>,
+    pub(crate) leaves: Vec<[u32; 2]>,
+    pub(crate) stale: Vec<u32>,
 }
 
 impl Default for Workspace {
@@ -188,15 +188,22 @@ fn run<K: BvKind>(
 
 /// The output of expanding one chunk of a frontier.
 #[derive(Default)]
-struct Expansion {
-    next_a: Vec<u32>,
-    next_b: Vec<u32>,
-    leaves: Vec<[u32; 2]>,
+pub(crate) struct Expansion {
+    pub(crate) next_a: Vec<u32>,
+    pub(crate) next_b: Vec<u32>,
+    pub(crate) leaves: Vec<[u32; 2]>,
 }
 
 impl Expansion {
     /// Appends the children pairs of the overlapping pairs (`mask[k] != 0`) and the leaf pairs.
-    fn expand(&mut self, ta: &RegionTree, tb: &RegionTree, ia: &[u32], ib: &[u32], mask: &[u32]) {
+    pub(crate) fn expand(
+        &mut self,
+        ta: &RegionTree,
+        tb: &RegionTree,
+        ia: &[u32],
+        ib: &[u32],
+        mask: &[u32],
+    ) {
         for k in 0..ia.len() {
             if mask[k] == 0 {
                 continue;

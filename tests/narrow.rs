@@ -72,7 +72,10 @@ fn origin_in_hull(s: &[V]) -> bool {
                     let l1 = vol(u, o, w, x);
                     let l2 = vol(u, v, o, x);
                     let l3 = vol(u, v, w, o);
-                    if [l0, l1, l2, l3].iter().all(|&li| li == 0 || (li > 0) == (d > 0)) {
+                    if [l0, l1, l2, l3]
+                        .iter()
+                        .all(|&li| li == 0 || (li > 0) == (d > 0))
+                    {
                         return true;
                     }
                 }
@@ -88,7 +91,10 @@ fn reference_scaled(a: &Tri, b: &Tri, scale: i32) -> bool {
     let conv = |p: &[f32; 3]| -> V {
         p.map(|c| {
             let x = f64::from(c) * f;
-            assert!(x == x.trunc() && x.abs() <= 67_108_864.0, "not a grid point: {c}");
+            assert!(
+                x == x.trunc() && x.abs() <= 67_108_864.0,
+                "not a grid point: {c}"
+            );
             x as i128
         })
     };
@@ -239,18 +245,38 @@ const A: Tri = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
 
 #[test]
 fn crossing_triangles_intersect() {
-    check(A, [[1.0, 1.0, -1.0], [3.0, 1.0, -1.0], [1.0, 1.0, 1.0]], true);
-    check(A, [[1.0, 1.0, -2.0], [2.0, 1.0, 2.0], [1.0, 2.0, 2.0]], true);
+    check(
+        A,
+        [[1.0, 1.0, -1.0], [3.0, 1.0, -1.0], [1.0, 1.0, 1.0]],
+        true,
+    );
+    check(
+        A,
+        [[1.0, 1.0, -2.0], [2.0, 1.0, 2.0], [1.0, 2.0, 2.0]],
+        true,
+    );
 }
 
 #[test]
 fn separated_triangles_do_not_intersect() {
     // Far apart (AABB reject).
-    check(A, [[10.0, 10.0, 10.0], [11.0, 10.0, 10.0], [10.0, 11.0, 10.0]], false);
+    check(
+        A,
+        [[10.0, 10.0, 10.0], [11.0, 10.0, 10.0], [10.0, 11.0, 10.0]],
+        false,
+    );
     // Boxes overlap, strictly above the plane.
-    check(A, [[1.0, 1.0, 1.0], [3.0, 1.0, 2.0], [1.0, 1.0, 3.0]], false);
+    check(
+        A,
+        [[1.0, 1.0, 1.0], [3.0, 1.0, 2.0], [1.0, 1.0, 3.0]],
+        false,
+    );
     // Crosses the plane outside the triangle (beyond the hypotenuse).
-    check(A, [[3.0, 3.0, -1.0], [4.0, 3.0, 1.0], [3.0, 4.0, 1.0]], false);
+    check(
+        A,
+        [[3.0, 3.0, -1.0], [4.0, 3.0, 1.0], [3.0, 4.0, 1.0]],
+        false,
+    );
     // Both straddle each other's plane but miss (interlocked ring-like near miss).
     check(
         [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, 0.0, 4.0]],
@@ -278,33 +304,77 @@ fn vertex_touches_face_edge_and_vertex() {
     // Vertex on the face interior.
     check(A, [[1.0, 1.0, 0.0], [2.0, 1.0, 2.0], [1.0, 2.0, 2.0]], true);
     // Vertex on an edge.
-    check(A, [[2.0, 0.0, 0.0], [2.0, 1.0, 2.0], [2.0, -1.0, 2.0]], true);
+    check(
+        A,
+        [[2.0, 0.0, 0.0], [2.0, 1.0, 2.0], [2.0, -1.0, 2.0]],
+        true,
+    );
     // Vertex on a vertex.
-    check(A, [[4.0, 0.0, 0.0], [5.0, 1.0, 2.0], [5.0, -1.0, 2.0]], true);
+    check(
+        A,
+        [[4.0, 0.0, 0.0], [5.0, 1.0, 2.0], [5.0, -1.0, 2.0]],
+        true,
+    );
     // Vertex just outside an edge in the plane (no touch).
-    check(A, [[2.0, -1.0, 0.0], [2.0, 1.0, 2.0], [2.0, -1.0, 2.0]], false);
+    check(
+        A,
+        [[2.0, -1.0, 0.0], [2.0, 1.0, 2.0], [2.0, -1.0, 2.0]],
+        false,
+    );
 }
 
 #[test]
 fn skew_edges_touch_at_a_point() {
     // b (in the plane x = 2) has an edge lying in a's plane, overlapping a.
-    check(A, [[2.0, -1.0, 0.0], [2.0, 1.0, 0.0], [2.0, 0.0, -3.0]], true);
+    check(
+        A,
+        [[2.0, -1.0, 0.0], [2.0, 1.0, 0.0], [2.0, 0.0, -3.0]],
+        true,
+    );
     // Same but b's edge lifted to z = 1: misses.
-    check(A, [[2.0, -1.0, 1.0], [2.0, 1.0, 1.0], [2.0, 0.0, 3.0]], false);
+    check(
+        A,
+        [[2.0, -1.0, 1.0], [2.0, 1.0, 1.0], [2.0, 0.0, 3.0]],
+        false,
+    );
     // Edge-edge touching from outside the plane on both sides.
-    check(A, [[2.0, -1.0, 0.0], [2.0, -0.5, 1.0], [2.0, -0.5, -1.0]], false);
-    check(A, [[2.0, -1.0, 0.0], [2.0, 0.0, 1.0], [2.0, 0.0, -1.0]], true);
-    check(A, [[2.0, -1.0, 1.0], [2.0, 1.0, -1.0], [2.0, -3.0, 0.0]], true);
+    check(
+        A,
+        [[2.0, -1.0, 0.0], [2.0, -0.5, 1.0], [2.0, -0.5, -1.0]],
+        false,
+    );
+    check(
+        A,
+        [[2.0, -1.0, 0.0], [2.0, 0.0, 1.0], [2.0, 0.0, -1.0]],
+        true,
+    );
+    check(
+        A,
+        [[2.0, -1.0, 1.0], [2.0, 1.0, -1.0], [2.0, -3.0, 0.0]],
+        true,
+    );
 }
 
 #[test]
 fn shared_vertex_and_shared_edge() {
     // Shared vertex position, fanning out of the plane.
-    check(A, [[0.0, 0.0, 0.0], [-1.0, -1.0, 2.0], [-2.0, 0.0, 1.0]], true);
+    check(
+        A,
+        [[0.0, 0.0, 0.0], [-1.0, -1.0, 2.0], [-2.0, 0.0, 1.0]],
+        true,
+    );
     // Shared edge, folded.
-    check(A, [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, -2.0, 3.0]], true);
+    check(
+        A,
+        [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, -2.0, 3.0]],
+        true,
+    );
     // Shared edge, coplanar, on the other side.
-    check(A, [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, -2.0, 0.0]], true);
+    check(
+        A,
+        [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, -2.0, 0.0]],
+        true,
+    );
 }
 
 #[test]
@@ -323,19 +393,39 @@ fn identical_triangles() {
 #[test]
 fn coplanar_cases() {
     // Overlap (edges cross, no vertex inside the other).
-    check(A, [[-1.0, 1.0, 0.0], [3.0, 1.0, 0.0], [1.0, -1.0, 0.0]], true);
+    check(
+        A,
+        [[-1.0, 1.0, 0.0], [3.0, 1.0, 0.0], [1.0, -1.0, 0.0]],
+        true,
+    );
     // Containment (b inside a, and a contains b).
     check(A, [[1.0, 1.0, 0.0], [2.0, 1.0, 0.0], [1.0, 2.0, 0.0]], true);
     // Disjoint, boxes overlap.
-    check(A, [[3.0, 3.0, 0.0], [4.0, 4.0, 0.0], [3.0, 4.0, 0.0]], false);
+    check(
+        A,
+        [[3.0, 3.0, 0.0], [4.0, 4.0, 0.0], [3.0, 4.0, 0.0]],
+        false,
+    );
     // Vertex on edge (hypotenuse x + y = 4).
     check(A, [[2.0, 2.0, 0.0], [4.0, 4.0, 0.0], [3.0, 5.0, 0.0]], true);
     // Collinear edges overlapping, triangles on opposite sides.
-    check(A, [[2.0, 0.0, 0.0], [6.0, 0.0, 0.0], [4.0, -2.0, 0.0]], true);
+    check(
+        A,
+        [[2.0, 0.0, 0.0], [6.0, 0.0, 0.0], [4.0, -2.0, 0.0]],
+        true,
+    );
     // Collinear edges touching at an endpoint only.
-    check(A, [[4.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, -2.0, 0.0]], true);
+    check(
+        A,
+        [[4.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, -2.0, 0.0]],
+        true,
+    );
     // Collinear edges, a gap between.
-    check(A, [[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, -2.0, 0.0]], false);
+    check(
+        A,
+        [[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, -2.0, 0.0]],
+        false,
+    );
     // Star of David: two triangles, no vertex inside the other.
     check(
         [[0.0, 0.0, 0.0], [6.0, 0.0, 0.0], [3.0, 6.0, 0.0]],
@@ -362,7 +452,11 @@ fn coplanar_cases() {
 /// Segment `p q` as a degenerate triangle with its midpoint (collinear corners) and as one
 /// with a repeated endpoint position.
 fn seg_tris(p: [f32; 3], q: [f32; 3]) -> [Tri; 2] {
-    let m = [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0, (p[2] + q[2]) / 2.0];
+    let m = [
+        (p[0] + q[0]) / 2.0,
+        (p[1] + q[1]) / 2.0,
+        (p[2] + q[2]) / 2.0,
+    ];
     [[p, m, q], [p, q, q]]
 }
 
@@ -459,7 +553,11 @@ fn point_vs_segment_and_point() {
         check(a, point_tri([2.0, 1.0, 2.0]), false);
     }
     check(point_tri([1.0, 2.0, 3.0]), point_tri([1.0, 2.0, 3.0]), true);
-    check(point_tri([1.0, 2.0, 3.0]), point_tri([1.0, 2.0, 4.0]), false);
+    check(
+        point_tri([1.0, 2.0, 3.0]),
+        point_tri([1.0, 2.0, 4.0]),
+        false,
+    );
     // A point-triangle with a repeated corner vs a collinear one.
     check(
         [[1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [3.0, 3.0, 3.0]],

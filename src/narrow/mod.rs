@@ -47,7 +47,10 @@ pub fn intersection_segment(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> Option<[[f3
         return None;
     }
     let pts = pts.as_slice();
-    debug_assert!(!pts.is_empty(), "an intersecting pair yields a candidate point");
+    debug_assert!(
+        !pts.is_empty(),
+        "an intersecting pair yields a candidate point"
+    );
     let first = *pts.first()?;
     let (mut p, mut q, mut best) = (first, first, -1.0);
     for (i, u) in pts.iter().enumerate() {

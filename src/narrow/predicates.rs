@@ -86,7 +86,6 @@ pub(crate) fn lex_le(a: &[f32], b: &[f32]) -> bool {
     true
 }
 
-
 /// `p + t (q - p)` in `f64`, `t` clamped to `[0, 1]`; exact at `t = 0` and `t = 1`.
 #[inline]
 pub(crate) fn lerp(p: &P3, q: &P3, t: f64) -> [f64; 3] {

@@ -6,9 +6,7 @@
 //! *is* the segment between its lexicographically smallest and largest corners, and is
 //! tested as that segment (or point).
 
-use super::predicates::{
-    keep, lerp, lex_le, orient2d, orient3d, projection_axis, sign, Tri, P3,
-};
+use super::predicates::{keep, lerp, lex_le, orient2d, orient3d, projection_axis, sign, Tri, P3};
 
 /// Receives the candidate points of the intersection region. With `COLLECT = false` the
 /// test stops at the first hit and computes no points.
