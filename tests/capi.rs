@@ -306,7 +306,7 @@ fn bad_arguments_are_error_codes() {
             DHCD_ERR_INVALID_ARGUMENT
         );
         // Misaligned array.
-        let bytes = vec![0u8; 64];
+        let bytes = [0u8; 64];
         let odd = bytes.as_ptr().add(1).cast::<f32>();
         assert_eq!(
             dhcd_hierarchy_update_positions(a, odd, 1),

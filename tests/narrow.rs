@@ -62,8 +62,7 @@ fn origin_in_hull(s: &[V]) -> bool {
                 {
                     return true;
                 }
-                for l in k + 1..n {
-                    let x = s[l];
+                for &x in &s[k + 1..n] {
                     let d = vol(u, v, w, x);
                     if d == 0 {
                         continue;
