@@ -86,7 +86,8 @@ int dhcd_self_collide(DhcdHierarchy *h, uint32_t threads, DhcdContacts *out);
 void dhcd_contacts_free(DhcdContacts *c);
 
 /* Contact detail: segments receives 6 floats (p.xyz, q.xyz) per pair. For
- * self-contacts pass the same hierarchy as a and b. */
+ * self-contacts pass the same hierarchy as a and b. With count == 0, pairs and
+ * segments may be NULL. */
 int dhcd_contact_segments(const DhcdHierarchy *a, const DhcdHierarchy *b,
                           const uint32_t *pairs, size_t count, float *segments);
 

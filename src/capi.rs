@@ -464,7 +464,7 @@ pub unsafe extern "C" fn dhcd_self_collide(
 /// Contact detail: the intersection segment of each of `count` pairs `[tri of a, tri of b]`
 /// (`pairs` holds `2 * count` indices, e.g. `DhcdContacts.pairs`), in the current poses,
 /// into `segments` (`6 * count` floats: p.xyz, q.xyz per pair). For self-contacts pass the
-/// same hierarchy as `a` and `b`.
+/// same hierarchy as `a` and `b`. With `count == 0`, `pairs` and `segments` may be NULL.
 ///
 /// # Safety
 /// `a`, `b` null or live handles; `pairs` holds `2 * count` `u32`, `segments` room for
@@ -481,6 +481,10 @@ pub unsafe extern "C" fn dhcd_contact_segments(
         // SAFETY: null or live handles (caller's contract); only read.
         let (a, b) = unsafe { (a.as_ref(), b.as_ref()) };
         let (a, b) = (a.ok_or_else(|| null("a"))?, b.ok_or_else(|| null("b"))?);
+        if count == 0 {
+            // An empty result (`pairs == NULL`) has no segments.
+            return Ok(());
+        }
         // SAFETY: `pairs` holds `2 * count` u32 (caller's contract).
         let pairs = unsafe { slice(pairs.cast::<[u32; 2]>(), count, "pairs")? };
         if segments.is_null() {

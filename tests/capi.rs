@@ -258,6 +258,19 @@ fn bad_arguments_are_error_codes() {
         assert_eq!(dhcd_hierarchy_method(null(), &mut 0), DHCD_ERR_NULL);
         assert_eq!(
             dhcd_contact_segments(a, a, null(), 0, null_mut()),
+            DHCD_OK,
+            "empty result"
+        );
+        assert_eq!(
+            dhcd_contact_segments(a, a, null(), 1, [0.0f32; 6].as_mut_ptr()),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_contact_segments(a, a, [0u32, 0].as_ptr(), 1, null_mut()),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_contact_segments(null(), a, null(), 0, null_mut()),
             DHCD_ERR_NULL
         );
         assert_eq!(

@@ -88,6 +88,7 @@ int main(void) {
   OK(dhcd_hierarchy_update_positions(b, far, 3));
   OK(dhcd_collide(a, b, 1, &c));
   CHECK(c.count == 0 && c.pairs == NULL);
+  OK(dhcd_contact_segments(a, b, c.pairs, c.count, NULL)); /* empty: nothing to write */
   dhcd_contacts_free(&c);
 
   /* Errors: null, wrong length, same handle twice, wrong kind. */
