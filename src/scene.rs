@@ -8,9 +8,9 @@
 //!    whose closed boxes overlap are kept. Far-apart objects cost a box comparison.
 //! 2. **Schedule**: the kept pairs, and the objects with self-collision on, are *jobs*,
 //!    sorted by object. Each job needs `&mut` access to its objects (lazy refit), so the
-//!    jobs are cut into batches in which no object appears twice: a job goes into the batch
-//!    after the last batch of either of its objects (greedy, in job order, independent of
-//!    the thread count).
+//!    jobs are cut into batches in which no object appears twice: each job, in order, goes
+//!    into the first batch where both its objects are free (first-fit edge colouring;
+//!    independent of the thread count).
 //! 3. **Narrow**: the jobs of a batch run in parallel (rayon), each a two-object query
 //!    ([`collide_with`](crate::collide_with)) or a self query
 //!    ([`self_collide_with`](crate::self_collide_with)) that may itself split its frontier
@@ -67,6 +67,9 @@ pub struct SceneContacts {
     pub counters: Counters,
     /// Object pairs whose root boxes were compared in the broad phase.
     pub broad_phase_tests: u64,
+    /// Batches of the parallel schedule (jobs in one batch share no object and run
+    /// concurrently; batches run one after the other).
+    pub batches: usize,
 }
 
 /// One object of the scene.
@@ -354,16 +357,21 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
     );
     jobs.sort_unstable();
 
-    // Batches in which no object appears twice (greedy, in job order).
-    let mut next_free = vec![0usize; objects.len()];
+    // Batches in which no object appears twice: first fit, in job order (a greedy edge
+    // colouring: at most 2 * max_degree - 1 batches). `used[b][i]`: object `i` is in batch `b`.
     let mut batches: Vec<Vec<usize>> = Vec::new();
+    let mut used: Vec<Vec<bool>> = Vec::new();
     for (k, &(a, b)) in jobs.iter().enumerate() {
-        let batch = next_free[a].max(next_free[b]);
-        next_free[a] = batch + 1;
-        next_free[b] = batch + 1;
-        if batches.len() <= batch {
-            batches.resize_with(batch + 1, Vec::new);
-        }
+        let batch = match used.iter().position(|u| !u[a] && !u[b]) {
+            Some(batch) => batch,
+            None => {
+                used.push(vec![false; objects.len()]);
+                batches.push(Vec::new());
+                used.len() - 1
+            }
+        };
+        used[batch][a] = true;
+        used[batch][b] = true;
         batches[batch].push(k);
     }
 
@@ -417,6 +425,7 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
 
     let mut out = SceneContacts {
         broad_phase_tests,
+        batches: batches.len(),
         ..SceneContacts::default()
     };
     for (&(a, b), c) in jobs.iter().zip(results) {

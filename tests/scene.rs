@@ -271,3 +271,25 @@ fn stale_contacts_are_an_error_for_segments() {
     scene.remove(a).unwrap();
     assert_eq!(scene.contact_segments(&c), Err(Error::UnknownObject(0)));
 }
+
+#[test]
+fn a_ring_of_touching_objects_runs_in_two_batches() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let mut scene = Scene::new(Method::Dh, Options::default());
+    let n = 8;
+    for k in 0..n {
+        let id = scene.add(&m).unwrap();
+        let a = k as f32 / n as f32 * std::f32::consts::TAU;
+        let offset = [2.4 * a.cos(), 2.4 * a.sin(), 0.0];
+        scene
+            .update_positions(id, &dhcd::shapes::translated(m.positions(), offset))
+            .unwrap();
+    }
+    let c = scene.contacts(Par::Rayon(2));
+    assert_eq!(c.per_pair.len(), n, "neighbours only");
+    assert_eq!(
+        c.batches, 2,
+        "first fit colours an even ring with two colours"
+    );
+    assert!(!c.pairs.is_empty());
+}
