@@ -121,18 +121,39 @@ impl<K: BvKind> Hierarchy<K> {
     pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {
         check_positions(positions, self.tree.vertex_total())?;
         self.points.gather_from(positions, self.tree.vert_order());
-        if self.epoch == u32::MAX {
-            self.stamp.fill(0);
-            self.epoch = 1;
-        } else {
-            self.epoch += 1;
-        }
+        self.invalidate();
         match self.refit {
             Refit::Lazy => {}
             Refit::Eager => self.refit_all(),
             Refit::EagerBottomUp => self.refit_bottom_up(),
         }
         Ok(())
+    }
+
+    /// Marks every bounding volume stale without moving anything (the next query refits
+    /// what it tests). Used by calibration and benchmarks to repeat a step's refit work.
+    pub fn invalidate(&mut self) {
+        if self.epoch == u32::MAX {
+            self.stamp.fill(0);
+            self.epoch = 1;
+        } else {
+            self.epoch += 1;
+        }
+    }
+
+    /// Refits exactly the stale nodes among `ids` (each once), as the lazy traversal does,
+    /// counting them as updates.
+    pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) {
+        let mut stale = Vec::new();
+        par.install(|| self.ensure_fitted(ids, par.is_parallel(), &mut stale));
+    }
+
+    /// The nodes fitted to the current positions (after a lazy query: the nodes it refitted
+    /// or found fresh), in increasing order.
+    pub fn fitted_nodes(&self) -> Vec<u32> {
+        (0..self.node_count() as u32)
+            .filter(|&n| self.stamp[n as usize] == self.epoch)
+            .collect()
     }
 
     /// Refits every stale node exactly.

@@ -52,5 +52,5 @@ pub use mesh::Mesh;
 pub use par::Par;
 pub use scene::{ObjectId, Scene, SceneContacts};
 pub use self_collide::{self_collide, self_collide_with};
-pub use traverse::{collide, collide_with, Contacts, Workspace};
+pub use traverse::{broad_phase, collide, collide_with, narrow_phase, Contacts, Workspace};
 pub use tree::RegionTree;

@@ -92,6 +92,54 @@ fn run<K: BvKind>(
     ws: &mut Workspace,
     parallel: bool,
 ) -> Contacts {
+    let mut counters = broad(a, b, ws, parallel);
+    let narrow = narrow(a, b, &ws.leaves, ws.grain, parallel);
+    debug_assert_eq!(narrow.counters.prim_tests, counters.prim_tests);
+    counters.contacts = narrow.counters.contacts;
+    Contacts {
+        pairs: narrow.pairs,
+        counters,
+    }
+}
+
+/// The broad phase alone: lazy refit and traversal down to the overlapping leaf pairs, which
+/// stay in `ws` ([`Workspace::leaf_pairs`]). Its counters have `bv_tests`, `bv_updates` and
+/// `prim_tests` (the triangle pairs the narrow phase will test) as [`collide_with`] counts
+/// them; `contacts` is 0. With [`narrow_phase`] it is [`collide_with`] split in two, for
+/// benchmarks and cost-model calibration.
+pub fn broad_phase<K: BvKind>(
+    a: &mut Hierarchy<K>,
+    b: &mut Hierarchy<K>,
+    ws: &mut Workspace,
+    par: Par,
+) -> Counters {
+    par.install(|| broad(a, b, ws, par.is_parallel()))
+}
+
+/// The narrow phase alone: exact tests of every triangle pair of the given leaf pairs (node
+/// ids, as left in a [`Workspace`] by [`broad_phase`]). Counts `prim_tests` and `contacts`.
+pub fn narrow_phase<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    leaves: &[[u32; 2]],
+    par: Par,
+) -> Contacts {
+    par.install(|| narrow(a, b, leaves, DEFAULT_GRAIN, par.is_parallel()))
+}
+
+impl Workspace {
+    /// The overlapping leaf pairs (node ids) found by the last query or [`broad_phase`].
+    pub fn leaf_pairs(&self) -> &[[u32; 2]] {
+        &self.leaves
+    }
+}
+
+fn broad<K: BvKind>(
+    a: &mut Hierarchy<K>,
+    b: &mut Hierarchy<K>,
+    ws: &mut Workspace,
+    parallel: bool,
+) -> Counters {
     let mut counters = Counters::default();
     let grain = ws.grain;
     ws.leaves.clear();
@@ -155,19 +203,33 @@ fn run<K: BvKind>(
         std::mem::swap(&mut ws.ib, &mut ws.next_b);
     }
     counters.bv_updates = a.take_updates() + b.take_updates();
+    let (ta, tb) = (a.tree(), b.tree());
+    counters.prim_tests = ws
+        .leaves
+        .iter()
+        .map(|&[x, y]| (ta.tri_range(x as usize).len() * tb.tri_range(y as usize).len()) as u64)
+        .sum();
+    counters
+}
 
-    let (ha, hb) = (&*a, &*b);
+fn narrow<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    leaves: &[[u32; 2]],
+    grain: usize,
+    parallel: bool,
+) -> Contacts {
+    let mut counters = Counters::default();
     let leaf_grain = (grain / 64).max(1);
     let mut pairs = Vec::new();
-    if parallel && ws.leaves.len() > leaf_grain {
-        let parts: Vec<(Vec<[u32; 2]>, u64)> = ws
-            .leaves
+    if parallel && leaves.len() > leaf_grain {
+        let parts: Vec<(Vec<[u32; 2]>, u64)> = leaves
             .par_chunks(leaf_grain)
             .map(|chunk| {
                 let mut out = Vec::new();
                 let tested = chunk
                     .iter()
-                    .map(|&[la, lb]| narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut out))
+                    .map(|&[la, lb]| narrow_leaf_pair(a, b, la as usize, lb as usize, &mut out))
                     .sum::<u64>();
                 (out, tested)
             })
@@ -177,8 +239,8 @@ fn run<K: BvKind>(
             counters.prim_tests += tested;
         }
     } else {
-        for &[la, lb] in &ws.leaves {
-            counters.prim_tests += narrow_leaf_pair(ha, hb, la as usize, lb as usize, &mut pairs);
+        for &[la, lb] in leaves {
+            counters.prim_tests += narrow_leaf_pair(a, b, la as usize, lb as usize, &mut pairs);
         }
     }
     pairs.sort_unstable();

@@ -465,3 +465,95 @@ fn parallel_equals_sequential_sphere() {
 fn parallel_equals_sequential_aabb() {
     parallel_equals_sequential_for::<Aabb>();
 }
+
+#[test]
+fn broad_then_narrow_phase_equals_collide() {
+    let a = icosphere(3, 1.0, [0.0; 3]);
+    let b = icosphere(3, 1.0, [1.4, 0.3, 0.0]);
+    let mut ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
+    let mut hb = Hierarchy::<Dh>::new(&b, Options::default()).unwrap();
+    ha.update_positions(&wave(a.positions(), 0.5, 0.1, [0.0; 3]))
+        .unwrap();
+    hb.update_positions(&wave(b.positions(), 0.5, 0.1, [1.4, 0.3, 0.0]))
+        .unwrap();
+    let whole = collide(&mut ha.clone(), &mut hb.clone());
+    let mut ws = dhcd::Workspace::default();
+    let broad = dhcd::broad_phase(&mut ha, &mut hb, &mut ws, dhcd::Par::Seq);
+    let narrow = dhcd::narrow_phase(&ha, &hb, ws.leaf_pairs(), dhcd::Par::Rayon(2));
+    assert_eq!(narrow.pairs, whole.pairs);
+    assert_eq!(broad.bv_tests, whole.counters.bv_tests);
+    assert_eq!(broad.bv_updates, whole.counters.bv_updates);
+    assert_eq!(broad.prim_tests, whole.counters.prim_tests);
+    assert_eq!(narrow.counters.prim_tests, whole.counters.prim_tests);
+    // Replaying the step's refit: invalidate, then refit exactly the nodes the query fitted.
+    let fitted = ha.fitted_nodes();
+    assert_eq!(
+        fitted.len() + hb.fitted_nodes().len(),
+        whole.counters.bv_updates as usize
+    );
+    ha.invalidate();
+    assert_eq!(ha.validate().unwrap(), 0);
+    ha.refit_nodes(&fitted, dhcd::Par::Rayon(2));
+    assert_eq!(ha.take_updates(), fitted.len() as u64);
+    assert_eq!(ha.validate().unwrap(), fitted.len());
+}
+
+fn scaled(mesh: &Mesh, s: f32, offset: [f32; 3]) -> Mesh {
+    with_positions(
+        mesh,
+        mesh.positions()
+            .iter()
+            .map(|p| {
+                [
+                    p[0] * s + offset[0],
+                    p[1] * s + offset[1],
+                    p[2] * s + offset[2],
+                ]
+            })
+            .collect(),
+    )
+}
+
+#[test]
+fn extreme_magnitudes_stay_exact() {
+    // Squared distances overflow (1e25^2) or underflow (1e-25^2) in f32: the bounds must stay
+    // conservative, and touching triangles must still be found.
+    let a = grid(3, 3, 1.0, [0.0; 3]);
+    let b = Mesh::new(
+        a.positions()
+            .iter()
+            .map(|p| [p[0], 1.5, p[1] - 1.0])
+            .collect(),
+        a.triangles().to_vec(),
+    )
+    .unwrap();
+    for s in [1e25f32, 1e18, 1e-18, 1e-25, 1e-38] {
+        let (sa, sb) = (scaled(&a, s, [0.0; 3]), scaled(&b, s, [0.0; 3]));
+        assert!(!assert_exact(&sa, &sb, 3).is_empty(), "scale {s}");
+    }
+    // Far from the origin: large common offset, small features.
+    let (fa, fb) = (
+        scaled(&a, 1.0, [3e6, -2e6, 1e6]),
+        scaled(&b, 1.0, [3e6, -2e6, 1e6]),
+    );
+    assert!(!assert_exact(&fa, &fb, 3).is_empty());
+}
+
+#[test]
+fn unreferenced_vertices_are_ignored() {
+    let mut positions = vec![[100.0, 100.0, 100.0]];
+    positions.extend_from_slice(icosphere(1, 1.0, [0.0; 3]).positions());
+    positions.push([-50.0, 0.0, 0.0]);
+    let tris = icosphere(1, 1.0, [0.0; 3])
+        .triangles()
+        .iter()
+        .map(|t| t.map(|v| v + 1))
+        .collect();
+    let a = Mesh::new(positions, tris).unwrap();
+    let b = icosphere(1, 1.0, [0.5, 0.0, 0.0]);
+    assert!(!assert_exact(&a, &b, 4).is_empty());
+    let mut h = Hierarchy::<Aabb>::new(&a, Options::default()).unwrap();
+    h.refit_all();
+    // The root box is the sphere's, not stretched to the unreferenced vertices.
+    assert!(h.record(0).max[0] < 2.0 && h.record(0).min[0] > -2.0);
+}

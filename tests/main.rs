@@ -1,7 +1,10 @@
 //! One integration-test binary; each module is a suite.
 
 mod capi;
+#[cfg(feature = "cli")]
 mod cli;
+#[cfg(feature = "cli")]
+mod cli_collide;
 mod hierarchies;
 mod io;
 mod narrow;

@@ -3,13 +3,134 @@
 //!
 //! Every kernel has a scalar reference beside it (`*_scalar`) with the same operation order.
 //!
+//! Each public entry is a SIMD kernel with runtime dispatch (pulp): a private generic body
+//! `x_simd<S: pulp::Simd>`, a small `pulp::WithSimd` struct, and the entry that dispatches
+//! it on the cached [`arch`]. Every entry also has a `*_with(simd, ..)` twin that runs the
+//! same body on a backend chosen by the caller (tests run `pulp::Scalar`, `Scalar128b`,
+//! `Scalar256b`, `Scalar512b` and the dispatched backend against the references).
+//!
+//! Exactness: the SIMD bodies use no fused multiply-add. pulp's `mul_add_e_f32s` is fused on
+//! the vector backends but unfused on `pulp::Scalar`, so fusing would make results depend on
+//! the backend; the kernels are bound by index gathers, not by arithmetic, so the two saved
+//! operations per pair are not worth it. Overlap kernels therefore give bit-identical masks on
+//! every backend; reductions ([`refit`]) are exact against `*_scalar_lanes(.., lanes)` for the
+//! backend's lane count ([`f32_lanes`]).
+//!
 //! NaN policy: overlap tests use ordered comparisons only, so a NaN anywhere in a pair makes
-//! the pair *not* overlap, on every backend. (The `dhcd` crate rejects non-finite input
-//! before it reaches a kernel, so this only matters to direct users of this crate.)
+//! the pair *not* overlap, on every backend. Reductions skip NaN values (see [`refit`]).
+//! (The `dhcd` crate rejects non-finite input before it reaches a kernel, so this only
+//! matters to direct users of this crate.)
 #![deny(unsafe_op_in_unsafe_fn)]
+// Kernels index several parallel arrays (lanes x fields, axes) with one counter; the
+// iterator forms clippy suggests hide that layout.
+#![allow(clippy::needless_range_loop)]
 
+pub mod narrow;
 pub mod overlap;
 pub mod refit;
+
+pub use pulp;
+
+use pulp::Simd;
+use std::sync::OnceLock;
+
+/// The widest lane count of any pulp backend for `f32` (AVX-512: 16). Staging buffers for
+/// gathers have this size.
+pub(crate) const MAX_LANES: usize = 16;
+
+/// The cached runtime-detected backend every public kernel entry dispatches on.
+#[inline]
+pub fn arch() -> pulp::Arch {
+    static ARCH: OnceLock<pulp::Arch> = OnceLock::new();
+    *ARCH.get_or_init(pulp::Arch::new)
+}
+
+struct F32Lanes;
+
+impl pulp::WithSimd for F32Lanes {
+    type Output = usize;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _simd: S) -> usize {
+        S::F32_LANES
+    }
+}
+
+/// The `f32` lane count of the dispatched backend ([`arch`]): the `lanes` argument for which
+/// the `refit::*_scalar_lanes` references reproduce the dispatched reductions exactly.
+pub fn f32_lanes() -> usize {
+    arch().dispatch(F32Lanes)
+}
+
+/// Lane-width helpers shared by the kernels (no `unsafe`: pulp's vector types are `Pod` with
+/// the alignment of their element, so a slice of `F32_LANES` elements reinterprets in place).
+pub(crate) mod lanes {
+    use pulp::Simd;
+
+    /// Loads the first `S::F32_LANES` values of `v`.
+    #[inline(always)]
+    pub fn load<S: Simd>(v: &[f32]) -> S::f32s {
+        S::as_simd_f32s(&v[..S::F32_LANES]).0[0]
+    }
+
+    /// Stores `v` into the first `S::F32_LANES` values of `out`.
+    #[inline(always)]
+    pub fn store_u32<S: Simd>(out: &mut [u32], v: S::u32s) {
+        S::as_mut_simd_u32s(&mut out[..S::U32_LANES]).0[0] = v;
+    }
+
+    /// Stores `v` into the first `S::F32_LANES` values of `out`.
+    #[inline(always)]
+    pub fn store_f32<S: Simd>(out: &mut [f32], v: S::f32s) {
+        S::as_mut_simd_f32s(&mut out[..S::F32_LANES]).0[0] = v;
+    }
+
+    /// The lanes of `v`, lane 0 first.
+    #[inline(always)]
+    pub fn f32_array<S: Simd>(v: &S::f32s) -> &[f32] {
+        bytemuck::cast_slice(core::slice::from_ref(v))
+    }
+
+    /// The lanes of `v`, lane 0 first.
+    #[inline(always)]
+    pub fn u32_array<S: Simd>(v: &S::u32s) -> &[u32] {
+        bytemuck::cast_slice(core::slice::from_ref(v))
+    }
+
+    /// `m[0]`, then `if v > m { m = v }` for the other values in order: the lane fold of the
+    /// max reductions (NaN never replaces; among equal values the first one stays).
+    #[inline(always)]
+    pub fn fold_max(v: &[f32]) -> f32 {
+        let mut m = v[0];
+        for &x in &v[1..] {
+            if x > m {
+                m = x;
+            }
+        }
+        m
+    }
+
+    /// Like [`fold_max`] with `<`.
+    #[inline(always)]
+    pub fn fold_min(v: &[f32]) -> f32 {
+        let mut m = v[0];
+        for &x in &v[1..] {
+            if x < m {
+                m = x;
+            }
+        }
+        m
+    }
+
+    /// `v[0] + v[1] + ...`, sequentially.
+    #[inline(always)]
+    pub fn fold_sum(v: &[f32]) -> f32 {
+        let mut s = v[0];
+        for &x in &v[1..] {
+            s += x;
+        }
+        s
+    }
+}
 
 /// Points (or centres) in structure-of-arrays form: `x[i], y[i], z[i]` is point `i`.
 #[derive(Clone, Copy, Debug)]

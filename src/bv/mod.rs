@@ -25,16 +25,23 @@ pub const PAD: usize = 16;
 /// conservative: two regions that share a point always test as overlapping.
 const RADIUS_INFLATION: f32 = 1.0 + 16.0 * f32::EPSILON;
 
+/// Smallest radius. Below about 1e-18 squared distances leave f32's normal range and lose
+/// their relative precision (a computed `d2` under 1e-36 only proves the distance is under
+/// sqrt(3) * 1e-18), so radii are floored here: regions smaller than that are treated as
+/// this size, which costs culling only on absurdly tiny meshes and never an answer.
+const MIN_RADIUS: f32 = 2e-18;
+
 /// A radius that encloses a point at squared distance `d2` despite rounding in `d2`.
+/// Overflow is conservative too: `d2 = inf` gives an infinite radius.
 #[inline]
 pub(crate) fn conservative_radius(d2: f32) -> f32 {
-    d2.sqrt() * RADIUS_INFLATION + f32::MIN_POSITIVE
+    (d2.sqrt() * RADIUS_INFLATION).max(MIN_RADIUS)
 }
 
 /// Rounds a sum of distances up the same way (bottom-up bounds).
 #[inline]
 pub(crate) fn conservative_sum(a: f32, b: f32) -> f32 {
-    (a + b) * RADIUS_INFLATION + f32::MIN_POSITIVE
+    ((a + b) * RADIUS_INFLATION).max(MIN_RADIUS)
 }
 
 pub(crate) fn padded(n: usize) -> usize {

@@ -21,9 +21,41 @@ fn c3(p: &P3) -> Coord3D<f64> {
     }
 }
 
-/// Sign-exact orientation of `d` against the plane through `a, b, c` (zero iff coplanar).
+/// Shewchuk's static error bound for the floating-point `orient3d` (same constant as
+/// `robust`): `(7 + 56 eps) eps`, `eps = 2^-53`.
+const O3D_ERRBOUND_A: f64 = (7.0 + 56.0 * EPS) * EPS;
+const EPS: f64 = f64::EPSILON / 2.0;
+
+/// Sign-exact orientation of `d` against the plane through `a, b, c` (zero iff coplanar);
+/// same sign convention as `robust::orient3d`.
+///
+/// PERF: `robust::orient3d` is not inlined across the crate boundary and the call costs
+/// as much as the arithmetic; this is its floating-point stage (Shewchuk's filter, same
+/// formula and bound) inlined here, falling back to `robust::orient3d` (whose adaptive
+/// stages are exact) only when the filter cannot certify the sign.
 #[inline(always)]
 pub(crate) fn orient3d(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
+    let f = f64::from;
+    let (adx, bdx, cdx) = (f(a[0]) - f(d[0]), f(b[0]) - f(d[0]), f(c[0]) - f(d[0]));
+    let (ady, bdy, cdy) = (f(a[1]) - f(d[1]), f(b[1]) - f(d[1]), f(c[1]) - f(d[1]));
+    let (adz, bdz, cdz) = (f(a[2]) - f(d[2]), f(b[2]) - f(d[2]), f(c[2]) - f(d[2]));
+    let (bdxcdy, cdxbdy) = (bdx * cdy, cdx * bdy);
+    let (cdxady, adxcdy) = (cdx * ady, adx * cdy);
+    let (adxbdy, bdxady) = (adx * bdy, bdx * ady);
+    let det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * adz.abs()
+        + (cdxady.abs() + adxcdy.abs()) * bdz.abs()
+        + (adxbdy.abs() + bdxady.abs()) * cdz.abs();
+    let errbound = O3D_ERRBOUND_A * permanent;
+    if det > errbound || -det > errbound {
+        return det;
+    }
+    orient3d_exact(a, b, c, d)
+}
+
+#[cold]
+#[inline(never)]
+fn orient3d_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
     robust::orient3d(c3(a), c3(b), c3(c), c3(d))
 }
 
@@ -99,4 +131,42 @@ pub(crate) fn lerp(p: &P3, q: &P3, t: f64) -> [f64; 3] {
         x[i] = a + t * (b - a);
     }
     x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn robust_sign(a: &P3, b: &P3, c: &P3, d: &P3) -> i32 {
+        sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(5000))]
+
+        /// The inlined filter returns robust's sign, also for nearly coplanar `d` (an affine
+        /// combination of `a, b, c` rounded to f32, nudged by a few ulps).
+        #[test]
+        fn inlined_orient3d_matches_robust(
+            p in prop::array::uniform3(prop::array::uniform3(-1e3f32..1e3)),
+            s in -2.0f64..3.0,
+            t in -2.0f64..3.0,
+            nudge in prop::array::uniform3(-2i32..=2),
+        ) {
+            let [a, b, c] = p;
+            let mut d = [0.0f32; 3];
+            for k in 0..3 {
+                let (x, y, z) = (f64::from(a[k]), f64::from(b[k]), f64::from(c[k]));
+                let mut v = (x + s * (y - x) + t * (z - x)) as f32;
+                for _ in 0..nudge[k].unsigned_abs() {
+                    v = if nudge[k] > 0 { v.next_up() } else { v.next_down() };
+                }
+                d[k] = v;
+            }
+            prop_assert_eq!(sign(orient3d(&a, &b, &c, &d)), robust_sign(&a, &b, &c, &d));
+            prop_assert_eq!(sign(orient3d(&a, &b, &c, &c)), 0);
+            prop_assert_eq!(sign(orient3d(&d, &a, &b, &c)), -robust_sign(&a, &b, &c, &d));
+        }
+    }
 }

@@ -32,7 +32,8 @@ pub(crate) struct Points {
 }
 
 impl Points {
-    /// Upper bound on pushes: 6 edges x (2 endpoints + 3 edge crossings x up to 4 points).
+    /// Upper bound on pushes: 6 edges x (2 endpoints + 3 edge crossings x up to 4 points)
+    /// = 84, plus slack.
     const CAP: usize = 96;
 
     pub(crate) fn new() -> Self {
@@ -60,6 +61,9 @@ impl Sink for Points {
         }
     }
 }
+
+/// Projection axis not computed yet (the triangle is known non-degenerate).
+const AXIS_UNKNOWN: usize = usize::MAX;
 
 #[inline(always)]
 fn to64(p: &P3) -> [f64; 3] {
@@ -136,12 +140,12 @@ fn tri_tri_full<S: Sink>(a: &Tri, da: &[f64; 3], b: &Tri, db: &[f64; 3], sink: &
     let a_axis = if db.iter().all(|&d| d == 0.0) {
         projection_axis(&a[0], &a[1], &a[2])
     } else {
-        Some(usize::MAX)
+        Some(AXIS_UNKNOWN)
     };
     let b_axis = if da.iter().all(|&d| d == 0.0) {
         projection_axis(&b[0], &b[1], &b[2])
     } else {
-        Some(usize::MAX)
+        Some(AXIS_UNKNOWN)
     };
     match (a_axis, b_axis) {
         (Some(ka), Some(kb)) => {
@@ -169,7 +173,7 @@ fn tri_tri_full<S: Sink>(a: &Tri, da: &[f64; 3], b: &Tri, db: &[f64; 3], sink: &
 
 /// Edges of `s` against the non-degenerate triangle `t`; `ds[i]` is the orientation of
 /// `s[i]` against the plane of `t`; `axis` is a projection keeping `t` non-degenerate, or
-/// `usize::MAX` meaning "not computed yet".
+/// [`AXIS_UNKNOWN`] (computed on first need).
 #[inline]
 fn edges_vs_tri<S: Sink>(s: &Tri, ds: &[f64; 3], t: &Tri, axis: usize, sink: &mut S) -> bool {
     let mut hit = false;
@@ -200,10 +204,12 @@ fn seg_vs_tri<S: Sink>(
         return false;
     }
     if sp == 0.0 && sq == 0.0 {
-        let k = if axis == usize::MAX {
+        let k = if axis == AXIS_UNKNOWN {
             match projection_axis(&t[0], &t[1], &t[2]) {
                 Some(k) => k,
-                None => unreachable!("seg_vs_tri needs a non-degenerate triangle"),
+                // Only reachable with non-finite input (finite: a nonzero orientation
+                // against t's plane proved t non-degenerate); the answer is unspecified.
+                None => return false,
             }
         } else {
             axis
