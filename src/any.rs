@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
 use crate::mesh::Mesh;
 use crate::par::Par;
+use crate::self_collide::self_collide_with;
 use crate::traverse::{collide_with, Contacts, Workspace};
 use crate::tree::RegionTree;
 
@@ -87,11 +88,34 @@ impl AnyHierarchy {
             (Self::Dh(a), Self::Dh(b)) => Ok(collide_with(a, b, ws, par)),
             (Self::Sphere(a), Self::Sphere(b)) => Ok(collide_with(a, b, ws, par)),
             (Self::Aabb(a), Self::Aabb(b)) => Ok(collide_with(a, b, ws, par)),
-            (a, b) => Err(Error::InvalidOption(format!(
-                "cannot collide a {} hierarchy with a {} hierarchy",
-                a.method(),
-                b.method()
-            ))),
+            (a, b) => Err(Error::MethodMismatch {
+                a: a.method(),
+                b: b.method(),
+            }),
+        }
+    }
+
+    /// Self-contacts of this object (see [`self_collide`](crate::self_collide)).
+    pub fn self_collide(&mut self, ws: &mut Workspace, par: Par) -> Contacts {
+        each!(self, h => self_collide_with(h, ws, par))
+    }
+
+    /// Intersection segments of contacts between `self` and `other` (see
+    /// [`contact_segments`](crate::detail::contact_segments)); an error if the kinds differ.
+    pub fn contact_segments(
+        &self,
+        other: &AnyHierarchy,
+        pairs: &[[u32; 2]],
+    ) -> Result<Vec<crate::detail::Segment>> {
+        use crate::detail::contact_segments;
+        match (self, other) {
+            (Self::Dh(a), Self::Dh(b)) => contact_segments(a, b, pairs),
+            (Self::Sphere(a), Self::Sphere(b)) => contact_segments(a, b, pairs),
+            (Self::Aabb(a), Self::Aabb(b)) => contact_segments(a, b, pairs),
+            (a, b) => Err(Error::MethodMismatch {
+                a: a.method(),
+                b: b.method(),
+            }),
         }
     }
 }

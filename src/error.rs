@@ -34,6 +34,13 @@ pub enum Error {
     WrongVertexCount { expected: usize, got: usize },
     #[error("levels must be between 1 and {max}, got {got}", max = crate::tree::MAX_LEVELS)]
     InvalidLevels { got: usize },
+    #[error("cannot collide a {a} hierarchy with a {b} hierarchy")]
+    MethodMismatch {
+        a: crate::bv::Method,
+        b: crate::bv::Method,
+    },
+    #[error("no object with id {0} in the scene")]
+    UnknownObject(u64),
     #[error("invalid option: {0}")]
     InvalidOption(String),
     #[error("{path}: {message}")]

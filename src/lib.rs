@@ -20,11 +20,15 @@
 //! assert!(collide(&mut a, &mut b).pairs.is_empty());
 //! # Ok::<(), dhcd::Error>(())
 //! ```
-#![forbid(unsafe_code)]
+// Unsafe code lives only in the C ABI (`capi`), every block with a `// SAFETY:` comment.
+#![deny(unsafe_code)]
 
 pub mod any;
 pub mod bv;
+#[allow(unsafe_code)]
+pub mod capi;
 pub mod counters;
+pub mod detail;
 pub mod error;
 pub mod hierarchy;
 pub mod io;
@@ -32,6 +36,8 @@ pub mod mesh;
 pub mod narrow;
 pub mod par;
 pub mod points;
+pub mod scene;
+pub mod self_collide;
 pub mod shapes;
 pub mod sim;
 pub mod traverse;
@@ -44,5 +50,7 @@ pub use error::{Error, Result};
 pub use hierarchy::{Hierarchy, InvariantError, Options, Refit};
 pub use mesh::Mesh;
 pub use par::Par;
+pub use scene::{ObjectId, Scene, SceneContacts};
+pub use self_collide::{self_collide, self_collide_with};
 pub use traverse::{broad_phase, collide, collide_with, narrow_phase, Contacts, Workspace};
 pub use tree::RegionTree;

@@ -36,15 +36,15 @@ pub const DEFAULT_GRAIN: usize = 1024;
 /// avoid allocating every step. Also holds the parallel grain.
 #[derive(Clone, Debug)]
 pub struct Workspace {
-    grain: usize,
-    ia: Vec<u32>,
-    ib: Vec<u32>,
-    next_a: Vec<u32>,
-    next_b: Vec<u32>,
-    mask: Vec<u32>,
-    leaves: Vec<[u32; 2]>,
-    stale: Vec<u32>,
-    sel: Vec<u32>,
+    pub(crate) grain: usize,
+    pub(crate) ia: Vec<u32>,
+    pub(crate) ib: Vec<u32>,
+    pub(crate) next_a: Vec<u32>,
+    pub(crate) next_b: Vec<u32>,
+    pub(crate) mask: Vec<u32>,
+    pub(crate) leaves: Vec<[u32; 2]>,
+    pub(crate) stale: Vec<u32>,
+    pub(crate) sel: Vec<u32>,
 }
 
 impl Default for Workspace {
@@ -136,6 +136,56 @@ impl Workspace {
     }
 }
 
+/// One round of the frontier: batch-tests the pairs `ws.ia[k], ws.ib[k]` (already fitted)
+/// and appends the expansion of the overlapping ones to `ws.next_a`/`ws.next_b` (children
+/// pairs) and `ws.leaves` (leaf pairs), in chunk order. Returns the number of pairs tested.
+/// Shared by the two-object query and self-collision (`a` and `b` the same hierarchy).
+pub(crate) fn test_and_expand<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    ws: &mut Workspace,
+    parallel: bool,
+) -> u64 {
+    let grain = ws.grain;
+    ws.mask.resize(ws.ia.len(), 0);
+    let test = |ia: &[u32], ib: &[u32], out: &mut [u32]| {
+        K::overlap(a.nodes(), a.points(), b.nodes(), b.points(), ia, ib, out);
+    };
+    let (ta, tb) = (&**a.tree(), &**b.tree());
+    if parallel && ws.ia.len() > grain {
+        ws.mask
+            .par_chunks_mut(grain)
+            .zip(ws.ia.par_chunks(grain).zip(ws.ib.par_chunks(grain)))
+            .for_each(|(out, (ia, ib))| test(ia, ib, out));
+        let parts: Vec<Expansion> = ws
+            .ia
+            .par_chunks(grain)
+            .zip(ws.ib.par_chunks(grain).zip(ws.mask.par_chunks(grain)))
+            .map(|(ia, (ib, mask))| {
+                let mut e = Expansion::default();
+                e.expand(ta, tb, ia, ib, mask);
+                e
+            })
+            .collect();
+        for e in parts {
+            ws.next_a.extend_from_slice(&e.next_a);
+            ws.next_b.extend_from_slice(&e.next_b);
+            ws.leaves.extend_from_slice(&e.leaves);
+        }
+    } else {
+        test(&ws.ia, &ws.ib, &mut ws.mask);
+        let mut e = Expansion {
+            next_a: std::mem::take(&mut ws.next_a),
+            next_b: std::mem::take(&mut ws.next_b),
+            leaves: std::mem::take(&mut ws.leaves),
+            sel: std::mem::take(&mut ws.sel),
+        };
+        e.expand(ta, tb, &ws.ia, &ws.ib, &ws.mask);
+        (ws.next_a, ws.next_b, ws.leaves, ws.sel) = (e.next_a, e.next_b, e.leaves, e.sel);
+    }
+    ws.ia.len() as u64
+}
+
 fn broad<K: BvKind>(
     a: &mut Hierarchy<K>,
     b: &mut Hierarchy<K>,
@@ -143,7 +193,6 @@ fn broad<K: BvKind>(
     parallel: bool,
 ) -> Counters {
     let mut counters = Counters::default();
-    let grain = ws.grain;
     ws.leaves.clear();
     ws.ia.clear();
     ws.ib.clear();
@@ -152,56 +201,9 @@ fn broad<K: BvKind>(
     while !ws.ia.is_empty() {
         a.ensure_fitted(&ws.ia, parallel, &mut ws.stale);
         b.ensure_fitted(&ws.ib, parallel, &mut ws.stale);
-        ws.mask.resize(ws.ia.len(), 0);
-        counters.bv_tests += ws.ia.len() as u64;
-        let (ha, hb) = (&*a, &*b);
-        let test = |ia: &[u32], ib: &[u32], out: &mut [u32]| {
-            K::overlap(
-                ha.nodes(),
-                ha.points(),
-                hb.nodes(),
-                hb.points(),
-                ia,
-                ib,
-                out,
-            );
-        };
-        let (ta, tb) = (&**a.tree(), &**b.tree());
-        if parallel && ws.ia.len() > grain {
-            ws.mask
-                .par_chunks_mut(grain)
-                .zip(ws.ia.par_chunks(grain).zip(ws.ib.par_chunks(grain)))
-                .for_each(|(out, (ia, ib))| test(ia, ib, out));
-            let parts: Vec<Expansion> = ws
-                .ia
-                .par_chunks(grain)
-                .zip(ws.ib.par_chunks(grain).zip(ws.mask.par_chunks(grain)))
-                .map(|(ia, (ib, mask))| {
-                    let mut e = Expansion::default();
-                    e.expand(ta, tb, ia, ib, mask);
-                    e
-                })
-                .collect();
-            ws.next_a.clear();
-            ws.next_b.clear();
-            for e in parts {
-                ws.next_a.extend_from_slice(&e.next_a);
-                ws.next_b.extend_from_slice(&e.next_b);
-                ws.leaves.extend_from_slice(&e.leaves);
-            }
-        } else {
-            test(&ws.ia, &ws.ib, &mut ws.mask);
-            let mut e = Expansion {
-                next_a: std::mem::take(&mut ws.next_a),
-                next_b: std::mem::take(&mut ws.next_b),
-                leaves: std::mem::take(&mut ws.leaves),
-                sel: std::mem::take(&mut ws.sel),
-            };
-            e.next_a.clear();
-            e.next_b.clear();
-            e.expand(ta, tb, &ws.ia, &ws.ib, &ws.mask);
-            (ws.next_a, ws.next_b, ws.leaves, ws.sel) = (e.next_a, e.next_b, e.leaves, e.sel);
-        }
+        ws.next_a.clear();
+        ws.next_b.clear();
+        counters.bv_tests += test_and_expand(a, b, ws, parallel);
         std::mem::swap(&mut ws.ia, &mut ws.next_a);
         std::mem::swap(&mut ws.ib, &mut ws.next_b);
     }
@@ -258,12 +260,12 @@ fn narrow<K: BvKind>(
 
 /// The output of expanding one chunk of a frontier.
 #[derive(Default)]
-struct Expansion {
-    next_a: Vec<u32>,
-    next_b: Vec<u32>,
-    leaves: Vec<[u32; 2]>,
+pub(crate) struct Expansion {
+    pub(crate) next_a: Vec<u32>,
+    pub(crate) next_b: Vec<u32>,
+    pub(crate) leaves: Vec<[u32; 2]>,
     /// Scratch: positions of the overlapping pairs.
-    sel: Vec<u32>,
+    pub(crate) sel: Vec<u32>,
 }
 
 impl Expansion {
@@ -272,7 +274,14 @@ impl Expansion {
     /// PERF: most tested pairs do not overlap and the mask is unpredictable, so the overlapping
     /// positions are first compacted without branches (`sel`), then expanded; children runs
     /// are appended with `extend` (one capacity check per run, not per pair).
-    fn expand(&mut self, ta: &RegionTree, tb: &RegionTree, ia: &[u32], ib: &[u32], mask: &[u32]) {
+    pub(crate) fn expand(
+        &mut self,
+        ta: &RegionTree,
+        tb: &RegionTree,
+        ia: &[u32],
+        ib: &[u32],
+        mask: &[u32],
+    ) {
         let sel = &mut self.sel;
         sel.clear();
         sel.resize(ia.len(), 0);

@@ -1,6 +1,8 @@
 //! Command-line front end. Every failure is one line on stderr and a non-zero exit code.
 
 mod collide;
+mod scene;
+mod self_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -19,6 +21,11 @@ struct Cli {
 enum Command {
     /// Contacts (intersecting triangle pairs) between two meshes.
     Collide(collide::CollideArgs),
+    /// Self-contacts of one mesh: intersecting triangle pairs sharing no vertex.
+    #[command(name = "self")]
+    SelfCollide(self_cmd::SelfArgs),
+    /// Contacts between every pair of several meshes.
+    Scene(scene::SceneArgs),
 }
 
 /// Parses the arguments, runs the command, returns the process exit code.
@@ -32,6 +39,8 @@ pub fn run() -> i32 {
     };
     let result = match cli.command {
         Command::Collide(args) => collide::run(args),
+        Command::SelfCollide(args) => self_cmd::run(args),
+        Command::Scene(args) => scene::run(args),
     };
     match result {
         Ok(()) => 0,

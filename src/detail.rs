@@ -1,0 +1,88 @@
+//! Contact detail (opt-in): the intersection segment of each contact, for simulations that
+//! need contact points rather than triangle pairs. The queries never compute it; call these
+//! on their results, in the same pose.
+
+use crate::bv::BvKind;
+use crate::error::{Error, Result};
+use crate::hierarchy::Hierarchy;
+use crate::narrow::intersection_segment;
+use crate::traverse::corners;
+
+/// An intersection segment `[p, q]` (`p == q` for a single point); see
+/// [`intersection_segment`].
+pub type Segment = [[f32; 3]; 2];
+
+/// Corners of triangles by the caller's original index, in a hierarchy's current pose.
+pub(crate) struct OriginalCorners<'h, K: BvKind> {
+    h: &'h Hierarchy<K>,
+    slot: Vec<u32>,
+}
+
+impl<'h, K: BvKind> OriginalCorners<'h, K> {
+    pub(crate) fn new(h: &'h Hierarchy<K>) -> Self {
+        let order = h.tree().tri_order();
+        let mut slot = vec![0; order.len()];
+        for (i, &o) in order.iter().enumerate() {
+            slot[o as usize] = i as u32;
+        }
+        Self { h, slot }
+    }
+
+    pub(crate) fn get(&self, t: u32) -> Result<[[f32; 3]; 3]> {
+        let i = *self.slot.get(t as usize).ok_or_else(|| {
+            Error::InvalidOption(format!(
+                "contact names triangle {t}, but the mesh has only {} triangles",
+                self.slot.len()
+            ))
+        })?;
+        Ok(corners(
+            self.h.points(),
+            self.h.tree().triangles()[i as usize],
+        ))
+    }
+}
+
+/// The intersection segment of every contact `[ta, tb]` (original indices) between `a` and
+/// `b`, in their current poses, in the order of `pairs`.
+///
+/// Errors if a triangle index is out of range, or if a pair does not intersect in the
+/// current pose (contacts from an earlier pose).
+///
+/// ```
+/// use dhcd::{bv::Aabb, collide, detail::contact_segments, Hierarchy, Mesh, Options};
+/// let a = Mesh::new(vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]], vec![[0, 1, 2]])?;
+/// let b = Mesh::new(vec![[0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [0.2, 0.8, 0.0]], vec![[0, 1, 2]])?;
+/// let (mut ha, mut hb) = (Hierarchy::<Aabb>::new(&a, Options::default())?, Hierarchy::<Aabb>::new(&b, Options::default())?);
+/// let c = collide(&mut ha, &mut hb);
+/// let seg = contact_segments(&ha, &hb, &c.pairs)?;
+/// assert_eq!(seg.len(), 1);
+/// assert!(seg[0].iter().all(|p| p[2] == 0.0)); // on A's plane z = 0
+/// # Ok::<(), dhcd::Error>(())
+/// ```
+pub fn contact_segments<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    pairs: &[[u32; 2]],
+) -> Result<Vec<Segment>> {
+    let (ca, cb) = (OriginalCorners::new(a), OriginalCorners::new(b));
+    pairs
+        .iter()
+        .map(|&[ta, tb]| segment(&ca.get(ta)?, &cb.get(tb)?, [ta, tb]))
+        .collect()
+}
+
+/// [`contact_segments`] for self-contacts of one hierarchy.
+pub fn self_contact_segments<K: BvKind>(
+    h: &Hierarchy<K>,
+    pairs: &[[u32; 2]],
+) -> Result<Vec<Segment>> {
+    contact_segments(h, h, pairs)
+}
+
+pub(crate) fn segment(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], pair: [u32; 2]) -> Result<Segment> {
+    intersection_segment(a, b).ok_or_else(|| {
+        Error::InvalidOption(format!(
+            "triangles {pair:?} do not intersect in the current pose (stale contacts?)"
+        ))
+    })
+}

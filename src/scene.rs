@@ -1,0 +1,448 @@
+//! [`Scene`]: any number of deformable objects, added, removed and deformed at will; one call
+//! returns every contact between every pair of objects (and, per object on request, its
+//! self-contacts).
+//!
+//! A query runs in three phases:
+//! 1. **Broad phase**: each object's root box (min/max of its live vertex positions,
+//!    recomputed on every update) goes through sweep-and-prune along x; only object pairs
+//!    whose closed boxes overlap are kept. Far-apart objects cost a box comparison.
+//! 2. **Schedule**: the kept pairs, and the objects with self-collision on, are *jobs*,
+//!    sorted by object. Each job needs `&mut` access to its objects (lazy refit), so the
+//!    jobs are cut into batches in which no object appears twice: each job, in order, goes
+//!    into the first batch where both its objects are free (first-fit edge colouring;
+//!    independent of the thread count).
+//! 3. **Narrow**: the jobs of a batch run in parallel (rayon), each a two-object query
+//!    ([`collide_with`](crate::collide_with)) or a self query
+//!    ([`self_collide_with`](crate::self_collide_with)) that may itself split its frontier
+//!    across the pool. Batches run one after the other.
+//!
+//! Output is deterministic: contacts are sorted, per-pair counters are listed in job order,
+//! and the schedule does not depend on the thread count, so the lazy refits (and the
+//! `bv_updates` attributed to each pair) are the same for every `Par`.
+
+use rayon::prelude::*;
+
+use crate::bv::{Aabb, BvKind, Dh, Method, Sphere};
+use crate::counters::Counters;
+use crate::detail::{segment, OriginalCorners, Segment};
+use crate::error::{Error, Result};
+use crate::hierarchy::{Hierarchy, Options};
+use crate::mesh::Mesh;
+use crate::par::Par;
+use crate::self_collide::self_collide_with;
+use crate::traverse::{collide_with, Contacts, Workspace};
+
+/// Identifies an object of a [`Scene`]. Ids are handed out in increasing order from 0 and
+/// are **never reused**, even after [`Scene::remove`]: a stale id is always an
+/// [`Error::UnknownObject`], never another object.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ObjectId(pub u64);
+
+impl std::fmt::Display for ObjectId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+/// The work of one object pair (or one object's self-collision when `a == b`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PairCounters {
+    pub a: ObjectId,
+    pub b: ObjectId,
+    pub counters: Counters,
+}
+
+/// Result of [`Scene::contacts`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SceneContacts {
+    /// `[object_a, tri_a, object_b, tri_b]`, sorted ascending. Between objects
+    /// `object_a < object_b`; self-contacts have `object_a == object_b` and `tri_a < tri_b`.
+    /// Triangle indices are each object's original indices.
+    pub pairs: Vec<[u64; 4]>,
+    /// Counters of every object pair that passed the broad phase (and of every
+    /// self-collision query), sorted by `(a, b)`. Pairs culled by the broad phase cost no
+    /// BV work and are not listed.
+    pub per_pair: Vec<PairCounters>,
+    /// Sum of `per_pair`.
+    pub counters: Counters,
+    /// Object pairs whose root boxes were compared in the broad phase.
+    pub broad_phase_tests: u64,
+    /// Batches of the parallel schedule (jobs in one batch share no object and run
+    /// concurrently; batches run one after the other).
+    pub batches: usize,
+}
+
+/// One object of the scene.
+#[derive(Clone, Debug)]
+struct Object<K: BvKind> {
+    id: u64,
+    h: Hierarchy<K>,
+    self_collision: bool,
+    /// Closed box `[min, max]` of the live positions of the vertices used by triangles.
+    bounds: [[f32; 3]; 2],
+}
+
+impl<K: BvKind> Object<K> {
+    fn refresh_bounds(&mut self) {
+        let p = self.h.points();
+        let n = self.h.tree().referenced_vertices();
+        let mut b = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
+        for (k, axis) in [&p.x, &p.y, &p.z].into_iter().enumerate() {
+            for &v in &axis[..n] {
+                b[0][k] = b[0][k].min(v);
+                b[1][k] = b[1][k].max(v);
+            }
+        }
+        self.bounds = b;
+    }
+}
+
+#[derive(Clone, Debug)]
+enum Objects {
+    Dh(Vec<Object<Dh>>),
+    Sphere(Vec<Object<Sphere>>),
+    Aabb(Vec<Object<Aabb>>),
+}
+
+macro_rules! each {
+    ($self:expr, $v:ident => $e:expr) => {
+        match $self {
+            Objects::Dh($v) => $e,
+            Objects::Sphere($v) => $e,
+            Objects::Aabb($v) => $e,
+        }
+    };
+}
+
+/// A set of deformable objects of one bounding-volume kind.
+///
+/// ```
+/// use dhcd::{scene::Scene, shapes, Method, Options, Par};
+/// let mut scene = Scene::new(Method::Dh, Options::default());
+/// let ball = shapes::icosphere(2, 1.0, [0.0; 3]);
+/// let a = scene.add(&ball)?;
+/// let b = scene.add(&ball)?;
+/// let far = scene.add(&ball)?;
+/// // Deform: B overlaps A, the third object is far away.
+/// scene.update_positions(b, &shapes::translated(ball.positions(), [1.5, 0.0, 0.0]))?;
+/// scene.update_positions(far, &shapes::translated(ball.positions(), [50.0, 0.0, 0.0]))?;
+/// let c = scene.contacts(Par::Seq);
+/// assert!(!c.pairs.is_empty());
+/// assert!(c.pairs.iter().all(|p| p[0] == a.0 && p[2] == b.0));
+/// // Only the pair (A, B) passed the broad phase.
+/// assert_eq!(c.per_pair.len(), 1);
+/// scene.remove(b)?;
+/// assert!(scene.contacts(Par::Seq).pairs.is_empty());
+/// assert!(scene.remove(b).is_err()); // ids are never reused
+/// # Ok::<(), dhcd::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Scene {
+    options: Options,
+    next_id: u64,
+    /// Sorted by id (ids only grow, so `add` appends).
+    objects: Objects,
+}
+
+impl Scene {
+    /// An empty scene whose objects get hierarchies of kind `method` built with `options`.
+    pub fn new(method: Method, options: Options) -> Self {
+        let objects = match method {
+            Method::Dh => Objects::Dh(Vec::new()),
+            Method::Sphere => Objects::Sphere(Vec::new()),
+            Method::Aabb => Objects::Aabb(Vec::new()),
+        };
+        Self {
+            options,
+            next_id: 0,
+            objects,
+        }
+    }
+
+    pub fn method(&self) -> Method {
+        match self.objects {
+            Objects::Dh(_) => Method::Dh,
+            Objects::Sphere(_) => Method::Sphere,
+            Objects::Aabb(_) => Method::Aabb,
+        }
+    }
+
+    pub fn options(&self) -> Options {
+        self.options
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        each!(&self.objects, v => v.len())
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The ids of the objects, ascending.
+    pub fn ids(&self) -> Vec<ObjectId> {
+        each!(&self.objects, v => v.iter().map(|o| ObjectId(o.id)).collect())
+    }
+
+    pub fn contains(&self, id: ObjectId) -> bool {
+        self.index(id).is_ok()
+    }
+
+    /// Adds an object whose rest pose is `mesh` (its hierarchy is built now) with
+    /// self-collision off; returns its id.
+    pub fn add(&mut self, mesh: &Mesh) -> Result<ObjectId> {
+        let id = self.next_id;
+        let options = self.options;
+        each!(&mut self.objects, v => {
+            let mut o = Object {
+                id,
+                h: Hierarchy::new(mesh, options)?,
+                self_collision: false,
+                bounds: [[0.0; 3]; 2],
+            };
+            o.refresh_bounds();
+            v.push(o);
+        });
+        self.next_id += 1;
+        Ok(ObjectId(id))
+    }
+
+    /// Removes an object. Its id is never handed out again.
+    pub fn remove(&mut self, id: ObjectId) -> Result<()> {
+        let i = self.index(id)?;
+        each!(&mut self.objects, v => { v.remove(i); });
+        Ok(())
+    }
+
+    /// The object's new vertex positions (its mesh's vertex order and count, finite).
+    /// On error nothing changes.
+    pub fn update_positions(&mut self, id: ObjectId, positions: &[[f32; 3]]) -> Result<()> {
+        let i = self.index(id)?;
+        each!(&mut self.objects, v => {
+            v[i].h.update_positions(positions)?;
+            v[i].refresh_bounds();
+        });
+        Ok(())
+    }
+
+    /// Turns the object's self-collision on or off (off when added). With it on,
+    /// [`Scene::contacts`] also reports the object's self-contacts.
+    pub fn set_self_collision(&mut self, id: ObjectId, on: bool) -> Result<()> {
+        let i = self.index(id)?;
+        each!(&mut self.objects, v => v[i].self_collision = on);
+        Ok(())
+    }
+
+    pub fn self_collision(&self, id: ObjectId) -> Result<bool> {
+        let i = self.index(id)?;
+        Ok(each!(&self.objects, v => v[i].self_collision))
+    }
+
+    /// Root box `[min, max]` of the object's current pose (what the broad phase compares).
+    pub fn bounds(&self, id: ObjectId) -> Result<[[f32; 3]; 2]> {
+        let i = self.index(id)?;
+        Ok(each!(&self.objects, v => v[i].bounds))
+    }
+
+    /// Every contact of the current poses: between all object pairs, and inside objects with
+    /// self-collision on. The result does not depend on `par`.
+    pub fn contacts(&mut self, par: Par) -> SceneContacts {
+        each!(&mut self.objects, v => par.install(|| contacts_of(v, par.is_parallel())))
+    }
+
+    /// Intersection segments of `contacts` (from [`Scene::contacts`] in the current poses),
+    /// in the order of `contacts.pairs`. Errors if an object is gone, an index is out of
+    /// range, or a pair no longer intersects.
+    pub fn contact_segments(&self, contacts: &SceneContacts) -> Result<Vec<Segment>> {
+        each!(&self.objects, v => {
+            let mut cache: Vec<Option<OriginalCorners<'_, _>>> = (0..v.len()).map(|_| None).collect();
+            let mut out = Vec::with_capacity(contacts.pairs.len());
+            for &[oa, ta, ob, tb] in &contacts.pairs {
+                let (ia, ib) = (self.index(ObjectId(oa))?, self.index(ObjectId(ob))?);
+                let tri = |t: u64| {
+                    u32::try_from(t).map_err(|_| {
+                        Error::InvalidOption(format!("triangle index {t} out of range"))
+                    })
+                };
+                let (ta, tb) = (tri(ta)?, tri(tb)?);
+                for i in [ia, ib] {
+                    if cache[i].is_none() {
+                        cache[i] = Some(OriginalCorners::new(&v[i].h));
+                    }
+                }
+                let ca = cache[ia].as_ref().map(|c| c.get(ta)).transpose()?;
+                let cb = cache[ib].as_ref().map(|c| c.get(tb)).transpose()?;
+                match (ca, cb) {
+                    (Some(ca), Some(cb)) => out.push(segment(&ca, &cb, [ta, tb])?),
+                    _ => unreachable!("both caches were filled above"),
+                }
+            }
+            Ok(out)
+        })
+    }
+
+    fn index(&self, id: ObjectId) -> Result<usize> {
+        each!(&self.objects, v => v.binary_search_by_key(&id.0, |o| o.id))
+            .map_err(|_| Error::UnknownObject(id.0))
+    }
+}
+
+/// Sweep-and-prune on the root boxes along x: the index pairs `(i, j)`, `i < j`, of objects
+/// whose closed boxes overlap, sorted; and the number of box pairs compared.
+fn broad_phase(bounds: &[[[f32; 3]; 2]]) -> (Vec<(usize, usize)>, u64) {
+    let mut order: Vec<usize> = (0..bounds.len()).collect();
+    order.sort_by(|&i, &j| bounds[i][0][0].total_cmp(&bounds[j][0][0]).then(i.cmp(&j)));
+    let mut active: Vec<usize> = Vec::new();
+    let mut out = Vec::new();
+    let mut tests = 0u64;
+    for &i in &order {
+        let b = &bounds[i];
+        // Closed intervals: an object whose max x equals this min x still touches it.
+        active.retain(|&j| bounds[j][1][0] >= b[0][0]);
+        for &j in &active {
+            tests += 1;
+            let c = &bounds[j];
+            if (1..3).all(|k| b[0][k] <= c[1][k] && c[0][k] <= b[1][k]) {
+                out.push((i.min(j), i.max(j)));
+            }
+        }
+        active.push(i);
+    }
+    out.sort_unstable();
+    (out, tests)
+}
+
+/// The objects a job needs exclusively: two distinct ones, or one (self-collision).
+enum Work<'a, K: BvKind> {
+    Pair(usize, &'a mut Object<K>, usize, &'a mut Object<K>),
+    Myself(usize, &'a mut Object<K>),
+}
+
+fn take<'a, K: BvKind>(slots: &mut [Option<&'a mut Object<K>>], i: usize) -> &'a mut Object<K> {
+    slots[i]
+        .take()
+        .expect("the schedule puts an object at most once in a batch")
+}
+
+/// Runs one job; hands the objects back with its contacts.
+fn run_job<'a, K: BvKind>(
+    ws: &mut Workspace,
+    w: Work<'a, K>,
+    inner: Par,
+) -> (Contacts, Work<'a, K>) {
+    match w {
+        Work::Pair(ia, a, ib, b) => {
+            let c = collide_with(&mut a.h, &mut b.h, ws, inner);
+            (c, Work::Pair(ia, a, ib, b))
+        }
+        Work::Myself(i, a) => {
+            let c = self_collide_with(&mut a.h, ws, inner);
+            (c, Work::Myself(i, a))
+        }
+    }
+}
+
+fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
+    let bounds: Vec<_> = objects.iter().map(|o| o.bounds).collect();
+    let (candidates, broad_phase_tests) = broad_phase(&bounds);
+    // Jobs in (a, b) order; a self job is (a, a).
+    let mut jobs: Vec<(usize, usize)> = candidates;
+    jobs.extend(
+        objects
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.self_collision)
+            .map(|(i, _)| (i, i)),
+    );
+    jobs.sort_unstable();
+
+    // Batches in which no object appears twice: first fit, in job order (a greedy edge
+    // colouring: at most 2 * max_degree - 1 batches). `used[b][i]`: object `i` is in batch `b`.
+    let mut batches: Vec<Vec<usize>> = Vec::new();
+    let mut used: Vec<Vec<bool>> = Vec::new();
+    for (k, &(a, b)) in jobs.iter().enumerate() {
+        let batch = match used.iter().position(|u| !u[a] && !u[b]) {
+            Some(batch) => batch,
+            None => {
+                used.push(vec![false; objects.len()]);
+                batches.push(Vec::new());
+                used.len() - 1
+            }
+        };
+        used[batch][a] = true;
+        used[batch][b] = true;
+        batches[batch].push(k);
+    }
+
+    // Inner queries split their frontiers on the current pool too (nested rayon).
+    let inner = if parallel { Par::Rayon(0) } else { Par::Seq };
+
+    let mut results: Vec<Option<Contacts>> = (0..jobs.len()).map(|_| None).collect();
+    let mut slots: Vec<Option<&mut Object<K>>> = objects.iter_mut().map(Some).collect();
+    let mut ws = Workspace::default();
+    for batch in &batches {
+        let work: Vec<(usize, Work<'_, K>)> = batch
+            .iter()
+            .map(|&k| {
+                let (a, b) = jobs[k];
+                let w = if a == b {
+                    Work::Myself(a, take(&mut slots, a))
+                } else {
+                    let oa = take(&mut slots, a);
+                    Work::Pair(a, oa, b, take(&mut slots, b))
+                };
+                (k, w)
+            })
+            .collect();
+        let done: Vec<(usize, Contacts, Work<'_, K>)> = if parallel && work.len() > 1 {
+            work.into_par_iter()
+                .map_init(Workspace::default, |ws, (k, w)| {
+                    let (c, w) = run_job(ws, w, inner);
+                    (k, c, w)
+                })
+                .collect()
+        } else {
+            work.into_iter()
+                .map(|(k, w)| {
+                    let (c, w) = run_job(&mut ws, w, inner);
+                    (k, c, w)
+                })
+                .collect()
+        };
+        for (k, c, w) in done {
+            results[k] = Some(c);
+            match w {
+                Work::Pair(ia, a, ib, b) => {
+                    slots[ia] = Some(a);
+                    slots[ib] = Some(b);
+                }
+                Work::Myself(i, a) => slots[i] = Some(a),
+            }
+        }
+    }
+    drop(slots);
+
+    let mut out = SceneContacts {
+        broad_phase_tests,
+        batches: batches.len(),
+        ..SceneContacts::default()
+    };
+    for (&(a, b), c) in jobs.iter().zip(results) {
+        let c = c.expect("every job ran in some batch");
+        let (ida, idb) = (objects[a].id, objects[b].id);
+        out.pairs.extend(
+            c.pairs
+                .iter()
+                .map(|&[ta, tb]| [ida, ta as u64, idb, tb as u64]),
+        );
+        out.per_pair.push(PairCounters {
+            a: ObjectId(ida),
+            b: ObjectId(idb),
+            counters: c.counters,
+        });
+        out.counters += c.counters;
+    }
+    out.pairs.sort_unstable();
+    out
+}

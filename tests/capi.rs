@@ -1,0 +1,466 @@
+//! The C ABI from Rust: results equal the Rust API, bad arguments are error codes (null,
+//! mismatched lengths, wrong kind, unknown ids), and `include/dhcd.h` declares exactly the
+//! exported functions and constants.
+
+use std::collections::BTreeSet;
+use std::ffi::CStr;
+use std::ptr::{null, null_mut};
+
+use dhcd::capi::*;
+use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
+use dhcd::shapes::{icosphere, translated, wave};
+use dhcd::Mesh;
+
+fn flat(mesh: &Mesh) -> (Vec<f32>, Vec<u32>) {
+    (
+        mesh.positions().iter().flatten().copied().collect(),
+        mesh.triangles().iter().flatten().copied().collect(),
+    )
+}
+
+fn new_h(method: i32, mesh: &Mesh) -> *mut DhcdHierarchy {
+    let (p, t) = flat(mesh);
+    let mut h = null_mut();
+    // SAFETY: arrays of the stated lengths; `h` writable.
+    let rc = unsafe {
+        dhcd_hierarchy_new(
+            method,
+            4,
+            p.as_ptr(),
+            mesh.vertex_count(),
+            t.as_ptr(),
+            mesh.triangle_count(),
+            &mut h,
+        )
+    };
+    assert_eq!(rc, DHCD_OK, "{}", last_error());
+    assert!(!h.is_null());
+    h
+}
+
+fn last_error() -> String {
+    // SAFETY: never null, NUL-terminated.
+    unsafe { CStr::from_ptr(dhcd_last_error_message()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn pairs_of(c: &DhcdContacts) -> Vec<[u32; 2]> {
+    if c.count == 0 {
+        assert!(c.pairs.is_null());
+        return Vec::new();
+    }
+    // SAFETY: the library wrote `2 * count` u32 at `pairs`.
+    let s = unsafe { std::slice::from_raw_parts(c.pairs, 2 * c.count) };
+    s.chunks(2).map(|p| [p[0], p[1]]).collect()
+}
+
+fn empty() -> DhcdContacts {
+    DhcdContacts {
+        pairs: null_mut(),
+        count: 0,
+        counters: DhcdCounters::default(),
+    }
+}
+
+#[test]
+fn collide_and_self_collide_equal_brute_force() {
+    let a = icosphere(2, 1.0, [0.0; 3]);
+    let b_pos = wave(a.positions(), 0.7, 0.2, [1.2, 0.3, 0.0]);
+    let b = Mesh::new(b_pos.clone(), a.triangles().to_vec()).unwrap();
+    let crumpled = Mesh::new(
+        wave(a.positions(), 1.3, 0.6, [0.0; 3]),
+        a.triangles().to_vec(),
+    )
+    .unwrap();
+    for method in [DHCD_METHOD_DH, DHCD_METHOD_SPHERE, DHCD_METHOD_AABB] {
+        let ha = new_h(method, &a);
+        let hb = new_h(method, &a);
+        let mut m = -1;
+        // SAFETY: live handles, valid out-pointers and arrays throughout.
+        unsafe {
+            assert_eq!(dhcd_hierarchy_method(ha, &mut m), DHCD_OK);
+            assert_eq!(m, method);
+            let flat_b: Vec<f32> = b_pos.iter().flatten().copied().collect();
+            assert_eq!(
+                dhcd_hierarchy_update_positions(hb, flat_b.as_ptr(), b_pos.len()),
+                DHCD_OK
+            );
+            let mut c = empty();
+            assert_eq!(dhcd_collide(ha, hb, 2, &mut c), DHCD_OK);
+            let pairs = pairs_of(&c);
+            assert_eq!(pairs, brute_force_pairs(&a, &b));
+            assert!(!pairs.is_empty());
+            assert_eq!(c.counters.contacts as usize, c.count);
+            // Segments of every contact.
+            let mut segs = vec![0.0f32; 6 * c.count];
+            assert_eq!(
+                dhcd_contact_segments(ha, hb, c.pairs, c.count, segs.as_mut_ptr()),
+                DHCD_OK
+            );
+            assert!(segs.iter().all(|x| x.is_finite()));
+            dhcd_contacts_free(&mut c);
+            assert!(c.pairs.is_null() && c.count == 0);
+            dhcd_contacts_free(&mut c); // twice: no-op
+            dhcd_contacts_free(null_mut());
+
+            let flat_c: Vec<f32> = crumpled.positions().iter().flatten().copied().collect();
+            assert_eq!(
+                dhcd_hierarchy_update_positions(ha, flat_c.as_ptr(), a.vertex_count()),
+                DHCD_OK
+            );
+            let mut s = empty();
+            assert_eq!(dhcd_self_collide(ha, 1, &mut s), DHCD_OK);
+            assert_eq!(pairs_of(&s), brute_force_self_pairs(&crumpled));
+            assert!(s.count > 0);
+            let mut segs = vec![0.0f32; 6 * s.count];
+            assert_eq!(
+                dhcd_contact_segments(ha, ha, s.pairs, s.count, segs.as_mut_ptr()),
+                DHCD_OK
+            );
+            dhcd_contacts_free(&mut s);
+            dhcd_hierarchy_free(ha);
+            dhcd_hierarchy_free(hb);
+        }
+    }
+}
+
+#[test]
+fn scene_equals_rust_scene() {
+    let m = icosphere(2, 1.0, [0.0; 3]);
+    let (p, t) = flat(&m);
+    let mut rust = dhcd::Scene::new(
+        dhcd::Method::Sphere,
+        dhcd::Options {
+            levels: 4,
+            ..Default::default()
+        },
+    );
+    let mut s = null_mut();
+    // SAFETY: live handles, valid arrays and out-pointers throughout.
+    unsafe {
+        assert_eq!(dhcd_scene_new(DHCD_METHOD_SPHERE, 4, &mut s), DHCD_OK);
+        let mut ids = Vec::new();
+        for k in 0..4 {
+            let mut id = u64::MAX;
+            assert_eq!(
+                dhcd_scene_add(
+                    s,
+                    p.as_ptr(),
+                    m.vertex_count(),
+                    t.as_ptr(),
+                    m.triangle_count(),
+                    (k == 2) as i32,
+                    &mut id
+                ),
+                DHCD_OK
+            );
+            let rid = rust.add(&m).unwrap();
+            rust.set_self_collision(rid, k == 2).unwrap();
+            assert_eq!(id, rid.0);
+            ids.push(id);
+        }
+        for (k, &id) in ids.iter().enumerate() {
+            let pos = wave(m.positions(), k as f32, 0.5, [1.4 * k as f32, 0.0, 0.0]);
+            let f: Vec<f32> = pos.iter().flatten().copied().collect();
+            assert_eq!(
+                dhcd_scene_update_positions(s, id, f.as_ptr(), pos.len()),
+                DHCD_OK
+            );
+            rust.update_positions(dhcd::ObjectId(id), &pos).unwrap();
+        }
+        let mut c = DhcdSceneContacts {
+            pairs: null_mut(),
+            count: 0,
+            counters: DhcdCounters::default(),
+        };
+        assert_eq!(dhcd_scene_contacts(s, 0, &mut c), DHCD_OK);
+        let expected = rust.contacts(dhcd::Par::Seq);
+        assert!(c.count > 0);
+        let got: Vec<[u64; 4]> = std::slice::from_raw_parts(c.pairs, 4 * c.count)
+            .chunks(4)
+            .map(|q| [q[0], q[1], q[2], q[3]])
+            .collect();
+        assert_eq!(got, expected.pairs);
+        assert_eq!(c.counters, expected.counters.into());
+        assert!(
+            got.iter().any(|q| q[0] == 2 && q[2] == 2),
+            "self-contacts of object 2"
+        );
+        dhcd_scene_contacts_free(&mut c);
+        assert!(c.pairs.is_null());
+        assert_eq!(dhcd_scene_set_self_collision(s, 2, 0), DHCD_OK);
+        assert_eq!(dhcd_scene_remove(s, 1), DHCD_OK);
+        assert_eq!(dhcd_scene_remove(s, 1), DHCD_ERR_UNKNOWN_OBJECT);
+        assert!(
+            last_error().contains("no object with id 1"),
+            "{}",
+            last_error()
+        );
+        assert_eq!(
+            dhcd_scene_update_positions(s, 9, p.as_ptr(), m.vertex_count()),
+            DHCD_ERR_UNKNOWN_OBJECT
+        );
+        assert_eq!(
+            dhcd_scene_set_self_collision(s, 1, 1),
+            DHCD_ERR_UNKNOWN_OBJECT
+        );
+        dhcd_scene_free(s);
+        dhcd_scene_free(null_mut());
+    }
+}
+
+#[test]
+fn bad_arguments_are_error_codes() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let (p, t) = flat(&m);
+    let (nv, nt) = (m.vertex_count(), m.triangle_count());
+    let a = new_h(DHCD_METHOD_DH, &m);
+    let b = new_h(DHCD_METHOD_AABB, &m);
+    let mut h = null_mut();
+    let mut c = empty();
+    // SAFETY: every pointer is null, a live handle, or valid for its stated length.
+    unsafe {
+        // Null pointers.
+        assert_eq!(
+            dhcd_hierarchy_new(DHCD_METHOD_DH, 4, null(), nv, t.as_ptr(), nt, &mut h),
+            DHCD_ERR_NULL
+        );
+        assert!(last_error().contains("positions"));
+        assert_eq!(
+            dhcd_hierarchy_new(DHCD_METHOD_DH, 4, p.as_ptr(), nv, null(), nt, &mut h),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_hierarchy_new(
+                DHCD_METHOD_DH,
+                4,
+                p.as_ptr(),
+                nv,
+                t.as_ptr(),
+                nt,
+                null_mut()
+            ),
+            DHCD_ERR_NULL
+        );
+        assert!(h.is_null());
+        assert_eq!(dhcd_collide(null_mut(), b, 1, &mut c), DHCD_ERR_NULL);
+        assert_eq!(dhcd_collide(a, b, 1, null_mut()), DHCD_ERR_NULL);
+        assert_eq!(dhcd_self_collide(null_mut(), 1, &mut c), DHCD_ERR_NULL);
+        assert_eq!(
+            dhcd_hierarchy_update_positions(null_mut(), p.as_ptr(), nv),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_hierarchy_update_positions(a, null(), nv),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(dhcd_hierarchy_method(null(), &mut 0), DHCD_ERR_NULL);
+        assert_eq!(
+            dhcd_contact_segments(a, a, null(), 0, null_mut()),
+            DHCD_OK,
+            "empty result"
+        );
+        assert_eq!(
+            dhcd_contact_segments(a, a, null(), 1, [0.0f32; 6].as_mut_ptr()),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_contact_segments(a, a, [0u32, 0].as_ptr(), 1, null_mut()),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_contact_segments(null(), a, null(), 0, null_mut()),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_scene_add(null_mut(), p.as_ptr(), nv, t.as_ptr(), nt, 0, &mut 0),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_scene_contacts(null_mut(), 1, null_mut()),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(dhcd_scene_new(DHCD_METHOD_DH, 5, null_mut()), DHCD_ERR_NULL);
+        // Mismatched lengths and bad meshes.
+        assert_eq!(
+            dhcd_hierarchy_update_positions(a, p.as_ptr(), nv - 1),
+            DHCD_ERR_LENGTH_MISMATCH
+        );
+        assert!(last_error().contains("vertices"), "{}", last_error());
+        assert_eq!(
+            dhcd_hierarchy_new(DHCD_METHOD_DH, 4, p.as_ptr(), 0, t.as_ptr(), nt, &mut h),
+            DHCD_ERR_INVALID_MESH
+        );
+        assert_eq!(
+            dhcd_hierarchy_new(DHCD_METHOD_DH, 4, p.as_ptr(), 3, t.as_ptr(), nt, &mut h),
+            DHCD_ERR_INVALID_MESH
+        );
+        let mut nan = p.clone();
+        nan[4] = f32::NAN;
+        assert_eq!(
+            dhcd_hierarchy_new(DHCD_METHOD_DH, 4, nan.as_ptr(), nv, t.as_ptr(), nt, &mut h),
+            DHCD_ERR_INVALID_MESH
+        );
+        assert_eq!(
+            dhcd_hierarchy_update_positions(a, nan.as_ptr(), nv),
+            DHCD_ERR_INVALID_MESH
+        );
+        assert_eq!(
+            dhcd_hierarchy_new(
+                DHCD_METHOD_DH,
+                4,
+                p.as_ptr(),
+                usize::MAX / 2,
+                t.as_ptr(),
+                nt,
+                &mut h
+            ),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        // Misaligned array.
+        let bytes = [0u8; 64];
+        let odd = bytes.as_ptr().add(1).cast::<f32>();
+        assert_eq!(
+            dhcd_hierarchy_update_positions(a, odd, 1),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        // Bad method, bad levels.
+        assert_eq!(
+            dhcd_hierarchy_new(7, 4, p.as_ptr(), nv, t.as_ptr(), nt, &mut h),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        assert_eq!(
+            dhcd_hierarchy_new(DHCD_METHOD_DH, 0, p.as_ptr(), nv, t.as_ptr(), nt, &mut h),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        let mut s = null_mut();
+        assert_eq!(dhcd_scene_new(-1, 5, &mut s), DHCD_ERR_INVALID_ARGUMENT);
+        assert_eq!(
+            dhcd_scene_new(DHCD_METHOD_DH, 99, &mut s),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        assert!(h.is_null() && s.is_null());
+        // Wrong kind; the same handle twice.
+        assert_eq!(dhcd_collide(a, b, 1, &mut c), DHCD_ERR_WRONG_KIND);
+        assert!(last_error().contains("dh") && last_error().contains("aabb"));
+        assert_eq!(
+            dhcd_contact_segments(a, b, [0u32, 0].as_ptr(), 1, [0.0f32; 6].as_mut_ptr()),
+            DHCD_ERR_WRONG_KIND
+        );
+        assert_eq!(dhcd_collide(a, a, 1, &mut c), DHCD_ERR_INVALID_ARGUMENT);
+        assert!(
+            c.pairs.is_null() && c.count == 0,
+            "failed calls leave an empty result"
+        );
+        // Segments: out of range, stale.
+        let mut seg = [0.0f32; 6];
+        assert_eq!(
+            dhcd_contact_segments(a, a, [0u32, 100_000].as_ptr(), 1, seg.as_mut_ptr()),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        let far = translated(m.positions(), [10.0, 0.0, 0.0]);
+        let other = new_h(
+            DHCD_METHOD_DH,
+            &Mesh::new(far, m.triangles().to_vec()).unwrap(),
+        );
+        assert_eq!(
+            dhcd_contact_segments(a, other, [0u32, 0].as_ptr(), 1, seg.as_mut_ptr()),
+            DHCD_ERR_STALE_CONTACT
+        );
+        // Everything still works after the errors.
+        assert_eq!(dhcd_collide(a, other, 1, &mut c), DHCD_OK);
+        assert_eq!(c.count, 0);
+        dhcd_hierarchy_free(other);
+        dhcd_hierarchy_free(a);
+        dhcd_hierarchy_free(b);
+        dhcd_hierarchy_free(null_mut());
+    }
+}
+
+#[test]
+fn last_error_is_per_thread() {
+    // SAFETY: null handles are allowed arguments (they are errors).
+    unsafe {
+        assert_eq!(dhcd_scene_remove(null_mut(), 0), DHCD_ERR_NULL);
+    }
+    let msg = last_error();
+    assert!(msg.contains("null"), "{msg}");
+    let other = std::thread::spawn(last_error).join().unwrap();
+    assert_eq!(other, "");
+}
+
+/// `include/dhcd.h` is hand-written: it must declare exactly the `dhcd_*` functions that
+/// `src/capi.rs` exports, and the same `DHCD_*` constants with the same values.
+#[test]
+fn header_matches_exports() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let header = std::fs::read_to_string(format!("{root}/include/dhcd.h")).unwrap();
+    let source = std::fs::read_to_string(format!("{root}/src/capi.rs")).unwrap();
+    let declared: BTreeSet<String> = header
+        .lines()
+        .filter(|l| !l.trim_start().starts_with(['*', '/', '#']))
+        .flat_map(|l| {
+            let pieces: Vec<&str> = l.split('(').collect();
+            let n = pieces.len().saturating_sub(1);
+            pieces
+                .into_iter()
+                .take(n)
+                .filter_map(|p| {
+                    p.rsplit(|c: char| !(c.is_alphanumeric() || c == '_'))
+                        .next()
+                })
+                .filter(|w| w.starts_with("dhcd_"))
+                .map(str::to_owned)
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let exported: BTreeSet<String> = source
+        .split("extern \"C\" fn ")
+        .skip(1)
+        .map(|rest| rest.split('(').next().unwrap().trim().to_owned())
+        .collect();
+    assert!(source.matches("#[no_mangle]").count() == exported.len());
+    assert!(exported.len() >= 17, "{exported:?}");
+    assert_eq!(declared, exported);
+
+    let defines: BTreeSet<(String, i32)> = header
+        .lines()
+        .filter_map(|l| l.strip_prefix("#define DHCD_"))
+        .filter_map(|l| {
+            let mut w = l.split_whitespace();
+            let (name, value) = (w.next()?, w.next()?);
+            Some((format!("DHCD_{name}"), value.parse().ok()?))
+        })
+        .collect();
+    let constants: BTreeSet<(String, i32)> = [
+        ("DHCD_OK", DHCD_OK),
+        ("DHCD_ERR_NULL", DHCD_ERR_NULL),
+        ("DHCD_ERR_INVALID_ARGUMENT", DHCD_ERR_INVALID_ARGUMENT),
+        ("DHCD_ERR_INVALID_MESH", DHCD_ERR_INVALID_MESH),
+        ("DHCD_ERR_LENGTH_MISMATCH", DHCD_ERR_LENGTH_MISMATCH),
+        ("DHCD_ERR_WRONG_KIND", DHCD_ERR_WRONG_KIND),
+        ("DHCD_ERR_UNKNOWN_OBJECT", DHCD_ERR_UNKNOWN_OBJECT),
+        ("DHCD_ERR_STALE_CONTACT", DHCD_ERR_STALE_CONTACT),
+        ("DHCD_ERR_PANIC", DHCD_ERR_PANIC),
+        ("DHCD_METHOD_DH", DHCD_METHOD_DH),
+        ("DHCD_METHOD_SPHERE", DHCD_METHOD_SPHERE),
+        ("DHCD_METHOD_AABB", DHCD_METHOD_AABB),
+    ]
+    .into_iter()
+    .map(|(n, v)| (n.to_owned(), v))
+    .collect();
+    assert_eq!(defines, constants);
+    let rust_consts = source.matches("pub const DHCD_").count();
+    assert_eq!(
+        rust_consts,
+        constants.len(),
+        "every Rust constant is in the table"
+    );
+    // Struct layouts the header assumes (LP64 / LLP64: size_t is pointer-sized).
+    assert_eq!(std::mem::size_of::<DhcdCounters>(), 32);
+    assert_eq!(
+        std::mem::size_of::<DhcdContacts>(),
+        2 * std::mem::size_of::<usize>() + 32
+    );
+}
