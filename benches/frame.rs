@@ -3,7 +3,7 @@
 //!
 //! Ids:
 //! - `frame/<scene>/<impl>`: a whole step, `impl` in `dhcd-dh`, `dhcd-sphere`, `dhcd-aabb`,
-//!   `parry3d`, plus `dhcd-dh-t1` / `dhcd-dh-t2` on `pawns8` (`Par::Rayon(1)` / `Rayon(2)`);
+//!   `parry3d`, plus `dhcd-dh-t1` / `dhcd-dh-t2` on `pawns8` (the `Scene` API, object pairs in parallel, `Par::Rayon(1)` / `Rayon(2)`);
 //! - `hier/<scene>/<impl>`: refit + traversal down to leaf pairs only (no triangle tests;
 //!   for dhcd `broad_phase`, which also refreshes the leaves' cached triangle boxes);
 //! - `narrow/<scene>/dhcd-dh`: the exact narrow phase alone on the leaf pairs of a frame
@@ -25,7 +25,7 @@ use std::time::{Duration, Instant};
 use criterion::{criterion_group, criterion_main, Criterion};
 use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
 use dhcd::traverse::{broad_phase, narrow_phase};
-use dhcd::{collide_with, Counters, Hierarchy, Mesh, Options, Par, Workspace};
+use dhcd::{collide_with, Counters, Hierarchy, Mesh, Method, Options, Par, Workspace};
 use parry3d::bounding_volume::Aabb as PAabb;
 use parry3d::math::{Pose, Vector};
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
@@ -358,6 +358,25 @@ fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
     });
 }
 
+fn bench_scene(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
+    let mut world = dhcd::scene::Scene::new(Method::Dh, Options::default());
+    let ids: Vec<_> = scene
+        .meshes
+        .iter()
+        .map(|m| world.add(m).expect("valid mesh"))
+        .collect();
+    let mut f = 0;
+    c.bench_function(&format!("frame/{}/{id}", scene.name), |b| {
+        b.iter(|| {
+            f = (f + 1) % FRAMES;
+            for (&id, p) in ids.iter().zip(&scene.frames[f]) {
+                world.update_positions(id, p).expect("valid positions");
+            }
+            black_box(world.contacts(par).pairs.len())
+        })
+    });
+}
+
 fn frame(c: &mut Criterion) {
     // DHCD_BENCH_NO_CHECK=1 skips the brute-force checks (profiling runs only).
     let checks = std::env::var_os("DHCD_BENCH_NO_CHECK").is_none();
@@ -379,8 +398,10 @@ fn frame(c: &mut Criterion) {
             })
         });
         if scene.pairs.len() > 1 {
-            bench_kind::<Dh>(c, scene, "dhcd-dh-t1", Par::Rayon(1));
-            bench_kind::<Dh>(c, scene, "dhcd-dh-t2", Par::Rayon(2));
+            // Many objects: the Scene API runs the object pairs in parallel (batches in which
+            // no object appears twice), the way a user with eight objects would.
+            bench_scene(c, scene, "dhcd-dh-t1", Par::Rayon(1));
+            bench_scene(c, scene, "dhcd-dh-t2", Par::Rayon(2));
         }
 
         let mut w = DhcdWorld::<Dh>::new(scene);
