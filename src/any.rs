@@ -8,7 +8,8 @@ use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
 use crate::mesh::Mesh;
 use crate::par::Par;
-use crate::traverse::{collide_with, Contacts, Workspace};
+use crate::counters::Counters;
+use crate::traverse::{broad_phase, collide_with, narrow_phase, Contacts, Workspace};
 use crate::tree::RegionTree;
 
 /// A hierarchy of a kind chosen at run time.
@@ -94,4 +95,62 @@ impl AnyHierarchy {
             ))),
         }
     }
+    /// Marks every bounding volume stale (see [`Hierarchy::invalidate`]).
+    pub fn invalidate(&mut self) {
+        each!(self, h => h.invalidate())
+    }
+
+    /// Refits the stale nodes among `ids` (see [`Hierarchy::refit_nodes`]).
+    pub fn refit_nodes(&mut self, ids: &[u32], par: Par) {
+        each!(self, h => h.refit_nodes(ids, par))
+    }
+
+    /// The nodes fitted to the current positions (see [`Hierarchy::fitted_nodes`]).
+    pub fn fitted_nodes(&self) -> Vec<u32> {
+        each!(self, h => h.fitted_nodes())
+    }
+
+    /// The BV updates done since the last call (see [`Hierarchy::take_updates`]).
+    pub fn take_updates(&mut self) -> u64 {
+        each!(self, h => h.take_updates())
+    }
+
+    /// [`broad_phase`] between two hierarchies of the same kind; an error if the kinds differ.
+    pub fn broad_phase(
+        &mut self,
+        other: &mut AnyHierarchy,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<Counters> {
+        match (self, other) {
+            (Self::Dh(a), Self::Dh(b)) => Ok(broad_phase(a, b, ws, par)),
+            (Self::Sphere(a), Self::Sphere(b)) => Ok(broad_phase(a, b, ws, par)),
+            (Self::Aabb(a), Self::Aabb(b)) => Ok(broad_phase(a, b, ws, par)),
+            (a, b) => Err(mismatch(a, b)),
+        }
+    }
+
+    /// [`narrow_phase`] on leaf pairs of two hierarchies of the same kind; an error if the
+    /// kinds differ.
+    pub fn narrow_phase(
+        &self,
+        other: &AnyHierarchy,
+        leaves: &[[u32; 2]],
+        par: Par,
+    ) -> Result<Contacts> {
+        match (self, other) {
+            (Self::Dh(a), Self::Dh(b)) => Ok(narrow_phase(a, b, leaves, par)),
+            (Self::Sphere(a), Self::Sphere(b)) => Ok(narrow_phase(a, b, leaves, par)),
+            (Self::Aabb(a), Self::Aabb(b)) => Ok(narrow_phase(a, b, leaves, par)),
+            (a, b) => Err(mismatch(a, b)),
+        }
+    }
+}
+
+fn mismatch(a: &AnyHierarchy, b: &AnyHierarchy) -> Error {
+    Error::InvalidOption(format!(
+        "cannot collide a {} hierarchy with a {} hierarchy",
+        a.method(),
+        b.method()
+    ))
 }

@@ -26,6 +26,7 @@ pub mod any;
 pub mod bv;
 pub mod counters;
 pub mod error;
+pub mod experiment;
 pub mod hierarchy;
 pub mod io;
 pub mod mesh;

@@ -1,0 +1,222 @@
+//! Calibration of the cost model `T = N_V*C_V + N_P*C_P + N_U*C_U` on this machine, from
+//! the real kernels on the experiment's own frames.
+//!
+//! For a calibration frame, every object gets the frame's positions and every object pair is
+//! queried once (lazy refit included), which records each pair's overlapping leaf pairs and
+//! each object's fitted nodes. Then, `reps` times:
+//!
+//! * **fixed**: `update_positions` of every object (validation, position copy into the
+//!   internal order, invalidation): a cost per step that does not depend on `N_*`;
+//! * **`C_U`**: `invalidate` + `refit_nodes(fitted)` of every object, divided by the `N_U` it
+//!   counts (the same nodes the query refitted);
+//! * **`C_V`**: `broad_phase` of every pair with every node it tests already fitted (so no
+//!   refit inside), divided by `N_V`;
+//! * **`C_P`**: `narrow_phase` of every pair's recorded leaf pairs, divided by `N_P`.
+//!
+//! Each repetition pools all calibration frames (total time / total count); the reported
+//! constant is the median over repetitions, with min, max and quartiles as the spread, plus
+//! the median per frame to show how the constant moves over the run.
+
+use std::time::Instant;
+
+use crate::any::AnyHierarchy;
+use crate::counters::Counters;
+use crate::par::Par;
+use crate::traverse::Workspace;
+
+use super::{two_mut, ExperimentError};
+
+/// Median, extremes and quartiles of a sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Spread {
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+    pub p25: f64,
+    pub p75: f64,
+    pub samples: usize,
+}
+
+impl Spread {
+    /// The spread of `xs` (all zero when empty).
+    pub fn of(xs: &[f64]) -> Self {
+        if xs.is_empty() {
+            return Self::default();
+        }
+        let mut v = xs.to_vec();
+        v.sort_by(f64::total_cmp);
+        Self {
+            median: quantile(&v, 0.5),
+            min: v[0],
+            max: v[v.len() - 1],
+            p25: quantile(&v, 0.25),
+            p75: quantile(&v, 0.75),
+            samples: v.len(),
+        }
+    }
+}
+
+/// Linear-interpolated quantile of sorted `v` (non-empty).
+fn quantile(v: &[f64], q: f64) -> f64 {
+    let x = q * (v.len() - 1) as f64;
+    let (i, f) = (x.floor() as usize, x.fract());
+    if i + 1 < v.len() {
+        v[i] * (1.0 - f) + v[i + 1] * f
+    } else {
+        v[i]
+    }
+}
+
+/// Median of `xs` (sorts it; 0 when empty).
+pub fn median(xs: &mut [f64]) -> f64 {
+    if xs.is_empty() {
+        return 0.0;
+    }
+    xs.sort_by(f64::total_cmp);
+    quantile(xs, 0.5)
+}
+
+/// The constants of one calibration frame (medians over repetitions) and its counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameCosts {
+    pub frame: usize,
+    pub counters: Counters,
+    pub c_v_ns: f64,
+    pub c_p_ns: f64,
+    pub c_u_ns: f64,
+    pub fixed_ns: f64,
+}
+
+/// Calibrated constants of one method.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Costs {
+    /// ns per BV-pair test (traversal: test + expansion + frontier bookkeeping).
+    pub c_v: Spread,
+    /// ns per triangle-pair test (exact narrow phase).
+    pub c_p: Spread,
+    /// ns per BV update (refit of one node).
+    pub c_u: Spread,
+    /// ns per step of `update_positions` of every object (not in the paper's model).
+    pub fixed_ns: Spread,
+    pub per_frame: Vec<FrameCosts>,
+}
+
+impl Costs {
+    /// `N_V*C_V + N_P*C_P + N_U*C_U` with the median constants.
+    pub fn predict(&self, c: &Counters) -> f64 {
+        c.bv_tests as f64 * self.c_v.median
+            + c.prim_tests as f64 * self.c_p.median
+            + c.bv_updates as f64 * self.c_u.median
+    }
+}
+
+/// `count` frames spread evenly over `0..frames` (the last one included), distinct.
+pub fn calibration_frames(frames: usize, count: usize) -> Vec<usize> {
+    let count = count.min(frames).max(1);
+    let mut v: Vec<usize> = (1..=count).map(|k| k * frames / count - 1).collect();
+    v.dedup();
+    v
+}
+
+fn per(t: f64, n: u64) -> Option<f64> {
+    (n > 0).then(|| t / n as f64)
+}
+
+/// Calibrates one method on hierarchies `hs` (one per object), frames `positions`.
+pub(super) fn calibrate(
+    hs: &mut [AnyHierarchy],
+    positions: &[Vec<Vec<[f32; 3]>>],
+    calib_frames: &[usize],
+    pairs: &[(usize, usize)],
+    reps: usize,
+    par: Par,
+    progress: &mut dyn FnMut(usize),
+) -> Result<Costs, ExperimentError> {
+    let mut ws = Workspace::default();
+    // Pooled over frames, per repetition: (time, count).
+    let mut pooled = vec![[(0.0, 0u64); 4]; reps];
+    let mut per_frame = Vec::with_capacity(calib_frames.len());
+    for (fi, &f) in calib_frames.iter().enumerate() {
+        progress(fi);
+        let frame = &positions[f];
+        for (h, p) in hs.iter_mut().zip(frame) {
+            h.update_positions(p)?;
+        }
+        let mut counters = Counters::default();
+        let mut leaves = Vec::with_capacity(pairs.len());
+        for &(i, j) in pairs {
+            let (a, b) = two_mut(hs, i, j);
+            counters += a.collide(b, &mut ws, par)?.counters;
+            leaves.push(ws.leaf_pairs().to_vec());
+        }
+        let fitted: Vec<Vec<u32>> = hs.iter().map(AnyHierarchy::fitted_nodes).collect();
+        let mut samples = [vec![], vec![], vec![], vec![]];
+        for acc in pooled.iter_mut() {
+            // fixed: update_positions (validates, copies, invalidates).
+            let t = Instant::now();
+            for (h, p) in hs.iter_mut().zip(frame) {
+                h.update_positions(p)?;
+            }
+            let fixed = t.elapsed().as_nanos() as f64;
+            // C_U: the step's refit, alone.
+            let t = Instant::now();
+            for (h, ids) in hs.iter_mut().zip(&fitted) {
+                h.invalidate();
+                h.refit_nodes(ids, par);
+            }
+            let tu = t.elapsed().as_nanos() as f64;
+            let nu: u64 = hs.iter_mut().map(AnyHierarchy::take_updates).sum();
+            debug_assert_eq!(nu, counters.bv_updates);
+            // C_V: traversal with everything already fitted.
+            let t = Instant::now();
+            let mut nv = 0;
+            for &(i, j) in pairs {
+                let (a, b) = two_mut(hs, i, j);
+                let c = a.broad_phase(b, &mut ws, par)?;
+                debug_assert_eq!(c.bv_updates, 0);
+                nv += c.bv_tests;
+            }
+            let tv = t.elapsed().as_nanos() as f64;
+            debug_assert_eq!(nv, counters.bv_tests);
+            // C_P: exact tests of the recorded leaf pairs.
+            let t = Instant::now();
+            let mut np = 0;
+            for (&(i, j), l) in pairs.iter().zip(&leaves) {
+                np += hs[i].narrow_phase(&hs[j], l, par)?.counters.prim_tests;
+            }
+            let tp = t.elapsed().as_nanos() as f64;
+            debug_assert_eq!(np, counters.prim_tests);
+
+            for (k, (t, n)) in [(tv, nv), (tp, np), (tu, nu), (fixed, 1)]
+                .into_iter()
+                .enumerate()
+            {
+                acc[k].0 += t;
+                acc[k].1 += n;
+                if let Some(c) = per(t, n) {
+                    samples[k].push(c);
+                }
+            }
+        }
+        per_frame.push(FrameCosts {
+            frame: f,
+            counters,
+            c_v_ns: median(&mut samples[0]),
+            c_p_ns: median(&mut samples[1]),
+            c_u_ns: median(&mut samples[2]),
+            fixed_ns: median(&mut samples[3]),
+        });
+    }
+    progress(calib_frames.len());
+    let spread = |k: usize| {
+        let xs: Vec<f64> = pooled.iter().filter_map(|a| per(a[k].0, a[k].1)).collect();
+        Spread::of(&xs)
+    };
+    Ok(Costs {
+        c_v: spread(0),
+        c_p: spread(1),
+        c_u: spread(2),
+        fixed_ns: spread(3),
+        per_frame,
+    })
+}
