@@ -43,8 +43,8 @@ pub fn scene_with_mesh(mesh: Mesh, config: &SimConfig) -> Result<Simulation> {
             0.0,
             (row as f64 - 0.5) * spacing,
         );
-        let angle = (splitmix64(&mut state) >> 11) as f64 / (1u64 << 53) as f64
-            * std::f64::consts::TAU;
+        let angle =
+            (splitmix64(&mut state) >> 11) as f64 / (1u64 << 53) as f64 * std::f64::consts::TAU;
         let (s, c) = angle.sin_cos();
         let positions = mesh
             .positions()

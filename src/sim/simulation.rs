@@ -71,6 +71,9 @@ pub struct SimConfig {
     pub drag: f64,
     /// Drive toward the scene centre at the bottom of an object (scale/s^2).
     pub drive_strength: f64,
+    /// Within this horizontal distance of the scene centre (scale units) the drive fades
+    /// linearly to zero, like a spring, so objects are never flung across the centre.
+    pub drive_radius: f64,
     /// Relative linear growth of the drive per simulated second (0 = constant drive); a
     /// slowly growing push makes the contact area keep growing.
     pub drive_growth: f64,
@@ -89,6 +92,11 @@ pub struct SimConfig {
     pub max_contact_depth: f64,
     /// Largest contact acceleration of one vertex (scale/s^2).
     pub max_contact_accel: f64,
+    /// Share (0..=1) of an object's total contact push applied to all its vertices alike
+    /// instead of to the touching ones: the touching ones dent, the whole object is
+    /// stopped. Without it the whole push must travel through the shape pull and a fast
+    /// object ploughs through the other before its dent can stop it.
+    pub contact_body_share: f64,
     /// Speed limit of every vertex (scale/s).
     pub max_speed: f64,
     /// Gap between neighbouring objects in the built-in scenes, relative to their width.
@@ -104,20 +112,22 @@ impl Default for SimConfig {
             substeps: 8,
             edge_stiffness: 3000.0,
             bend_stiffness: 300.0,
-            shape_stiffness: 150.0,
-            internal_damping: 6.0,
-            drag: 1.5,
-            drive_strength: 3.0,
+            shape_stiffness: 1000.0,
+            internal_damping: 20.0,
+            drag: 2.0,
+            drive_strength: 0.6,
+            drive_radius: 0.5,
             drive_growth: 0.5,
             shear: 1.0,
             wobble: 0.5,
             wobble_period: 0.6,
-            contact_stiffness: 2000.0,
+            contact_stiffness: 1000.0,
             contact_offset: 0.005,
             max_contact_depth: 0.05,
-            max_contact_accel: 200.0,
-            max_speed: 3.0,
-            initial_gap: 0.08,
+            max_contact_accel: 300.0,
+            contact_body_share: 0.5,
+            max_speed: 1.0,
+            initial_gap: 0.04,
             seed: 1,
         }
     }
@@ -140,6 +150,7 @@ impl SimConfig {
             ("max_contact_depth", self.max_contact_depth),
             ("max_contact_accel", self.max_contact_accel),
             ("initial_gap", self.initial_gap),
+            ("drive_radius", self.drive_radius),
         ];
         for (name, value) in non_negative {
             if !(value.is_finite() && value >= 0.0) {
@@ -159,6 +170,12 @@ impl SimConfig {
                     "{name} must be finite and positive, got {value}"
                 )));
             }
+        }
+        if !(0.0..=1.0).contains(&self.contact_body_share) {
+            return Err(Error::InvalidOption(format!(
+                "contact_body_share must be in 0..=1, got {}",
+                self.contact_body_share
+            )));
         }
         if self.substeps == 0 {
             return Err(Error::InvalidOption("substeps must be at least 1".into()));
@@ -202,7 +219,10 @@ struct Body {
     contact: Vec<DVec3>,
     /// `pos` as f32, refreshed after every frame.
     out: Vec<[f32; 3]>,
-    drive_dir: DVec3,
+    /// Scene centre the drive pulls toward.
+    centre: DVec3,
+    /// Share of the frame's total contact push applied uniformly to every vertex.
+    contact_mean: DVec3,
     wobble_dir: DVec3,
     phase: f64,
 }
@@ -217,6 +237,7 @@ struct Params {
     internal: f64,
     drag: f64,
     drive: f64,
+    drive_radius: f64,
     shear: f64,
     wobble: f64,
     omega: f64,
@@ -265,18 +286,14 @@ impl Simulation {
         for body in &mut bodies {
             let mut to_centre = centre - body.com();
             to_centre.y = 0.0;
-            body.drive_dir = if to_centre.length() > 1e-9 * scale {
-                to_centre.normalize()
-            } else {
-                DVec3::ZERO
-            };
+            body.centre = centre;
             let phase = unit(splitmix64(&mut state));
             body.phase = phase * std::f64::consts::TAU;
-            body.wobble_dir = if body.drive_dir == DVec3::ZERO {
+            body.wobble_dir = if to_centre.length() <= 1e-9 * scale {
                 let a = unit(splitmix64(&mut state)) * std::f64::consts::TAU;
                 DVec3::new(a.cos(), 0.0, a.sin())
             } else {
-                DVec3::Y.cross(body.drive_dir)
+                DVec3::Y.cross(to_centre.normalize())
             };
         }
         Ok(Self {
@@ -305,6 +322,7 @@ impl Simulation {
             internal: c.internal_damping,
             drag: c.drag,
             drive: c.drive_strength * growth * self.scale,
+            drive_radius: (c.drive_radius * self.scale).max(1e-12),
             shear: c.shear,
             wobble: c.wobble * self.scale,
             omega: std::f64::consts::TAU / c.wobble_period,
@@ -441,7 +459,9 @@ impl Simulation {
                 continue;
             }
             let behind = |t: &[DVec3; 3], n: DVec3, c: DVec3| {
-                t.iter().map(|&v| (c - v).dot(n).max(0.0)).fold(0.0, f64::max)
+                t.iter()
+                    .map(|&v| (c - v).dot(n).max(0.0))
+                    .fold(0.0, f64::max)
             };
             let depth = (behind(&ta, nb, cb) + behind(&tb, na, ca)).min(max_depth);
             let push = dir * (c.contact_stiffness * (offset + depth));
@@ -460,9 +480,16 @@ impl Simulation {
             }
         }
         let limit = c.max_contact_accel * self.scale;
+        let share = c.contact_body_share;
         for body in &mut self.bodies {
-            for a in &mut body.contact {
+            let mut total = DVec3::ZERO;
+            for (a, m) in body.contact.iter_mut().zip(&body.mass) {
                 *a = a.clamp_length_max(limit);
+                total += *a * *m;
+            }
+            body.contact_mean = total * (share / body.total_mass);
+            for a in &mut body.contact {
+                *a *= 1.0 - share;
             }
         }
     }
@@ -530,14 +557,18 @@ impl Body {
             stiffness[s.a as usize] += s.k;
             stiffness[s.b as usize] += s.k;
         }
-        let mass: Vec<f64> = stiffness.iter().map(|&k| (4.0 * h * h * k).max(1.0)).collect();
+        let mass: Vec<f64> = stiffness
+            .iter()
+            .map(|&k| (4.0 * h * h * k).max(1.0))
+            .collect();
         let total_mass: f64 = mass.iter().sum();
         let com = pos.iter().zip(&mass).map(|(p, m)| *p * *m).sum::<DVec3>() / total_mass;
         let rest_offset = pos.iter().map(|p| *p - com).collect();
-        let (lo, hi) = pos.iter().fold(
-            (f64::INFINITY, f64::NEG_INFINITY),
-            |(lo, hi), p| (lo.min(p.y), hi.max(p.y)),
-        );
+        let (lo, hi) = pos
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.y), hi.max(p.y))
+            });
         let height = pos
             .iter()
             .map(|p| if hi > lo { (p.y - lo) / (hi - lo) } else { 0.5 })
@@ -555,7 +586,8 @@ impl Body {
             contact: vec![DVec3::ZERO; n],
             pos,
             out,
-            drive_dir: DVec3::ZERO,
+            centre: DVec3::ZERO,
+            contact_mean: DVec3::ZERO,
             wobble_dir: DVec3::ZERO,
             phase: 0.0,
         }
@@ -599,7 +631,11 @@ impl Body {
             }
         }
         let wobble = self.wobble_dir * (p.wobble * (p.omega * t + self.phase).sin());
-        let drive = self.drive_dir * p.drive;
+        // Toward the centre from where the object is now (so an overshoot is pulled back),
+        // fading linearly within `drive_radius` of it instead of flipping direction.
+        let mut to_centre = self.centre - com;
+        to_centre.y = 0.0;
+        let drive = to_centre * (p.drive / to_centre.length().max(p.drive_radius));
         let denom = 1.0 + p.h * (p.internal + p.drag);
         for i in 0..self.pos.len() {
             let goal = com + self.rest_offset[i];
@@ -608,6 +644,7 @@ impl Body {
                 + (goal - self.pos[i]) * p.shape
                 + self.contact[i]
                 + drive * (1.0 + p.shear * hgt)
+                + self.contact_mean
                 + wobble * hgt;
             let v = ((self.vel[i] + accel * p.h + vcom * (p.h * p.internal)) / denom)
                 .clamp_length_max(p.max_speed);
