@@ -1,6 +1,7 @@
 //! Command-line front end. Every failure is one line on stderr and a non-zero exit code.
 
 mod collide;
+mod experiment;
 
 use clap::{Parser, Subcommand};
 
@@ -19,6 +20,8 @@ struct Cli {
 enum Command {
     /// Contacts (intersecting triangle pairs) between two meshes.
     Collide(collide::CollideArgs),
+    /// The paper's experiment (eight deforming pawns) and the cost-model report.
+    Experiment(experiment::ExperimentArgs),
 }
 
 /// Parses the arguments, runs the command, returns the process exit code.
@@ -31,7 +34,8 @@ pub fn run() -> i32 {
         }
     };
     let result = match cli.command {
-        Command::Collide(args) => collide::run(args),
+        Command::Collide(args) => collide::run(args).map_err(|e| e.to_string()),
+        Command::Experiment(args) => experiment::run(args),
     };
     match result {
         Ok(()) => 0,
