@@ -13,9 +13,11 @@
 //!   refit inside), divided by `N_V`;
 //! * **`C_P`**: `narrow_phase` of every pair's recorded leaf pairs, divided by `N_P`.
 //!
-//! Each repetition pools all calibration frames (total time / total count); the reported
-//! constant is the median over repetitions, with min, max and quartiles as the spread, plus
-//! the median per frame to show how the constant moves over the run.
+//! The constant is pooled over the calibration frames from each frame's median time:
+//! `C = sum_f median_rep(t_f) / sum_f N_f` (the median makes one preempted repetition
+//! harmless; pooling weights frames by their work, as the run does). The spread is that of
+//! every single sample `t / N` (all frames and repetitions): median, min, max, quartiles.
+//! The median per frame shows how the constant moves over the run.
 
 use std::time::Instant;
 
@@ -87,26 +89,35 @@ pub struct FrameCosts {
     pub fixed_ns: f64,
 }
 
+/// One calibrated constant: the pooled value and the spread of the single samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Constant {
+    /// `sum_f median_rep(t_f) / sum_f N_f` (ns per operation).
+    pub value: f64,
+    /// Spread of the single samples `t / N` over frames and repetitions.
+    pub spread: Spread,
+}
+
 /// Calibrated constants of one method.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Costs {
     /// ns per BV-pair test (traversal: test + expansion + frontier bookkeeping).
-    pub c_v: Spread,
+    pub c_v: Constant,
     /// ns per triangle-pair test (exact narrow phase).
-    pub c_p: Spread,
+    pub c_p: Constant,
     /// ns per BV update (refit of one node).
-    pub c_u: Spread,
+    pub c_u: Constant,
     /// ns per step of `update_positions` of every object (not in the paper's model).
-    pub fixed_ns: Spread,
+    pub fixed_ns: Constant,
     pub per_frame: Vec<FrameCosts>,
 }
 
 impl Costs {
-    /// `N_V*C_V + N_P*C_P + N_U*C_U` with the median constants.
+    /// `N_V*C_V + N_P*C_P + N_U*C_U` with the pooled constants.
     pub fn predict(&self, c: &Counters) -> f64 {
-        c.bv_tests as f64 * self.c_v.median
-            + c.prim_tests as f64 * self.c_p.median
-            + c.bv_updates as f64 * self.c_u.median
+        c.bv_tests as f64 * self.c_v.value
+            + c.prim_tests as f64 * self.c_p.value
+            + c.bv_updates as f64 * self.c_u.value
     }
 }
 
@@ -133,8 +144,9 @@ pub(super) fn calibrate(
     progress: &mut dyn FnMut(usize),
 ) -> Result<Costs, ExperimentError> {
     let mut ws = Workspace::default();
-    // Pooled over frames, per repetition: (time, count).
-    let mut pooled = vec![[(0.0, 0u64); 4]; reps];
+    // Per kind: sum over frames of (median time, count), and every single sample.
+    let mut pooled = [(0.0, 0u64); 4];
+    let mut all: [Vec<f64>; 4] = Default::default();
     let mut per_frame = Vec::with_capacity(calib_frames.len());
     for (fi, &f) in calib_frames.iter().enumerate() {
         progress(fi);
@@ -150,8 +162,10 @@ pub(super) fn calibrate(
             leaves.push(ws.leaf_pairs().to_vec());
         }
         let fitted: Vec<Vec<u32>> = hs.iter().map(AnyHierarchy::fitted_nodes).collect();
-        let mut samples = [vec![], vec![], vec![], vec![]];
-        for acc in pooled.iter_mut() {
+        let mut samples: [Vec<f64>; 4] = Default::default();
+        let mut times: [Vec<f64>; 4] = Default::default();
+        let mut counts = [0u64; 4];
+        for _ in 0..reps {
             // fixed: update_positions (validates, copies, invalidates).
             let t = Instant::now();
             for (h, p) in hs.iter_mut().zip(frame) {
@@ -191,12 +205,17 @@ pub(super) fn calibrate(
                 .into_iter()
                 .enumerate()
             {
-                acc[k].0 += t;
-                acc[k].1 += n;
+                times[k].push(t);
+                counts[k] = n;
                 if let Some(c) = per(t, n) {
                     samples[k].push(c);
                 }
             }
+        }
+        for k in 0..4 {
+            pooled[k].0 += median(&mut times[k]);
+            pooled[k].1 += counts[k];
+            all[k].extend_from_slice(&samples[k]);
         }
         per_frame.push(FrameCosts {
             frame: f,
@@ -208,9 +227,9 @@ pub(super) fn calibrate(
         });
     }
     progress(calib_frames.len());
-    let spread = |k: usize| {
-        let xs: Vec<f64> = pooled.iter().filter_map(|a| per(a[k].0, a[k].1)).collect();
-        Spread::of(&xs)
+    let spread = |k: usize| Constant {
+        value: per(pooled[k].0, pooled[k].1).unwrap_or(0.0),
+        spread: Spread::of(&all[k]),
     };
     Ok(Costs {
         c_v: spread(0),

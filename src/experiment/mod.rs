@@ -36,7 +36,7 @@ use crate::sim::{pawn_scene, scene_with_mesh, ObjectContact, SimConfig, Simulati
 use crate::traverse::Workspace;
 use crate::tree::{RegionTree, DEFAULT_LEVELS};
 
-pub use cost::{Costs, Spread};
+pub use cost::{Constant, Costs, Spread};
 
 /// What can stop the experiment.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -94,8 +94,8 @@ impl Default for Config {
             seed: 1,
             mesh: None,
             sim: SimConfig::default(),
-            timing_reps: 3,
-            calibration_frames: 5,
+            timing_reps: 5,
+            calibration_frames: 10,
             calibration_reps: 7,
         }
     }
@@ -227,7 +227,7 @@ impl MethodReport {
     /// The fixed cost of one step (calibrated position copy of every object), not in the
     /// paper's model.
     pub fn fixed_ns(&self) -> f64 {
-        self.costs.fixed_ns.median
+        self.costs.fixed_ns.value
     }
     /// Model plus the fixed term, summed over all steps.
     pub fn total_predicted_with_fixed_ns(&self) -> f64 {

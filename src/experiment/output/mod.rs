@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
-use super::{cost::Spread, MethodReport, Report};
+use super::{cost::Constant, MethodReport, Report};
 use crate::bv::Method;
 use crate::error::{Error, Result};
 
@@ -40,7 +40,8 @@ fn label(m: Method) -> &'static str {
     }
 }
 
-fn spread_json(s: &Spread) -> Value {
+fn spread_json(c: &Constant) -> Value {
+    let s = &c.spread;
     json!({"median": s.median, "min": s.min, "max": s.max, "p25": s.p25, "p75": s.p75, "samples": s.samples})
 }
 
@@ -69,10 +70,10 @@ fn method_json(m: &MethodReport) -> Value {
         "bytes_per_hierarchy": m.bytes_per_hierarchy,
         "bytes_all_hierarchies": m.bytes_all_hierarchies,
         "costs": {
-            "c_v_ns": c.c_v.median,
-            "c_p_ns": c.c_p.median,
-            "c_u_ns": c.c_u.median,
-            "fixed_ns_per_step": c.fixed_ns.median,
+            "c_v_ns": c.c_v.value,
+            "c_p_ns": c.c_p.value,
+            "c_u_ns": c.c_u.value,
+            "fixed_ns_per_step": c.fixed_ns.value,
             "c_v_spread": spread_json(&c.c_v),
             "c_p_spread": spread_json(&c.c_p),
             "c_u_spread": spread_json(&c.c_u),
@@ -179,10 +180,11 @@ pub fn summary_table(r: &Report) -> String {
     s
 }
 
-fn spread_cell(s: &Spread) -> String {
+fn spread_cell(c: &Constant) -> String {
+    let s = &c.spread;
     format!(
-        "{:.1} [{:.1}–{:.1}] (IQR {:.1}–{:.1}, n={})",
-        s.median, s.min, s.max, s.p25, s.p75, s.samples
+        "**{:.1}** (samples: median {:.1}, IQR {:.1}–{:.1}, range {:.1}–{:.1}, n={})",
+        c.value, s.median, s.p25, s.p75, s.min, s.max, s.samples
     )
 }
 
@@ -223,7 +225,11 @@ pub fn markdown(r: &Report) -> String {
             ms(m.total_time_ns())
         );
     }
-    let _ = writeln!(md, "\n## Cost constants (ns per operation; median [min–max] over calibration repetitions)\n");
+    let _ = writeln!(md, "\n## Cost constants (ns per operation)\n");
+    let _ = writeln!(
+        md,
+        "Constant = sum over calibration frames of the median time (over repetitions) / sum of the counts. Spread: every single sample time/count, over all calibration frames and repetitions.\n"
+    );
     let _ = writeln!(
         md,
         "| method | C_V | C_P | C_U | fixed per step (update_positions) |"
@@ -233,14 +239,14 @@ pub fn markdown(r: &Report) -> String {
         let c = &m.costs;
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {:.0} ns [{:.0}–{:.0}] |",
+            "| {} | {} | {} | {} | {:.0} ns (range {:.0}–{:.0}) |",
             label(m.method),
             spread_cell(&c.c_v),
             spread_cell(&c.c_p),
             spread_cell(&c.c_u),
-            c.fixed_ns.median,
-            c.fixed_ns.min,
-            c.fixed_ns.max
+            c.fixed_ns.value,
+            c.fixed_ns.spread.min,
+            c.fixed_ns.spread.max
         );
     }
     let _ = writeln!(md, "\nPer calibration frame (medians):\n");
@@ -279,9 +285,9 @@ pub fn markdown(r: &Report) -> String {
             md,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             label(m.method),
-            ms(t.bv_tests as f64 * c.c_v.median),
-            ms(t.prim_tests as f64 * c.c_p.median),
-            ms(t.bv_updates as f64 * c.c_u.median),
+            ms(t.bv_tests as f64 * c.c_v.value),
+            ms(t.prim_tests as f64 * c.c_p.value),
+            ms(t.bv_updates as f64 * c.c_u.value),
             ms(m.total_predicted_ns()),
             ms(m.total_time_ns()),
             pct(m.model_error()),

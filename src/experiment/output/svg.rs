@@ -249,20 +249,30 @@ pub fn scene(snap: &Snapshot, title: &str) -> String {
         w / 2.0,
         esc(title)
     );
-    // Consecutive triangles of one colour share a path element.
+    // One CSS class per colour; consecutive triangles of one colour share a path element;
+    // whole-pixel coordinates (the stroke in the fill colour hides the seams).
+    let mut colors: Vec<[u8; 3]> = tris.iter().map(|t| t.color).collect();
+    colors.sort_unstable();
+    colors.dedup();
+    s.push_str("<style>path{stroke-width:0.6;stroke-linejoin:round}");
+    for (i, c) in colors.iter().enumerate() {
+        let _ = write!(
+            s,
+            ".c{i}{{fill:#{0:02x}{1:02x}{2:02x};stroke:#{0:02x}{1:02x}{2:02x}}}",
+            c[0], c[1], c[2]
+        );
+    }
+    s.push_str("</style>\n");
     let mut k = 0;
     while k < tris.len() {
         let c = tris[k].color;
-        let _ = write!(
-            s,
-            r##"<path fill="#{:02x}{:02x}{:02x}" stroke="#{:02x}{:02x}{:02x}" stroke-width="0.3" d=""##,
-            c[0], c[1], c[2], c[0], c[1], c[2]
-        );
+        let class = colors.binary_search(&c).unwrap_or(0);
+        let _ = write!(s, r#"<path class="c{class}" d=""#);
         while k < tris.len() && tris[k].color == c {
             for (i, p) in tris[k].pts.iter().enumerate() {
                 let x = ox + (p[0] - lo[0]) * scale;
                 let y = oy + (p[1] - lo[1]) * scale;
-                let _ = write!(s, "{}{:.1} {:.1}", if i == 0 { "M" } else { "L" }, x, y);
+                let _ = write!(s, "{}{:.0} {:.0}", if i == 0 { "M" } else { "L" }, x, y);
             }
             s.push('Z');
             k += 1;
