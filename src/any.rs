@@ -4,11 +4,11 @@
 use std::sync::Arc;
 
 use crate::bv::{Aabb, Dh, Method, Sphere};
+use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
 use crate::mesh::Mesh;
 use crate::par::Par;
-use crate::counters::Counters;
 use crate::traverse::{broad_phase, collide_with, narrow_phase, Contacts, Workspace};
 use crate::tree::RegionTree;
 

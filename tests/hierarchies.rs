@@ -472,8 +472,10 @@ fn broad_then_narrow_phase_equals_collide() {
     let b = icosphere(3, 1.0, [1.4, 0.3, 0.0]);
     let mut ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
     let mut hb = Hierarchy::<Dh>::new(&b, Options::default()).unwrap();
-    ha.update_positions(&wave(a.positions(), 0.5, 0.1, [0.0; 3])).unwrap();
-    hb.update_positions(&wave(b.positions(), 0.5, 0.1, [1.4, 0.3, 0.0])).unwrap();
+    ha.update_positions(&wave(a.positions(), 0.5, 0.1, [0.0; 3]))
+        .unwrap();
+    hb.update_positions(&wave(b.positions(), 0.5, 0.1, [1.4, 0.3, 0.0]))
+        .unwrap();
     let whole = collide(&mut ha.clone(), &mut hb.clone());
     let mut ws = dhcd::Workspace::default();
     let broad = dhcd::broad_phase(&mut ha, &mut hb, &mut ws, dhcd::Par::Seq);
@@ -485,7 +487,10 @@ fn broad_then_narrow_phase_equals_collide() {
     assert_eq!(narrow.counters.prim_tests, whole.counters.prim_tests);
     // Replaying the step's refit: invalidate, then refit exactly the nodes the query fitted.
     let fitted = ha.fitted_nodes();
-    assert_eq!(fitted.len() + hb.fitted_nodes().len(), whole.counters.bv_updates as usize);
+    assert_eq!(
+        fitted.len() + hb.fitted_nodes().len(),
+        whole.counters.bv_updates as usize
+    );
     ha.invalidate();
     assert_eq!(ha.validate().unwrap(), 0);
     ha.refit_nodes(&fitted, dhcd::Par::Rayon(2));

@@ -13,11 +13,16 @@
 //!   refit inside), divided by `N_V`;
 //! * **`C_P`**: `narrow_phase` of every pair's recorded leaf pairs, divided by `N_P`.
 //!
-//! The constant is pooled over the calibration frames from each frame's median time:
-//! `C = sum_f median_rep(t_f) / sum_f N_f` (the median makes one preempted repetition
-//! harmless; pooling weights frames by their work, as the run does). The spread is that of
-//! every single sample `t / N` (all frames and repetitions): median, min, max, quartiles.
-//! The median per frame shows how the constant moves over the run.
+//! The constant is pooled over the calibration frames from each frame's least time:
+//! `C = sum_f min_rep(t_f) / sum_f N_f`. The machine is shared (other processes preempt
+//! ours), so the least time over repetitions is the least-disturbed one; the measured step
+//! times use the same statistic, so model and measurement compare like with like. Pooling
+//! weights frames by their work, as the run does. The spread is that of every single sample
+//! `t / N` (all frames and repetitions): median, min, max, quartiles. The per-frame
+//! constants show how they move over the run.
+//!
+//! Calibration frames are calibrated right after they are measured (interleaved with the
+//! measurement), so both see the same machine load.
 
 use std::time::Instant;
 
@@ -78,7 +83,7 @@ pub fn median(xs: &mut [f64]) -> f64 {
     quantile(xs, 0.5)
 }
 
-/// The constants of one calibration frame (medians over repetitions) and its counts.
+/// The constants of one calibration frame (least time over repetitions) and its counts.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameCosts {
     pub frame: usize,
@@ -92,7 +97,7 @@ pub struct FrameCosts {
 /// One calibrated constant: the pooled value and the spread of the single samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Constant {
-    /// `sum_f median_rep(t_f) / sum_f N_f` (ns per operation).
+    /// `sum_f min_rep(t_f) / sum_f N_f` (ns per operation).
     pub value: f64,
     /// Spread of the single samples `t / N` over frames and repetitions.
     pub spread: Spread,
@@ -133,109 +138,131 @@ fn per(t: f64, n: u64) -> Option<f64> {
     (n > 0).then(|| t / n as f64)
 }
 
-/// Calibrates one method on hierarchies `hs` (one per object), frames `positions`.
-pub(super) fn calibrate(
+/// Calibration samples of one frame of one method (see [`combine`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameSamples {
+    pub frame: usize,
+    pub counters: Counters,
+    /// Per kind (`C_V`, `C_P`, `C_U`, fixed): the time of every repetition (ns).
+    pub times: [Vec<f64>; 4],
+}
+
+impl FrameSamples {
+    fn counts(&self) -> [u64; 4] {
+        let c = &self.counters;
+        [c.bv_tests, c.prim_tests, c.bv_updates, 1]
+    }
+}
+
+/// Calibrates one method on one frame: hierarchies `hs` (one per object) get `frame`'s
+/// positions, every pair is queried once, then the four measurements are repeated `reps`
+/// times.
+pub(super) fn calibrate_frame(
     hs: &mut [AnyHierarchy],
-    positions: &[Vec<Vec<[f32; 3]>>],
-    calib_frames: &[usize],
+    frame: &[Vec<[f32; 3]>],
+    frame_index: usize,
     pairs: &[(usize, usize)],
     reps: usize,
     par: Par,
-    progress: &mut dyn FnMut(usize),
-) -> Result<Costs, ExperimentError> {
+) -> Result<FrameSamples, ExperimentError> {
     let mut ws = Workspace::default();
-    // Per kind: sum over frames of (median time, count), and every single sample.
-    let mut pooled = [(0.0, 0u64); 4];
-    let mut all: [Vec<f64>; 4] = Default::default();
-    let mut per_frame = Vec::with_capacity(calib_frames.len());
-    for (fi, &f) in calib_frames.iter().enumerate() {
-        progress(fi);
-        let frame = &positions[f];
+    for (h, p) in hs.iter_mut().zip(frame) {
+        h.update_positions(p)?;
+    }
+    let mut counters = Counters::default();
+    let mut leaves = Vec::with_capacity(pairs.len());
+    for &(i, j) in pairs {
+        let (a, b) = two_mut(hs, i, j);
+        counters += a.collide(b, &mut ws, par)?.counters;
+        leaves.push(ws.leaf_pairs().to_vec());
+    }
+    let fitted: Vec<Vec<u32>> = hs.iter().map(AnyHierarchy::fitted_nodes).collect();
+    let mut times: [Vec<f64>; 4] = Default::default();
+    for _ in 0..reps {
+        // fixed: update_positions (validates, copies, invalidates).
+        let t = Instant::now();
         for (h, p) in hs.iter_mut().zip(frame) {
             h.update_positions(p)?;
         }
-        let mut counters = Counters::default();
-        let mut leaves = Vec::with_capacity(pairs.len());
+        let fixed = t.elapsed().as_nanos() as f64;
+        // C_U: the step's refit, alone.
+        let t = Instant::now();
+        for (h, ids) in hs.iter_mut().zip(&fitted) {
+            h.invalidate();
+            h.refit_nodes(ids, par);
+        }
+        let tu = t.elapsed().as_nanos() as f64;
+        let nu: u64 = hs.iter_mut().map(AnyHierarchy::take_updates).sum();
+        debug_assert_eq!(nu, counters.bv_updates);
+        // C_V: traversal with everything already fitted.
+        let t = Instant::now();
+        let mut nv = 0;
         for &(i, j) in pairs {
             let (a, b) = two_mut(hs, i, j);
-            counters += a.collide(b, &mut ws, par)?.counters;
-            leaves.push(ws.leaf_pairs().to_vec());
+            let c = a.broad_phase(b, &mut ws, par)?;
+            debug_assert_eq!(c.bv_updates, 0);
+            nv += c.bv_tests;
         }
-        let fitted: Vec<Vec<u32>> = hs.iter().map(AnyHierarchy::fitted_nodes).collect();
-        let mut samples: [Vec<f64>; 4] = Default::default();
-        let mut times: [Vec<f64>; 4] = Default::default();
-        let mut counts = [0u64; 4];
-        for _ in 0..reps {
-            // fixed: update_positions (validates, copies, invalidates).
-            let t = Instant::now();
-            for (h, p) in hs.iter_mut().zip(frame) {
-                h.update_positions(p)?;
-            }
-            let fixed = t.elapsed().as_nanos() as f64;
-            // C_U: the step's refit, alone.
-            let t = Instant::now();
-            for (h, ids) in hs.iter_mut().zip(&fitted) {
-                h.invalidate();
-                h.refit_nodes(ids, par);
-            }
-            let tu = t.elapsed().as_nanos() as f64;
-            let nu: u64 = hs.iter_mut().map(AnyHierarchy::take_updates).sum();
-            debug_assert_eq!(nu, counters.bv_updates);
-            // C_V: traversal with everything already fitted.
-            let t = Instant::now();
-            let mut nv = 0;
-            for &(i, j) in pairs {
-                let (a, b) = two_mut(hs, i, j);
-                let c = a.broad_phase(b, &mut ws, par)?;
-                debug_assert_eq!(c.bv_updates, 0);
-                nv += c.bv_tests;
-            }
-            let tv = t.elapsed().as_nanos() as f64;
-            debug_assert_eq!(nv, counters.bv_tests);
-            // C_P: exact tests of the recorded leaf pairs.
-            let t = Instant::now();
-            let mut np = 0;
-            for (&(i, j), l) in pairs.iter().zip(&leaves) {
-                np += hs[i].narrow_phase(&hs[j], l, par)?.counters.prim_tests;
-            }
-            let tp = t.elapsed().as_nanos() as f64;
-            debug_assert_eq!(np, counters.prim_tests);
+        let tv = t.elapsed().as_nanos() as f64;
+        debug_assert_eq!(nv, counters.bv_tests);
+        // C_P: exact tests of the recorded leaf pairs.
+        let t = Instant::now();
+        let mut np = 0;
+        for (&(i, j), l) in pairs.iter().zip(&leaves) {
+            np += hs[i].narrow_phase(&hs[j], l, par)?.counters.prim_tests;
+        }
+        let tp = t.elapsed().as_nanos() as f64;
+        debug_assert_eq!(np, counters.prim_tests);
+        for (k, t) in [tv, tp, tu, fixed].into_iter().enumerate() {
+            times[k].push(t);
+        }
+    }
+    Ok(FrameSamples {
+        frame: frame_index,
+        counters,
+        times,
+    })
+}
 
-            for (k, (t, n)) in [(tv, nv), (tp, np), (tu, nu), (fixed, 1)]
-                .into_iter()
-                .enumerate()
-            {
-                times[k].push(t);
-                counts[k] = n;
-                if let Some(c) = per(t, n) {
-                    samples[k].push(c);
-                }
-            }
-        }
+/// The constants from the samples of all calibration frames: per kind,
+/// `sum_f min_rep(t_f) / sum_f N_f`, and the spread of every single sample `t / N`.
+pub(super) fn combine(frames: &[FrameSamples]) -> Costs {
+    let mut pooled = [(0.0, 0u64); 4];
+    let mut all: [Vec<f64>; 4] = Default::default();
+    let mut per_frame = Vec::with_capacity(frames.len());
+    for f in frames {
+        let counts = f.counts();
+        let mut best = [0.0; 4];
         for k in 0..4 {
-            pooled[k].0 += median(&mut times[k]);
+            best[k] = least(&f.times[k]);
+            pooled[k].0 += best[k];
             pooled[k].1 += counts[k];
-            all[k].extend_from_slice(&samples[k]);
+            all[k].extend(f.times[k].iter().filter_map(|&t| per(t, counts[k])));
         }
+        let c = |k: usize| per(best[k], counts[k]).unwrap_or(0.0);
         per_frame.push(FrameCosts {
-            frame: f,
-            counters,
-            c_v_ns: median(&mut samples[0]),
-            c_p_ns: median(&mut samples[1]),
-            c_u_ns: median(&mut samples[2]),
-            fixed_ns: median(&mut samples[3]),
+            frame: f.frame,
+            counters: f.counters,
+            c_v_ns: c(0),
+            c_p_ns: c(1),
+            c_u_ns: c(2),
+            fixed_ns: c(3),
         });
     }
-    progress(calib_frames.len());
-    let spread = |k: usize| Constant {
+    let constant = |k: usize| Constant {
         value: per(pooled[k].0, pooled[k].1).unwrap_or(0.0),
         spread: Spread::of(&all[k]),
     };
-    Ok(Costs {
-        c_v: spread(0),
-        c_p: spread(1),
-        c_u: spread(2),
-        fixed_ns: spread(3),
+    Costs {
+        c_v: constant(0),
+        c_p: constant(1),
+        c_u: constant(2),
+        fixed_ns: constant(3),
         per_frame,
-    })
+    }
+}
+
+/// The least of `xs` (0 when empty): on a shared machine, the least-disturbed repetition.
+pub fn least(xs: &[f64]) -> f64 {
+    xs.iter().copied().reduce(f64::min).unwrap_or(0.0)
 }

@@ -10,11 +10,13 @@
 //! 2. **Measure** ([`Phase::Measure`]): per step, per method, `update_positions` on every
 //!    object (update time), then every object pair (query time, the lazy refit happens
 //!    inside). Each step is replayed `timing_reps` times (a replay redoes the whole update and
-//!    refit) and the median kept; the method order rotates per step so that no method always
-//!    runs on caches warmed by another. Contacts must be identical across methods (and equal
+//!    refit) and the least time kept (the machine is shared: the least-disturbed replay); the
+//!    method order rotates per step so that no method always runs on caches warmed by
+//!    another. Contacts must be identical across methods (and equal
 //!    to the simulation's), else [`ExperimentError::ContactMismatch`].
-//! 3. **Calibrate** ([`Phase::Calibrate`], module [`cost`]): `C_V`, `C_P`, `C_U` and the fixed
-//!    position-copy cost per method, from the real kernels on frames spread over the run.
+//! 3. **Calibrate** (module [`cost`]): `C_V`, `C_P`, `C_U` and the fixed position-copy cost
+//!    per method, from the real kernels on frames spread over the run, each calibrated right
+//!    after it is measured (same machine load).
 //!
 //! Results do not depend on the thread count (counters and contacts; times do).
 
@@ -76,7 +78,7 @@ pub struct Config {
     pub mesh: Option<Mesh>,
     /// Simulator parameters (its `seed` is replaced by [`Config::seed`]).
     pub sim: SimConfig,
-    /// Replays of every measured step; the median time is kept.
+    /// Replays of every measured step; the least time is kept.
     pub timing_reps: usize,
     /// Calibration frames, spread evenly over the run.
     pub calibration_frames: usize,
@@ -138,8 +140,8 @@ impl Config {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Phase {
     Simulate,
+    /// Measurement, with the calibration interleaved.
     Measure,
-    Calibrate,
 }
 
 impl Phase {
@@ -147,7 +149,6 @@ impl Phase {
         match self {
             Phase::Simulate => "simulate",
             Phase::Measure => "measure",
-            Phase::Calibrate => "calibrate",
         }
     }
 }
@@ -179,11 +180,11 @@ pub struct SceneInfo {
 pub struct Step {
     /// `N_V`, `N_P`, `N_U`, contacts, summed over all object pairs.
     pub counters: Counters,
-    /// `update_positions` of every object (median over replays).
+    /// `update_positions` of every object (least over replays).
     pub update_ns: f64,
-    /// All object-pair queries, lazy refit included (median over replays).
+    /// All object-pair queries, lazy refit included (least over replays).
     pub query_ns: f64,
-    /// Cost model `N_V*C_V + N_P*C_P + N_U*C_U` (calibrated medians).
+    /// Cost model `N_V*C_V + N_P*C_P + N_U*C_U` (calibrated constants).
     pub predicted_ns: f64,
 }
 
@@ -273,7 +274,7 @@ pub struct Report {
     pub methods: Vec<MethodReport>,
     /// The step with the most contacts (the first one if there are none).
     pub snapshot: Snapshot,
-    /// Wall time of the three phases (seconds).
+    /// Wall time of the phases (seconds; calibration is interleaved with measurement).
     pub simulate_s: f64,
     pub measure_s: f64,
     pub calibrate_s: f64,
@@ -312,7 +313,6 @@ pub fn run(
     progress: &mut dyn FnMut(Phase, usize, usize),
 ) -> Result<Report, ExperimentError> {
     config.check()?;
-    let par = config.par();
     let sim_config = SimConfig {
         seed: config.seed,
         ..config.sim.clone()
@@ -355,23 +355,20 @@ pub fn run(
         .collect::<Result<_, _>>()?;
 
     let t = Instant::now();
-    let steps = measure(&mut hierarchies, &frames, &pairs, config, progress)?;
-    let measure_s = t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
     let calib_frames = cost::calibration_frames(config.frames, config.calibration_frames);
-    let total = config.methods.len() * calib_frames.len();
+    let (steps, samples, calibrate_s) = measure(
+        &mut hierarchies,
+        &frames,
+        &pairs,
+        &calib_frames,
+        config,
+        progress,
+    )?;
+    let measure_s = t.elapsed().as_secs_f64() - calibrate_s;
+
     let mut methods = Vec::with_capacity(config.methods.len());
-    for (k, (hs, mut steps)) in hierarchies.iter_mut().zip(steps).enumerate() {
-        let costs = cost::calibrate(
-            hs,
-            &frames.positions,
-            &calib_frames,
-            &pairs,
-            config.calibration_reps,
-            par,
-            &mut |f| progress(Phase::Calibrate, k * calib_frames.len() + f, total),
-        )?;
+    for (k, ((hs, mut steps), samples)) in hierarchies.iter().zip(steps).zip(samples).enumerate() {
+        let costs = cost::combine(&samples);
         for s in &mut steps {
             s.predicted_ns = costs.predict(&s.counters);
         }
@@ -384,7 +381,6 @@ pub fn run(
             steps,
         });
     }
-    let calibrate_s = t.elapsed().as_secs_f64();
 
     let snapshot = snapshot(&frames, &meshes, &pairs);
     let scene = SceneInfo {
@@ -433,9 +429,8 @@ fn simulate(
     };
     for f in 0..config.frames {
         progress(Phase::Simulate, f, config.frames);
-        let positions: Vec<Vec<[f32; 3]>> = (0..dh.len())
-            .map(|o| sim.positions(o).to_vec())
-            .collect();
+        let positions: Vec<Vec<[f32; 3]>> =
+            (0..dh.len()).map(|o| sim.positions(o).to_vec()).collect();
         for (h, p) in dh.iter_mut().zip(&positions) {
             h.update_positions(p)?;
         }
@@ -462,18 +457,25 @@ fn simulate(
     Ok(frames)
 }
 
-/// Phase 2: every method on every frame; returns per method the steps (prediction still 0).
+/// Per method: the measured steps (prediction still 0) and the calibration samples; and
+/// the seconds spent calibrating.
+type Measured = (Vec<Vec<Step>>, Vec<Vec<cost::FrameSamples>>, f64);
+
+/// Phase 2: every method on every frame, calibrating at the calibration frames.
 fn measure(
     hierarchies: &mut [Vec<AnyHierarchy>],
     frames: &Frames,
     pairs: &[(usize, usize)],
+    calib_frames: &[usize],
     config: &Config,
     progress: &mut dyn FnMut(Phase, usize, usize),
-) -> Result<Vec<Vec<Step>>, ExperimentError> {
+) -> Result<Measured, ExperimentError> {
     let par = config.par();
     let methods = &config.methods;
     let mut ws = Workspace::default();
     let mut steps: Vec<Vec<Step>> = vec![Vec::with_capacity(config.frames); methods.len()];
+    let mut samples: Vec<Vec<cost::FrameSamples>> = vec![Vec::new(); methods.len()];
+    let mut calibrate_s = 0.0;
     let mut update_t = vec![0.0; config.timing_reps];
     let mut query_t = vec![0.0; config.timing_reps];
     for (s, positions) in frames.positions.iter().enumerate() {
@@ -508,19 +510,34 @@ fn measure(
                 let t2 = Instant::now();
                 update_t[rep] = (t1 - t0).as_nanos() as f64;
                 query_t[rep] = (t2 - t1).as_nanos() as f64;
-                debug_assert!(rep == 0 || sum == counters, "replayed step counted differently");
+                debug_assert!(
+                    rep == 0 || sum == counters,
+                    "replayed step counted differently"
+                );
                 counters = sum;
             }
             steps[k].push(Step {
                 counters,
-                update_ns: cost::median(&mut update_t),
-                query_ns: cost::median(&mut query_t),
+                update_ns: cost::least(&update_t),
+                query_ns: cost::least(&query_t),
                 predicted_ns: 0.0,
             });
+            if calib_frames.contains(&s) {
+                let t = Instant::now();
+                samples[k].push(cost::calibrate_frame(
+                    hs,
+                    positions,
+                    s,
+                    pairs,
+                    config.calibration_reps,
+                    par,
+                )?);
+                calibrate_s += t.elapsed().as_secs_f64();
+            }
         }
     }
     progress(Phase::Measure, config.frames, config.frames);
-    Ok(steps)
+    Ok((steps, samples, calibrate_s))
 }
 
 /// The step with the most contacts, with its contact triangles per object.

@@ -201,7 +201,7 @@ pub fn markdown(r: &Report) -> String {
     );
     let _ = writeln!(
         md,
-        "Wall time: simulate {:.1} s, measure {:.1} s, calibrate {:.1} s. Step times are medians over replays of the step.\n",
+        "Wall time: simulate {:.1} s, measure {:.1} s, calibrate {:.1} s. Step times are the least over replays of the step (the machine is shared).\n",
         r.simulate_s, r.measure_s, r.calibrate_s
     );
     let _ = writeln!(md, "## Per-method totals over all steps\n");
@@ -228,7 +228,7 @@ pub fn markdown(r: &Report) -> String {
     let _ = writeln!(md, "\n## Cost constants (ns per operation)\n");
     let _ = writeln!(
         md,
-        "Constant = sum over calibration frames of the median time (over repetitions) / sum of the counts. Spread: every single sample time/count, over all calibration frames and repetitions.\n"
+        "Constant = sum over calibration frames of the least time (over repetitions) / sum of the counts. Spread: every single sample time/count, over all calibration frames and repetitions.\n"
     );
     let _ = writeln!(
         md,
@@ -249,7 +249,10 @@ pub fn markdown(r: &Report) -> String {
             c.fixed_ns.spread.max
         );
     }
-    let _ = writeln!(md, "\nPer calibration frame (medians):\n");
+    let _ = writeln!(
+        md,
+        "\nPer calibration frame (least time over repetitions / count):\n"
+    );
     let _ = writeln!(md, "| method | frame | N_V | N_P | N_U | C_V | C_P | C_U |");
     let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|");
     for m in &r.methods {
@@ -277,7 +280,10 @@ pub fn markdown(r: &Report) -> String {
         md,
         "| method | N_V·C_V ms | N_P·C_P ms | N_U·C_U ms | model ms | measured ms | error | fixed ms | model + fixed ms | error | query ms | model vs query |"
     );
-    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        md,
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for m in &r.methods {
         let t = m.totals();
         let c = &m.costs;
@@ -316,12 +322,18 @@ pub fn markdown(r: &Report) -> String {
     }
     let _ = writeln!(md, "\n## Figures\n");
     for (f, cap) in [
-        ("fig1_scene.svg", "Figure 1: the scene at the step with most contacts (contacts in red)"),
+        (
+            "fig1_scene.svg",
+            "Figure 1: the scene at the step with most contacts (contacts in red)",
+        ),
         ("fig2_bv_tests.svg", "Figure 2: BV pairs tested per step"),
         ("fig3_contacts.svg", "Figure 3: contacts per step"),
         ("fig4_time.svg", "Figure 4: time per step"),
         ("bv_updates.svg", "BV updates per step"),
-        ("predicted_vs_measured.svg", "Cost model vs measured time per step"),
+        (
+            "predicted_vs_measured.svg",
+            "Cost model vs measured time per step",
+        ),
     ] {
         let _ = writeln!(md, "![{cap}]({f})\n");
     }

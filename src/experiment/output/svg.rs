@@ -66,7 +66,12 @@ fn trim(v: f64) -> String {
 
 /// A line chart of per-step values (x = step index from 0).
 pub fn line_chart(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> String {
-    let n = series.iter().map(|s| s.values.len()).max().unwrap_or(0).max(2);
+    let n = series
+        .iter()
+        .map(|s| s.values.len())
+        .max()
+        .unwrap_or(0)
+        .max(2);
     let y_max = series
         .iter()
         .flat_map(|s| s.values.iter().copied())
