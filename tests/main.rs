@@ -1,5 +1,6 @@
 //! One integration-test binary; each module is a suite.
 
+mod experiment;
 mod hierarchies;
 mod io;
 mod narrow;
