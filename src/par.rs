@@ -34,8 +34,11 @@ impl Par {
     }
 }
 
+/// Pools built so far, by thread count.
+type PoolCache = Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>>;
+
 fn pool(threads: usize) -> Option<Arc<rayon::ThreadPool>> {
-    static POOLS: OnceLock<Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>>> = OnceLock::new();
+    static POOLS: OnceLock<PoolCache> = OnceLock::new();
     let mut pools = POOLS
         .get_or_init(Default::default)
         .lock()
