@@ -4,12 +4,13 @@
 use std::sync::Arc;
 
 use crate::bv::{Aabb, Dh, Method, Sphere};
+use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
 use crate::mesh::Mesh;
 use crate::par::Par;
 use crate::self_collide::self_collide_with;
-use crate::traverse::{collide_with, Contacts, Workspace};
+use crate::traverse::{broad_phase, collide_with, narrow_phase, Contacts, Workspace};
 use crate::tree::RegionTree;
 
 /// A hierarchy of a kind chosen at run time.
@@ -26,6 +27,22 @@ macro_rules! each {
             AnyHierarchy::Dh($h) => $e,
             AnyHierarchy::Sphere($h) => $e,
             AnyHierarchy::Aabb($h) => $e,
+        }
+    };
+}
+
+/// Applies `$e` to two hierarchies of the same kind (bound as `$a`, `$b`); a
+/// [`Error::MethodMismatch`] when the kinds differ.
+macro_rules! pairwise {
+    ($x:expr, $y:expr, $a:ident, $b:ident => $e:expr) => {
+        match ($x, $y) {
+            (AnyHierarchy::Dh($a), AnyHierarchy::Dh($b)) => Ok($e),
+            (AnyHierarchy::Sphere($a), AnyHierarchy::Sphere($b)) => Ok($e),
+            (AnyHierarchy::Aabb($a), AnyHierarchy::Aabb($b)) => Ok($e),
+            (a, b) => Err(Error::MethodMismatch {
+                a: a.method(),
+                b: b.method(),
+            }),
         }
     };
 }
@@ -84,15 +101,7 @@ impl AnyHierarchy {
         ws: &mut Workspace,
         par: Par,
     ) -> Result<Contacts> {
-        match (self, other) {
-            (Self::Dh(a), Self::Dh(b)) => Ok(collide_with(a, b, ws, par)),
-            (Self::Sphere(a), Self::Sphere(b)) => Ok(collide_with(a, b, ws, par)),
-            (Self::Aabb(a), Self::Aabb(b)) => Ok(collide_with(a, b, ws, par)),
-            (a, b) => Err(Error::MethodMismatch {
-                a: a.method(),
-                b: b.method(),
-            }),
-        }
+        pairwise!(self, other, a, b => collide_with(a, b, ws, par))
     }
 
     /// Self-contacts of this object (see [`self_collide`](crate::self_collide)).
@@ -108,14 +117,47 @@ impl AnyHierarchy {
         pairs: &[[u32; 2]],
     ) -> Result<Vec<crate::detail::Segment>> {
         use crate::detail::contact_segments;
-        match (self, other) {
-            (Self::Dh(a), Self::Dh(b)) => contact_segments(a, b, pairs),
-            (Self::Sphere(a), Self::Sphere(b)) => contact_segments(a, b, pairs),
-            (Self::Aabb(a), Self::Aabb(b)) => contact_segments(a, b, pairs),
-            (a, b) => Err(Error::MethodMismatch {
-                a: a.method(),
-                b: b.method(),
-            }),
-        }
+        pairwise!(self, other, a, b => contact_segments(a, b, pairs)?)
+    }
+
+    /// Marks every bounding volume stale (see [`Hierarchy::invalidate`]).
+    pub fn invalidate(&mut self) {
+        each!(self, h => h.invalidate())
+    }
+
+    /// Refits the stale nodes among `ids` (see [`Hierarchy::refit_nodes`]).
+    pub fn refit_nodes(&mut self, ids: &[u32], par: Par) {
+        each!(self, h => h.refit_nodes(ids, par))
+    }
+
+    /// The nodes fitted to the current positions (see [`Hierarchy::fitted_nodes`]).
+    pub fn fitted_nodes(&self) -> Vec<u32> {
+        each!(self, h => h.fitted_nodes())
+    }
+
+    /// The BV updates done since the last call (see [`Hierarchy::take_updates`]).
+    pub fn take_updates(&mut self) -> u64 {
+        each!(self, h => h.take_updates())
+    }
+
+    /// [`broad_phase`] between two hierarchies of the same kind; an error if the kinds differ.
+    pub fn broad_phase(
+        &mut self,
+        other: &mut AnyHierarchy,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<Counters> {
+        pairwise!(self, other, a, b => broad_phase(a, b, ws, par))
+    }
+
+    /// [`narrow_phase`] on leaf pairs of two hierarchies of the same kind; an error if the
+    /// kinds differ.
+    pub fn narrow_phase(
+        &self,
+        other: &AnyHierarchy,
+        leaves: &[[u32; 2]],
+        par: Par,
+    ) -> Result<Contacts> {
+        pairwise!(self, other, a, b => narrow_phase(a, b, leaves, par))
     }
 }

@@ -30,6 +30,7 @@ pub mod capi;
 pub mod counters;
 pub mod detail;
 pub mod error;
+pub mod experiment;
 pub mod hierarchy;
 pub mod io;
 pub mod mesh;

@@ -5,6 +5,7 @@ mod capi;
 mod cli;
 #[cfg(feature = "cli")]
 mod cli_collide;
+mod experiment;
 mod hierarchies;
 mod io;
 mod narrow;

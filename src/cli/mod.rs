@@ -1,6 +1,7 @@
 //! Command-line front end. Every failure is one line on stderr and a non-zero exit code.
 
 mod collide;
+mod experiment;
 mod scene;
 mod self_cmd;
 
@@ -26,21 +27,31 @@ enum Command {
     SelfCollide(self_cmd::SelfArgs),
     /// Contacts between every pair of several meshes.
     Scene(scene::SceneArgs),
+    /// The paper's experiment (eight deforming pawns) and the cost-model report.
+    Experiment(experiment::ExperimentArgs),
 }
 
 /// Parses the arguments, runs the command, returns the process exit code.
 pub fn run() -> i32 {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
+        // Usage errors: clap's first line only (one line on stderr, like every failure).
+        Err(e) if e.use_stderr() => {
+            let text = e.render().to_string();
+            let line = text.lines().next().unwrap_or("error: invalid arguments");
+            eprintln!("dhcd: {line}");
+            return 2;
+        }
         Err(e) => {
             let _ = e.print();
-            return if e.use_stderr() { 2 } else { 0 };
+            return 0;
         }
     };
     let result = match cli.command {
-        Command::Collide(args) => collide::run(args),
-        Command::SelfCollide(args) => self_cmd::run(args),
-        Command::Scene(args) => scene::run(args),
+        Command::Collide(args) => collide::run(args).map_err(|e| e.to_string()),
+        Command::SelfCollide(args) => self_cmd::run(args).map_err(|e| e.to_string()),
+        Command::Scene(args) => scene::run(args).map_err(|e| e.to_string()),
+        Command::Experiment(args) => experiment::run(args),
     };
     match result {
         Ok(()) => 0,

@@ -1,0 +1,566 @@
+//! The paper's experiment: deformable objects pushed into each other, simulated once, then
+//! every hierarchy kind processes the identical frames, with counted work, measured time, and
+//! the cost model `T = N_V*C_V + N_P*C_P + N_U*C_U` calibrated on this machine.
+//!
+//! Phases of [`run`]:
+//!
+//! 1. **Simulate** ([`Phase::Simulate`]): the scene ([`pawn_scene`] or [`scene_with_mesh`])
+//!    advances `frames - 1` times; each frame's contacts (all object pairs, DH hierarchies)
+//!    feed the next [`Simulation::step`]. All frames' positions are kept.
+//! 2. **Measure** ([`Phase::Measure`]): per step, per method, `update_positions` on every
+//!    object (update time), then every object pair (query time, the lazy refit happens
+//!    inside). Each step is replayed `timing_reps` times (a replay redoes the whole update and
+//!    refit) and the least time kept (the machine is shared: the least-disturbed replay); the
+//!    method order rotates per step so that no method always runs on caches warmed by
+//!    another. Contacts must be identical across methods (and equal
+//!    to the simulation's), else [`ExperimentError::ContactMismatch`].
+//! 3. **Calibrate** (module [`cost`]): `C_V`, `C_P`, `C_U` and the fixed position-copy cost
+//!    per method, from the real kernels on frames spread over the run, each calibrated right
+//!    after it is measured (same machine load).
+//!
+//! Results do not depend on the thread count (counters and contacts; times do).
+
+pub mod cost;
+#[cfg(feature = "cli")]
+pub mod output;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use crate::any::AnyHierarchy;
+use crate::bv::Method;
+use crate::counters::Counters;
+use crate::error::Error;
+use crate::hierarchy::Refit;
+use crate::mesh::Mesh;
+use crate::par::Par;
+use crate::sim::{pawn_scene, scene_with_mesh, ObjectContact, SimConfig, Simulation};
+use crate::traverse::Workspace;
+use crate::tree::{RegionTree, DEFAULT_LEVELS};
+
+pub use cost::{Constant, Costs, Spread};
+
+/// What can stop the experiment.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ExperimentError {
+    #[error(transparent)]
+    Dhcd(#[from] Error),
+    /// Two methods found different contacts on the same frames: impossible for exact
+    /// conservative hierarchies, so a bug in dhcd.
+    #[error(
+        "contacts differ at step {step}, objects {object_a}-{object_b}: {method_a} found {count_a} triangle pairs, {method_b} found {count_b}"
+    )]
+    ContactMismatch {
+        step: usize,
+        object_a: usize,
+        object_b: usize,
+        method_a: &'static str,
+        count_a: usize,
+        method_b: &'static str,
+        count_b: usize,
+    },
+}
+
+/// Parameters of [`run`].
+#[derive(Clone, Debug)]
+pub struct Config {
+    /// Time steps (frames) processed by every method; frame 0 is the initial scene.
+    pub frames: usize,
+    /// Levels of the region trees (the paper: 5).
+    pub levels: usize,
+    /// Methods to measure, in report order (no duplicates).
+    pub methods: Vec<Method>,
+    /// 1: sequential ([`Par::Seq`]); n > 1: [`Par::Rayon`]`(n)`.
+    pub threads: usize,
+    /// Seed of the scene (object turns, wobble phases).
+    pub seed: u64,
+    /// The object mesh (eight copies); `None`: the built-in pawn.
+    pub mesh: Option<Mesh>,
+    /// Simulator parameters (its `seed` is replaced by [`Config::seed`]).
+    pub sim: SimConfig,
+    /// Replays of every measured step; the least time is kept.
+    pub timing_reps: usize,
+    /// Calibration frames, spread evenly over the run.
+    pub calibration_frames: usize,
+    /// Repetitions of each calibration measurement.
+    pub calibration_reps: usize,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self {
+            frames: 100,
+            levels: DEFAULT_LEVELS,
+            methods: Method::ALL.to_vec(),
+            threads: 1,
+            seed: 1,
+            mesh: None,
+            sim: SimConfig::default(),
+            timing_reps: 5,
+            calibration_frames: 10,
+            calibration_reps: 7,
+        }
+    }
+}
+
+impl Config {
+    /// The parallelism of the queries.
+    pub fn par(&self) -> Par {
+        if self.threads <= 1 {
+            Par::Seq
+        } else {
+            Par::Rayon(self.threads)
+        }
+    }
+
+    fn check(&self) -> Result<(), Error> {
+        let bad = |m: String| Err(Error::InvalidOption(m));
+        if self.frames == 0 {
+            return bad("frames must be at least 1".into());
+        }
+        if self.threads == 0 {
+            return bad("threads must be at least 1".into());
+        }
+        if self.methods.is_empty() {
+            return bad("at least one method is needed".into());
+        }
+        for (k, m) in self.methods.iter().enumerate() {
+            if self.methods[..k].contains(m) {
+                return bad(format!("method {m} is listed twice"));
+            }
+        }
+        if self.timing_reps == 0 || self.calibration_reps == 0 || self.calibration_frames == 0 {
+            return bad("repetition counts must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// The phases of [`run`], for progress reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Simulate,
+    /// Measurement, with the calibration interleaved.
+    Measure,
+}
+
+impl Phase {
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Simulate => "simulate",
+            Phase::Measure => "measure",
+        }
+    }
+}
+
+/// The scene as run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneInfo {
+    /// `"pawn"` or the user mesh's description.
+    pub mesh: String,
+    pub objects: usize,
+    /// Triangles of all objects.
+    pub triangles: usize,
+    /// Vertices of all objects.
+    pub vertices: usize,
+    pub triangles_per_object: usize,
+    pub vertices_per_object: usize,
+    /// Nodes of one object's region tree (the same for the three kinds).
+    pub nodes_per_hierarchy: usize,
+    pub frames: usize,
+    pub levels: usize,
+    pub threads: usize,
+    pub seed: u64,
+    /// Object pairs queried per step.
+    pub object_pairs: usize,
+}
+
+/// One step of one method.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Step {
+    /// `N_V`, `N_P`, `N_U`, contacts, summed over all object pairs.
+    pub counters: Counters,
+    /// `update_positions` of every object (least over replays).
+    pub update_ns: f64,
+    /// All object-pair queries, lazy refit included (least over replays).
+    pub query_ns: f64,
+    /// Cost model `N_V*C_V + N_P*C_P + N_U*C_U` (calibrated constants).
+    pub predicted_ns: f64,
+}
+
+impl Step {
+    /// Measured step time: update + query.
+    pub fn time_ns(&self) -> f64 {
+        self.update_ns + self.query_ns
+    }
+}
+
+/// Everything measured for one method.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MethodReport {
+    pub method: Method,
+    pub bytes_per_node: usize,
+    /// Node records of one object's hierarchy.
+    pub bytes_per_hierarchy: usize,
+    /// Node records of all objects' hierarchies.
+    pub bytes_all_hierarchies: usize,
+    pub costs: Costs,
+    pub steps: Vec<Step>,
+}
+
+impl MethodReport {
+    pub fn totals(&self) -> Counters {
+        self.steps.iter().map(|s| s.counters).sum()
+    }
+    pub fn total_time_ns(&self) -> f64 {
+        self.steps.iter().map(Step::time_ns).sum()
+    }
+    pub fn total_update_ns(&self) -> f64 {
+        self.steps.iter().map(|s| s.update_ns).sum()
+    }
+    pub fn total_query_ns(&self) -> f64 {
+        self.steps.iter().map(|s| s.query_ns).sum()
+    }
+    /// Sum of the three-term model over all steps.
+    pub fn total_predicted_ns(&self) -> f64 {
+        self.steps.iter().map(|s| s.predicted_ns).sum()
+    }
+    /// The fixed cost of one step (calibrated position copy of every object), not in the
+    /// paper's model.
+    pub fn fixed_ns(&self) -> f64 {
+        self.costs.fixed_ns.value
+    }
+    /// Model plus the fixed term, summed over all steps.
+    pub fn total_predicted_with_fixed_ns(&self) -> f64 {
+        self.total_predicted_ns() + self.fixed_ns() * self.steps.len() as f64
+    }
+    /// `(predicted - measured) / measured` over the whole run, three-term model vs update + query.
+    pub fn model_error(&self) -> f64 {
+        rel_err(self.total_predicted_ns(), self.total_time_ns())
+    }
+    /// Same, with the fixed term added to the prediction.
+    pub fn model_with_fixed_error(&self) -> f64 {
+        rel_err(self.total_predicted_with_fixed_ns(), self.total_time_ns())
+    }
+    /// Three-term model vs query time alone (where the lazy refit happens).
+    pub fn model_vs_query_error(&self) -> f64 {
+        rel_err(self.total_predicted_ns(), self.total_query_ns())
+    }
+}
+
+/// Relative error `(predicted - measured) / measured` (0 when nothing was measured).
+pub fn rel_err(predicted: f64, measured: f64) -> f64 {
+    if measured > 0.0 {
+        (predicted - measured) / measured
+    } else {
+        0.0
+    }
+}
+
+/// The scene at one step, for the picture (the paper's Figure 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    pub step: usize,
+    pub positions: Vec<Vec<[f32; 3]>>,
+    pub triangles: Vec<Vec<[u32; 3]>>,
+    /// Per object, the triangles in contact with another object (sorted, unique).
+    pub contact_triangles: Vec<Vec<u32>>,
+}
+
+/// The result of [`run`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    pub scene: SceneInfo,
+    pub methods: Vec<MethodReport>,
+    /// The step with the most contacts (the first one if there are none).
+    pub snapshot: Snapshot,
+    /// Wall time of the phases (seconds; calibration is interleaved with measurement).
+    pub simulate_s: f64,
+    pub measure_s: f64,
+    pub calibrate_s: f64,
+}
+
+impl Report {
+    pub fn method(&self, m: Method) -> Option<&MethodReport> {
+        self.methods.iter().find(|r| r.method == m)
+    }
+}
+
+/// Frames simulated once: positions per frame per object, and each frame's contacts per
+/// object pair (DH).
+struct Frames {
+    positions: Vec<Vec<Vec<[f32; 3]>>>,
+    contacts: Vec<Vec<Vec<[u32; 2]>>>,
+}
+
+/// The object pairs `(i, j)`, `i < j`, in order.
+fn object_pairs(n: usize) -> Vec<(usize, usize)> {
+    (0..n)
+        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+        .collect()
+}
+
+/// Two distinct elements of a slice, mutably.
+pub(crate) fn two_mut<T>(v: &mut [T], i: usize, j: usize) -> (&mut T, &mut T) {
+    assert!(i < j);
+    let (lo, hi) = v.split_at_mut(j);
+    (&mut lo[i], &mut hi[0])
+}
+
+/// Runs the experiment; `progress(phase, done, total)` is called as work completes.
+pub fn run(
+    config: &Config,
+    progress: &mut dyn FnMut(Phase, usize, usize),
+) -> Result<Report, ExperimentError> {
+    config.check()?;
+    let sim_config = SimConfig {
+        seed: config.seed,
+        ..config.sim.clone()
+    };
+    let (mesh_name, sim) = match &config.mesh {
+        Some(m) => (
+            format!(
+                "user mesh ({} triangles, {} vertices)",
+                m.triangle_count(),
+                m.vertex_count()
+            ),
+            scene_with_mesh(m.clone(), &sim_config)?,
+        ),
+        None => ("pawn".to_string(), pawn_scene(&sim_config)?),
+    };
+    let n = sim.object_count();
+    let meshes: Vec<Mesh> = (0..n)
+        .map(|o| Mesh::new(sim.positions(o).to_vec(), sim.triangles(o).to_vec()))
+        .collect::<Result<_, _>>()?;
+    let trees: Vec<Arc<RegionTree>> = meshes
+        .iter()
+        .map(|m| RegionTree::build(m, config.levels).map(Arc::new))
+        .collect::<Result<_, _>>()?;
+    let pairs = object_pairs(n);
+
+    let t = Instant::now();
+    let frames = simulate(sim, &meshes, &trees, &pairs, config, progress)?;
+    let simulate_s = t.elapsed().as_secs_f64();
+
+    let mut hierarchies: Vec<Vec<AnyHierarchy>> = config
+        .methods
+        .iter()
+        .map(|&m| {
+            meshes
+                .iter()
+                .zip(&trees)
+                .map(|(mesh, tree)| AnyHierarchy::with_tree(m, Arc::clone(tree), mesh, Refit::Lazy))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .collect::<Result<_, _>>()?;
+
+    let t = Instant::now();
+    let calib_frames = cost::calibration_frames(config.frames, config.calibration_frames);
+    let (steps, samples, calibrate_s) = measure(
+        &mut hierarchies,
+        &frames,
+        &pairs,
+        &calib_frames,
+        config,
+        progress,
+    )?;
+    let measure_s = t.elapsed().as_secs_f64() - calibrate_s;
+
+    let mut methods = Vec::with_capacity(config.methods.len());
+    for (k, ((hs, mut steps), samples)) in hierarchies.iter().zip(steps).zip(samples).enumerate() {
+        let costs = cost::combine(&samples);
+        for s in &mut steps {
+            s.predicted_ns = costs.predict(&s.counters);
+        }
+        methods.push(MethodReport {
+            method: config.methods[k],
+            bytes_per_node: hs[0].bytes_per_node(),
+            bytes_per_hierarchy: hs[0].bv_bytes(),
+            bytes_all_hierarchies: hs.iter().map(AnyHierarchy::bv_bytes).sum(),
+            costs,
+            steps,
+        });
+    }
+
+    let snapshot = snapshot(&frames, &meshes, &pairs);
+    let scene = SceneInfo {
+        mesh: mesh_name,
+        objects: n,
+        triangles: meshes.iter().map(Mesh::triangle_count).sum(),
+        vertices: meshes.iter().map(Mesh::vertex_count).sum(),
+        triangles_per_object: meshes[0].triangle_count(),
+        vertices_per_object: meshes[0].vertex_count(),
+        nodes_per_hierarchy: trees[0].node_count(),
+        frames: config.frames,
+        levels: config.levels,
+        threads: config.threads,
+        seed: config.seed,
+        object_pairs: pairs.len(),
+    };
+    Ok(Report {
+        scene,
+        methods,
+        snapshot,
+        simulate_s,
+        measure_s,
+        calibrate_s,
+    })
+}
+
+/// Phase 1: the frames, with DH contacts feeding the simulation.
+fn simulate(
+    mut sim: Simulation,
+    meshes: &[Mesh],
+    trees: &[Arc<RegionTree>],
+    pairs: &[(usize, usize)],
+    config: &Config,
+    progress: &mut dyn FnMut(Phase, usize, usize),
+) -> Result<Frames, ExperimentError> {
+    let par = config.par();
+    let mut dh: Vec<AnyHierarchy> = meshes
+        .iter()
+        .zip(trees)
+        .map(|(m, t)| AnyHierarchy::with_tree(Method::Dh, Arc::clone(t), m, Refit::Lazy))
+        .collect::<Result<_, _>>()?;
+    let mut ws = Workspace::default();
+    let mut frames = Frames {
+        positions: Vec::with_capacity(config.frames),
+        contacts: Vec::with_capacity(config.frames),
+    };
+    for f in 0..config.frames {
+        progress(Phase::Simulate, f, config.frames);
+        let positions: Vec<Vec<[f32; 3]>> =
+            (0..dh.len()).map(|o| sim.positions(o).to_vec()).collect();
+        for (h, p) in dh.iter_mut().zip(&positions) {
+            h.update_positions(p)?;
+        }
+        let mut per_pair = Vec::with_capacity(pairs.len());
+        let mut contacts = Vec::new();
+        for &(i, j) in pairs {
+            let (a, b) = two_mut(&mut dh, i, j);
+            let c = a.collide(b, &mut ws, par)?;
+            contacts.extend(c.pairs.iter().map(|&[ta, tb]| ObjectContact {
+                object_a: i as u32,
+                triangle_a: ta,
+                object_b: j as u32,
+                triangle_b: tb,
+            }));
+            per_pair.push(c.pairs);
+        }
+        frames.positions.push(positions);
+        frames.contacts.push(per_pair);
+        if f + 1 < config.frames {
+            sim.step(&contacts);
+        }
+    }
+    progress(Phase::Simulate, config.frames, config.frames);
+    Ok(frames)
+}
+
+/// Per method: the measured steps (prediction still 0) and the calibration samples; and
+/// the seconds spent calibrating.
+type Measured = (Vec<Vec<Step>>, Vec<Vec<cost::FrameSamples>>, f64);
+
+/// Phase 2: every method on every frame, calibrating at the calibration frames.
+fn measure(
+    hierarchies: &mut [Vec<AnyHierarchy>],
+    frames: &Frames,
+    pairs: &[(usize, usize)],
+    calib_frames: &[usize],
+    config: &Config,
+    progress: &mut dyn FnMut(Phase, usize, usize),
+) -> Result<Measured, ExperimentError> {
+    let par = config.par();
+    let methods = &config.methods;
+    let mut ws = Workspace::default();
+    let mut steps: Vec<Vec<Step>> = vec![Vec::with_capacity(config.frames); methods.len()];
+    let mut samples: Vec<Vec<cost::FrameSamples>> = vec![Vec::new(); methods.len()];
+    let mut calibrate_s = 0.0;
+    let mut update_t = vec![0.0; config.timing_reps];
+    let mut query_t = vec![0.0; config.timing_reps];
+    for (s, positions) in frames.positions.iter().enumerate() {
+        progress(Phase::Measure, s, config.frames);
+        for r in 0..methods.len() {
+            let k = (r + s) % methods.len();
+            let hs = &mut hierarchies[k];
+            let mut counters = Counters::default();
+            for rep in 0..config.timing_reps {
+                let t0 = Instant::now();
+                for (h, p) in hs.iter_mut().zip(positions) {
+                    h.update_positions(p)?;
+                }
+                let t1 = Instant::now();
+                let mut sum = Counters::default();
+                for (q, &(i, j)) in pairs.iter().enumerate() {
+                    let (a, b) = two_mut(hs, i, j);
+                    let c = a.collide(b, &mut ws, par)?;
+                    sum += c.counters;
+                    if rep == 0 && c.pairs != frames.contacts[s][q] {
+                        return Err(ExperimentError::ContactMismatch {
+                            step: s,
+                            object_a: i,
+                            object_b: j,
+                            method_a: Method::Dh.name(),
+                            count_a: frames.contacts[s][q].len(),
+                            method_b: methods[k].name(),
+                            count_b: c.pairs.len(),
+                        });
+                    }
+                }
+                let t2 = Instant::now();
+                update_t[rep] = (t1 - t0).as_nanos() as f64;
+                query_t[rep] = (t2 - t1).as_nanos() as f64;
+                debug_assert!(
+                    rep == 0 || sum == counters,
+                    "replayed step counted differently"
+                );
+                counters = sum;
+            }
+            steps[k].push(Step {
+                counters,
+                update_ns: cost::least(&update_t),
+                query_ns: cost::least(&query_t),
+                predicted_ns: 0.0,
+            });
+            if calib_frames.contains(&s) {
+                let t = Instant::now();
+                samples[k].push(cost::calibrate_frame(
+                    hs,
+                    positions,
+                    s,
+                    pairs,
+                    config.calibration_reps,
+                    par,
+                )?);
+                calibrate_s += t.elapsed().as_secs_f64();
+            }
+        }
+    }
+    progress(Phase::Measure, config.frames, config.frames);
+    Ok((steps, samples, calibrate_s))
+}
+
+/// The step with the most contacts, with its contact triangles per object.
+fn snapshot(frames: &Frames, meshes: &[Mesh], pairs: &[(usize, usize)]) -> Snapshot {
+    let count = |s: usize| frames.contacts[s].iter().map(Vec::len).sum::<usize>();
+    let step = (0..frames.positions.len())
+        .max_by_key(|&s| (count(s), std::cmp::Reverse(s)))
+        .unwrap_or(0);
+    let mut contact_triangles = vec![Vec::new(); meshes.len()];
+    for (q, &(i, j)) in pairs.iter().enumerate() {
+        for &[ta, tb] in &frames.contacts[step][q] {
+            contact_triangles[i].push(ta);
+            contact_triangles[j].push(tb);
+        }
+    }
+    for c in &mut contact_triangles {
+        c.sort_unstable();
+        c.dedup();
+    }
+    Snapshot {
+        step,
+        positions: frames.positions[step].clone(),
+        triangles: meshes.iter().map(|m| m.triangles().to_vec()).collect(),
+        contact_triangles,
+    }
+}

@@ -1,0 +1,216 @@
+//! `dhcd::experiment` and `dhcd experiment`: schema of the report, determinism (seed and
+//! thread count), the command line and its files, bad flags.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use dhcd::experiment::{output, run, Config, Report};
+use dhcd::sim::{pawn_mesh_with, PAWN_HEIGHT};
+use dhcd::Counters;
+
+/// A coarse pawn scene run long enough for the pawns to touch, with minimal timing work.
+fn small(frames: usize, threads: usize) -> Config {
+    Config {
+        frames,
+        threads,
+        mesh: Some(pawn_mesh_with(10, 24, PAWN_HEIGHT).unwrap()),
+        timing_reps: 1,
+        calibration_frames: 3,
+        calibration_reps: 2,
+        ..Config::default()
+    }
+}
+
+fn quiet(config: &Config) -> Report {
+    run(config, &mut |_, _, _| {}).unwrap()
+}
+
+fn counters(r: &Report) -> Vec<Vec<Counters>> {
+    r.methods
+        .iter()
+        .map(|m| m.steps.iter().map(|s| s.counters).collect())
+        .collect()
+}
+
+#[test]
+fn report_schema_and_contacts_agree() {
+    let frames = 30;
+    let report = quiet(&small(frames, 1));
+    let json = output::to_json(&report);
+    for key in [
+        "objects",
+        "triangles",
+        "vertices",
+        "frames",
+        "levels",
+        "threads",
+        "seed",
+    ] {
+        assert!(json["scene"][key].is_number(), "scene.{key}");
+    }
+    assert_eq!(json["scene"]["frames"], frames);
+    assert_eq!(json["scene"]["objects"], 8);
+    let methods = json["methods"].as_object().unwrap();
+    assert_eq!(
+        methods.keys().collect::<Vec<_>>(),
+        ["dh", "sphere", "aabb"],
+        "methods in order"
+    );
+    for (name, m) in methods {
+        for key in [
+            "bytes_per_node",
+            "bytes_per_hierarchy",
+            "total_time_ns",
+            "total_predicted_ns",
+        ] {
+            assert!(m[key].is_number(), "{name}.{key}");
+        }
+        for key in ["c_v_ns", "c_p_ns", "c_u_ns"] {
+            assert!(
+                m["costs"][key].as_f64().unwrap() >= 0.0,
+                "{name}.costs.{key}"
+            );
+            assert!(m["costs"][key.replace("_ns", "_spread")].is_object());
+        }
+        assert!(m["total_predicted_ns"].as_f64().unwrap() > 0.0, "{name}");
+        assert!(m["total_time_ns"].as_f64().unwrap() > 0.0, "{name}");
+        let steps = m["steps"].as_array().unwrap();
+        assert_eq!(steps.len(), frames, "{name}");
+        for s in steps {
+            for key in [
+                "bv_tests",
+                "prim_tests",
+                "bv_updates",
+                "contacts",
+                "time_ns",
+                "predicted_ns",
+            ] {
+                assert!(s[key].is_number(), "{name}.steps[].{key}");
+            }
+        }
+    }
+    assert_eq!(methods["dh"]["bytes_per_node"], 8);
+    assert_eq!(methods["sphere"]["bytes_per_node"], 16);
+    assert_eq!(methods["aabb"]["bytes_per_node"], 24);
+    // Contacts per step are identical across methods, and the pawns do touch.
+    let per_method: Vec<Vec<u64>> = report
+        .methods
+        .iter()
+        .map(|m| m.steps.iter().map(|s| s.counters.contacts).collect())
+        .collect();
+    assert_eq!(per_method[0], per_method[1]);
+    assert_eq!(per_method[0], per_method[2]);
+    assert!(per_method[0].iter().sum::<u64>() > 0, "no contacts at all");
+    // Markdown and figures render.
+    assert!(output::markdown(&report).contains("| DH |"));
+    let figures = output::figures(&report);
+    assert_eq!(figures.len(), 6);
+    assert!(figures.iter().all(|(_, svg)| svg.starts_with("<svg")));
+}
+
+#[test]
+fn deterministic_for_seed_and_thread_count() {
+    let a = quiet(&small(16, 1));
+    let b = quiet(&small(16, 1));
+    let c = quiet(&small(16, 2));
+    assert_eq!(counters(&a), counters(&b));
+    assert_eq!(counters(&a), counters(&c));
+    assert_eq!(a.snapshot, c.snapshot);
+    let other_seed = quiet(&Config {
+        seed: 7,
+        ..small(16, 1)
+    });
+    assert_eq!(other_seed.scene.seed, 7);
+}
+
+#[test]
+fn bad_configs_are_errors() {
+    for config in [
+        Config {
+            frames: 0,
+            ..small(1, 1)
+        },
+        Config {
+            threads: 0,
+            ..small(1, 1)
+        },
+        Config {
+            methods: vec![],
+            ..small(1, 1)
+        },
+        Config {
+            methods: vec![dhcd::Method::Dh, dhcd::Method::Dh],
+            ..small(1, 1)
+        },
+        Config {
+            levels: 0,
+            ..small(1, 1)
+        },
+    ] {
+        assert!(run(&config, &mut |_, _, _| {}).is_err(), "{config:?}");
+    }
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("dhcd-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn dhcd(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_dhcd"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn cli_writes_every_file() {
+    let dir = temp_dir("cli");
+    let out = dhcd(&[
+        "experiment",
+        "--frames",
+        "3",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in output::FILES {
+        let meta = std::fs::metadata(dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        assert!(meta.len() > 0, "{f} is empty");
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("dh") && stdout.contains("aabb"), "{stdout}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["methods"]["dh"]["steps"].as_array().unwrap().len(), 3);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn cli_bad_flags_fail_cleanly() {
+    let dir = temp_dir("bad");
+    let missing = dir.join("missing.obj");
+    for args in [
+        vec!["experiment", "--frames", "0"],
+        vec!["experiment", "--frames", "many"],
+        vec!["experiment", "--methods", "dh,octree"],
+        vec!["experiment", "--threads", "0"],
+        vec!["experiment", "--levels", "0", "--frames", "1"],
+        vec!["experiment", "--mesh", missing.to_str().unwrap()],
+        vec!["experiment", "--bogus"],
+    ] {
+        let out = dhcd(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(stderr.starts_with("dhcd: error:"), "{args:?}: {stderr}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+}
