@@ -2,6 +2,7 @@
 
 mod collide;
 mod experiment;
+mod query;
 mod scene;
 mod self_cmd;
 

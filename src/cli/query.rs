@@ -1,0 +1,75 @@
+//! What `collide`, `self` and `scene` share: the hierarchy flags and the contact report
+//! (one JSON object with `--json`, otherwise a summary line and one contact per line).
+
+use dhcd::{Counters, Method, Options};
+use serde_json::json;
+
+#[derive(clap::Args, Debug)]
+pub struct QueryArgs {
+    /// Bounding-volume hierarchy: dh, sphere or aabb.
+    #[arg(long, default_value = "dh")]
+    pub method: Method,
+    /// Levels of the region tree (root = level 0).
+    #[arg(long, default_value_t = dhcd::tree::DEFAULT_LEVELS)]
+    pub levels: usize,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl QueryArgs {
+    pub fn options(&self) -> Options {
+        Options {
+            levels: self.levels,
+            ..Options::default()
+        }
+    }
+
+    /// Prints the contacts (`rows`, each a contact's indices) and counters. `what` names
+    /// the contacts in the text summary, e.g. "contacts" or "self-contacts".
+    pub fn report<const N: usize, T: Copy + Into<u64>>(
+        &self,
+        what: &str,
+        rows: &[[T; N]],
+        counters: Counters,
+    ) {
+        let rows: Vec<[u64; N]> = rows.iter().map(|r| r.map(Into::into)).collect();
+        if self.json {
+            println!("{}", self.json_value(&rows, counters));
+            return;
+        }
+        println!(
+            "{} {what} ({} levels, {} bytes per node): {} BV pairs tested, {} triangle pairs tested, {} BV updates",
+            rows.len(),
+            self.levels,
+            self.method.bytes_per_node(),
+            counters.bv_tests,
+            counters.prim_tests,
+            counters.bv_updates
+        );
+        for row in &rows {
+            let line: Vec<String> = row.iter().map(u64::to_string).collect();
+            println!("{}", line.join(" "));
+        }
+    }
+
+    /// `{"method", "levels", "bytes_per_node", "pairs", "counters"}`, keys in this order.
+    fn json_value<const N: usize>(
+        &self,
+        rows: &[[u64; N]],
+        counters: Counters,
+    ) -> serde_json::Value {
+        json!({
+            "method": self.method.name(),
+            "levels": self.levels,
+            "bytes_per_node": self.method.bytes_per_node(),
+            "pairs": rows.iter().map(|r| r.to_vec()).collect::<Vec<_>>(),
+            "counters": {
+                "bv_tests": counters.bv_tests,
+                "prim_tests": counters.prim_tests,
+                "bv_updates": counters.bv_updates,
+                "contacts": counters.contacts,
+            },
+        })
+    }
+}
