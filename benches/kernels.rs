@@ -138,7 +138,7 @@ fn overlap_benches(c: &mut Criterion) {
         c,
         "aabb_pairs",
         &|ia, ib, out| overlap::aabb_pairs_scalar(a.aabb(), b.aabb(), ia, ib, out),
-        &|ia, ib, out| overlap::aabb_pairs(a.aabb(), b.aabb(), ia, ib, out),
+        &|ia, ib, out| overlap::aabb_pairs_vectorized(a.aabb(), b.aabb(), ia, ib, out),
     );
     bench_pairs(
         c,

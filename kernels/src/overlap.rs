@@ -428,7 +428,24 @@ pub fn aabb_pairs_scalar(a: AabbSoa, b: AabbSoa, ia: &[u32], ib: &[u32], out: &m
 }
 
 /// Box-box overlap: six interval comparisons per pair.
+///
+/// PERF: runs the scalar body. The test is gather-bound (12 indexed loads per pair) and the
+/// scalar version stops at the first separating axis, so it beats the lane-wise SIMD body
+/// (`aabb_pairs_with`) by 2.3-2.5x on this machine (`cargo bench --bench kernels --
+/// aabb_pairs`, docs/PERFORMANCE.md). The results are identical.
 pub fn aabb_pairs(a: AabbSoa, b: AabbSoa, ia: &[u32], ib: &[u32], out: &mut [u32]) -> usize {
+    aabb_pairs_scalar(a, b, ia, ib, out)
+}
+
+/// The runtime-dispatched SIMD body of [`aabb_pairs`] (kept for benchmarks and for machines
+/// where gathers are cheap; same results).
+pub fn aabb_pairs_vectorized(
+    a: AabbSoa,
+    b: AabbSoa,
+    ia: &[u32],
+    ib: &[u32],
+    out: &mut [u32],
+) -> usize {
     crate::arch().dispatch(AabbPairs { a, b, ia, ib, out })
 }
 

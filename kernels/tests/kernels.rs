@@ -386,6 +386,13 @@ fn dispatched_overlap_entries_match_reference() {
             ),
             (hw, &want)
         );
+        assert_eq!(
+            (
+                overlap::aabb_pairs_vectorized(ba.soa(), bb.soa(), &ia, &ib, &mut got),
+                &got
+            ),
+            (hw, &want)
+        );
         let ht = narrow::tri_aabb_overlap_pairs(ba.soa(), bb.soa(), &ia, &ib, &mut got);
         assert_eq!((ht, &got), (hw, &want));
         let bn = Boxes::random(&mut rng, n, 5);
