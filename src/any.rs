@@ -126,7 +126,7 @@ impl AnyHierarchy {
     }
 
     /// Refits the stale nodes among `ids` (see [`Hierarchy::refit_nodes`]).
-    pub fn refit_nodes(&mut self, ids: &[u32], par: Par) {
+    pub fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<()> {
         each!(self, h => h.refit_nodes(ids, par))
     }
 
@@ -158,6 +158,6 @@ impl AnyHierarchy {
         leaves: &[[u32; 2]],
         par: Par,
     ) -> Result<Contacts> {
-        pairwise!(self, other, a, b => narrow_phase(a, b, leaves, par))
+        pairwise!(self, other, a, b => narrow_phase(a, b, leaves, par)?)
     }
 }

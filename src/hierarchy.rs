@@ -187,10 +187,18 @@ impl<K: BvKind> Hierarchy<K> {
     }
 
     /// Refits exactly the stale nodes among `ids` (each once), as the lazy traversal does,
-    /// counting them as updates.
-    pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) {
+    /// counting them as updates. A node id out of range is an [`Error::InvalidOption`] and
+    /// nothing is refitted.
+    pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) -> Result<()> {
+        if let Some(&n) = ids.iter().find(|&&n| n as usize >= self.node_count()) {
+            return Err(Error::InvalidOption(format!(
+                "refit_nodes: node {n} out of range (the hierarchy has {} nodes)",
+                self.node_count()
+            )));
+        }
         let mut stale = Vec::new();
         par.install(|| self.ensure_fitted(ids, par.is_parallel(), &mut stale));
+        Ok(())
     }
 
     /// The nodes fitted to the current positions (after a lazy query: the nodes it refitted

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use crate::bv::BvKind;
 use crate::counters::Counters;
+use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::narrow;
 use crate::par::Par;
@@ -120,13 +121,24 @@ pub fn broad_phase<K: BvKind>(
 
 /// The narrow phase alone: exact tests of every triangle pair of the given leaf pairs (node
 /// ids, as left in a [`Workspace`] by [`broad_phase`]). Counts `prim_tests` and `contacts`.
+/// A pair naming a node that is not a leaf of its hierarchy is an [`Error::InvalidOption`].
 pub fn narrow_phase<K: BvKind>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
     leaves: &[[u32; 2]],
     par: Par,
-) -> Contacts {
-    par.install(|| narrow(a, b, leaves, DEFAULT_GRAIN, par.is_parallel()))
+) -> Result<Contacts> {
+    for &[la, lb] in leaves {
+        for (h, n) in [(a, la), (b, lb)] {
+            if n as usize >= h.node_count() || !h.tree().is_leaf(n as usize) {
+                return Err(Error::InvalidOption(format!(
+                    "narrow_phase: node {n} is not a leaf (the hierarchy has {} nodes)",
+                    h.node_count()
+                )));
+            }
+        }
+    }
+    Ok(par.install(|| narrow(a, b, leaves, DEFAULT_GRAIN, par.is_parallel())))
 }
 
 impl Workspace {

@@ -479,7 +479,7 @@ fn broad_then_narrow_phase_equals_collide() {
     let whole = collide(&mut ha.clone(), &mut hb.clone());
     let mut ws = dhcd::Workspace::default();
     let broad = dhcd::broad_phase(&mut ha, &mut hb, &mut ws, dhcd::Par::Seq);
-    let narrow = dhcd::narrow_phase(&ha, &hb, ws.leaf_pairs(), dhcd::Par::Rayon(2));
+    let narrow = dhcd::narrow_phase(&ha, &hb, ws.leaf_pairs(), dhcd::Par::Rayon(2)).unwrap();
     assert_eq!(narrow.pairs, whole.pairs);
     assert_eq!(broad.bv_tests, whole.counters.bv_tests);
     assert_eq!(broad.bv_updates, whole.counters.bv_updates);
@@ -493,9 +493,20 @@ fn broad_then_narrow_phase_equals_collide() {
     );
     ha.invalidate();
     assert_eq!(ha.validate().unwrap(), 0);
-    ha.refit_nodes(&fitted, dhcd::Par::Rayon(2));
+    ha.refit_nodes(&fitted, dhcd::Par::Rayon(2)).unwrap();
     assert_eq!(ha.take_updates(), fitted.len() as u64);
     assert_eq!(ha.validate().unwrap(), fitted.len());
+    // Node ids from elsewhere are errors, not panics.
+    let n = ha.node_count() as u32;
+    assert!(matches!(
+        ha.refit_nodes(&[0, n], dhcd::Par::Seq),
+        Err(Error::InvalidOption(_))
+    ));
+    assert!(dhcd::narrow_phase(&ha, &hb, &[[n, 0]], dhcd::Par::Seq).is_err());
+    assert!(
+        dhcd::narrow_phase(&ha, &hb, &[[0, 0]], dhcd::Par::Seq).is_err(),
+        "root is no leaf"
+    );
 }
 
 fn scaled(mesh: &Mesh, s: f32, offset: [f32; 3]) -> Mesh {

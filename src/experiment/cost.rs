@@ -189,7 +189,7 @@ pub(super) fn calibrate_frame(
         let t = Instant::now();
         for (h, ids) in hs.iter_mut().zip(&fitted) {
             h.invalidate();
-            h.refit_nodes(ids, par);
+            h.refit_nodes(ids, par)?;
         }
         let tu = t.elapsed().as_nanos() as f64;
         let nu: u64 = hs.iter_mut().map(AnyHierarchy::take_updates).sum();
