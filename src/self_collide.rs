@@ -15,14 +15,13 @@
 //! concatenated in chunk order; contacts are sorted. Contacts and counters are identical for
 //! every thread count.
 
-use rayon::prelude::*;
 
 use crate::bv::BvKind;
 use crate::counters::Counters;
 use crate::hierarchy::Hierarchy;
 use crate::narrow;
 use crate::par::Par;
-use crate::traverse::{corners, test_and_expand, Contacts, Workspace};
+use crate::traverse::{corners, exact_tests, test_and_expand, Contacts, Workspace};
 use crate::tree::RegionTree;
 
 /// Every pair of intersecting triangles of one object, `[ti, tj]` with `ti < tj` (the
@@ -104,33 +103,15 @@ fn run<K: BvKind>(h: &mut Hierarchy<K>, ws: &mut Workspace, parallel: bool) -> C
     counters.bv_updates = h.take_updates();
 
     let hh = &*h;
-    let leaf_grain = (grain / 64).max(1);
-    let mut pairs = Vec::new();
-    if parallel && ws.leaves.len() > leaf_grain {
-        let parts: Vec<(Vec<[u32; 2]>, u64)> = ws
-            .leaves
-            .par_chunks(leaf_grain)
-            .map(|chunk| {
-                let mut out = Vec::new();
-                let tested = chunk
-                    .iter()
-                    .map(|&[x, y]| narrow_self_leaves(hh, x as usize, y as usize, &mut out))
-                    .sum::<u64>();
-                (out, tested)
-            })
-            .collect();
-        for (out, tested) in parts {
-            pairs.extend_from_slice(&out);
-            counters.prim_tests += tested;
-        }
-    } else {
-        for &[x, y] in &ws.leaves {
-            counters.prim_tests += narrow_self_leaves(hh, x as usize, y as usize, &mut pairs);
-        }
+    let exact = exact_tests(&ws.leaves, grain, parallel, |x, y, out| {
+        narrow_self_leaves(hh, x, y, out)
+    });
+    counters.prim_tests = exact.counters.prim_tests;
+    counters.contacts = exact.counters.contacts;
+    Contacts {
+        pairs: exact.pairs,
+        counters,
     }
-    pairs.sort_unstable();
-    counters.contacts = pairs.len() as u64;
-    Contacts { pairs, counters }
 }
 
 #[inline]

@@ -241,6 +241,21 @@ fn narrow<K: BvKind>(
     grain: usize,
     parallel: bool,
 ) -> Contacts {
+    exact_tests(leaves, grain, parallel, |la, lb, out| {
+        narrow_leaf_pair(a, b, la, lb, out)
+    })
+}
+
+/// Runs `test_pair(x, y, out)` (which pushes contacts and returns the triangle pairs it
+/// tested) on every leaf pair, in chunks of `grain / 64` leaf pairs when parallel, with
+/// outputs concatenated in chunk order; returns the sorted contacts and `prim_tests` /
+/// `contacts`. Shared by the two-object query and self-collision.
+pub(crate) fn exact_tests(
+    leaves: &[[u32; 2]],
+    grain: usize,
+    parallel: bool,
+    test_pair: impl Fn(usize, usize, &mut Vec<[u32; 2]>) -> u64 + Sync,
+) -> Contacts {
     let mut counters = Counters::default();
     let leaf_grain = (grain / 64).max(1);
     let mut pairs = Vec::new();
@@ -251,7 +266,7 @@ fn narrow<K: BvKind>(
                 let mut out = Vec::new();
                 let tested = chunk
                     .iter()
-                    .map(|&[la, lb]| narrow_leaf_pair(a, b, la as usize, lb as usize, &mut out))
+                    .map(|&[x, y]| test_pair(x as usize, y as usize, &mut out))
                     .sum::<u64>();
                 (out, tested)
             })
@@ -261,8 +276,8 @@ fn narrow<K: BvKind>(
             counters.prim_tests += tested;
         }
     } else {
-        for &[la, lb] in leaves {
-            counters.prim_tests += narrow_leaf_pair(a, b, la as usize, lb as usize, &mut pairs);
+        for &[x, y] in leaves {
+            counters.prim_tests += test_pair(x as usize, y as usize, &mut pairs);
         }
     }
     pairs.sort_unstable();
