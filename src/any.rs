@@ -104,7 +104,7 @@ impl AnyHierarchy {
         pairwise!(self, other, a, b => collide_with(a, b, ws, par))
     }
 
-    /// Self-contacts of this object (see [`self_collide`](crate::self_collide)).
+    /// Self-contacts of this object (see [`self_collide`](crate::self_collide())).
     pub fn self_collide(&mut self, ws: &mut Workspace, par: Par) -> Contacts {
         each!(self, h => self_collide_with(h, ws, par))
     }

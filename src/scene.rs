@@ -12,8 +12,8 @@
 //!    into the first batch where both its objects are free (first-fit edge colouring;
 //!    independent of the thread count).
 //! 3. **Narrow**: the jobs of a batch run in parallel (rayon), each a two-object query
-//!    ([`collide_with`](crate::collide_with)) or a self query
-//!    ([`self_collide_with`](crate::self_collide_with)) that may itself split its frontier
+//!    ([`collide_with`](crate::collide_with())) or a self query
+//!    ([`self_collide_with`](crate::self_collide_with())) that may itself split its frontier
 //!    across the pool. Batches run one after the other.
 //!
 //! Output is deterministic: contacts are sorted, per-pair counters are listed in job order,

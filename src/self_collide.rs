@@ -15,7 +15,6 @@
 //! concatenated in chunk order; contacts are sorted. Contacts and counters are identical for
 //! every thread count.
 
-
 use crate::bv::BvKind;
 use crate::counters::Counters;
 use crate::hierarchy::Hierarchy;

@@ -138,7 +138,7 @@ fn per(t: f64, n: u64) -> Option<f64> {
     (n > 0).then(|| t / n as f64)
 }
 
-/// Calibration samples of one frame of one method (see [`combine`]).
+/// Calibration samples of one frame of one method (combined over frames by `combine`).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameSamples {
     pub frame: usize,
