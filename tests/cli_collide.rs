@@ -130,3 +130,31 @@ fn collide_reports_bad_input_in_one_line() {
     assert_eq!(bad_method.status.code(), Some(2));
     std::fs::remove_dir_all(dir).ok();
 }
+
+#[test]
+fn closed_stdout_is_not_a_panic() {
+    // A reader that stops early (`dhcd collide a b | head`) closes the pipe while dhcd is
+    // still writing: dhcd must end quietly, not panic in `println!`.
+    let dir = temp_dir("pipe");
+    let a = icosphere(3, 1.0, [0.0; 3]);
+    let pa = dir.join("a.obj");
+    write(&a, &pa);
+    for json in [true, false] {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_dhcd"));
+        cmd.args(["collide", pa.to_str().unwrap(), pa.to_str().unwrap()]);
+        if json {
+            cmd.arg("--json");
+        }
+        let mut child = cmd
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // the reader goes away before reading anything
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{err}");
+        assert_eq!(out.status.code(), Some(0), "{err}");
+    }
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -75,15 +75,18 @@ pub fn run(args: ExperimentArgs) -> Result<(), String> {
     let report = report?;
     output::write_all(&report, &args.out).map_err(|e| e.to_string())?;
     let s = &report.scene;
-    println!(
-        "{} objects x {} triangles, {} frames, {} levels, {} thread(s), seed {}",
-        s.objects, s.triangles_per_object, s.frames, s.levels, s.threads, s.seed
-    );
-    print!("{}", output::summary_table(&report));
-    println!(
-        "contacts identical across methods at every step; report in {} ({:.1} s)",
+    let text = format!(
+        "{} objects x {} triangles, {} frames, {} levels, {} thread(s), seed {}\n{}\
+         contacts identical across methods at every step; report in {} ({:.1} s)\n",
+        s.objects,
+        s.triangles_per_object,
+        s.frames,
+        s.levels,
+        s.threads,
+        s.seed,
+        output::summary_table(&report),
         args.out.display(),
         start.elapsed().as_secs_f64()
     );
-    Ok(())
+    super::emit(&text).map_err(|e| e.to_string())
 }

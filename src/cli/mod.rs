@@ -40,7 +40,7 @@ pub fn run() -> i32 {
         Err(e) if e.use_stderr() => {
             let text = e.render().to_string();
             let line = text.lines().next().unwrap_or("error: invalid arguments");
-            eprintln!("dhcd: {line}");
+            warn(&format!("dhcd: {line}"));
             return 2;
         }
         Err(e) => {
@@ -57,8 +57,28 @@ pub fn run() -> i32 {
     match result {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("dhcd: error: {e}");
+            warn(&format!("dhcd: error: {e}"));
             1
         }
     }
+}
+
+/// Writes `text` to standard output. A reader that went away (broken pipe, as in
+/// `dhcd collide a.obj b.obj | head`) is not an error: there is nobody left to tell.
+pub fn emit(text: &str) -> dhcd::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(dhcd::Error::Io {
+            path: "<standard output>".into(),
+            message: e.to_string(),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// One line on standard error; never panics (unlike `eprintln!` on a closed stderr).
+fn warn(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }

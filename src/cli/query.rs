@@ -32,13 +32,15 @@ impl QueryArgs {
         what: &str,
         rows: &[[T; N]],
         counters: Counters,
-    ) {
+    ) -> dhcd::Result<()> {
+        use std::fmt::Write;
         let rows: Vec<[u64; N]> = rows.iter().map(|r| r.map(Into::into)).collect();
         if self.json {
-            println!("{}", self.json_value(&rows, counters));
-            return;
+            return super::emit(&format!("{}\n", self.json_value(&rows, counters)));
         }
-        println!(
+        let mut text = String::new();
+        let _ = writeln!(
+            text,
             "{} {what} ({} levels, {} bytes per node): {} BV pairs tested, {} triangle pairs tested, {} BV updates",
             rows.len(),
             self.levels,
@@ -49,8 +51,9 @@ impl QueryArgs {
         );
         for row in &rows {
             let line: Vec<String> = row.iter().map(u64::to_string).collect();
-            println!("{}", line.join(" "));
+            let _ = writeln!(text, "{}", line.join(" "));
         }
+        super::emit(&text)
     }
 
     /// `{"method", "levels", "bytes_per_node", "pairs", "counters"}`, keys in this order.

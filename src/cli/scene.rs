@@ -40,6 +40,5 @@ pub fn run(args: SceneArgs) -> dhcd::Result<()> {
         scene.len(),
         contacts.per_pair.len()
     );
-    q.report(&what, &contacts.pairs, contacts.counters);
-    Ok(())
+    q.report(&what, &contacts.pairs, contacts.counters)
 }

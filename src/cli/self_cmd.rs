@@ -19,6 +19,5 @@ pub fn run(args: SelfArgs) -> dhcd::Result<()> {
     let mesh = dhcd::io::load(&args.mesh)?;
     let mut h = AnyHierarchy::new(q.method, &mesh, q.options())?;
     let contacts = h.self_collide(&mut Workspace::default(), Par::Seq);
-    q.report("self-contacts", &contacts.pairs, contacts.counters);
-    Ok(())
+    q.report("self-contacts", &contacts.pairs, contacts.counters)
 }
