@@ -1,32 +1,26 @@
 //! The `dhcd` binary's `self` and `scene` commands (JSON output, errors).
 
 use std::path::PathBuf;
-use std::process::Command;
 
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
 use dhcd::shapes::{icosphere, wave};
 use dhcd::Mesh;
 
+use crate::support;
+
+/// Writes `mesh` as `name` in this suite's directory.
 fn write_obj(name: &str, mesh: &Mesh) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("dhcd-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    let mut s = String::new();
-    for p in mesh.positions() {
-        s += &format!("v {:?} {:?} {:?}\n", p[0], p[1], p[2]);
-    }
-    for t in mesh.triangles() {
-        s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
-    }
-    std::fs::write(&path, s).unwrap();
+    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    let path = DIR
+        .get_or_init(|| support::temp_dir("self-scene-cli"))
+        .join(name);
+    support::write_obj(mesh, &path);
     path
 }
 
+/// Exit code, stdout, stderr.
 fn dhcd(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dhcd"))
-        .args(args)
-        .output()
-        .unwrap();
+    let out = support::run_dhcd(args);
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8(out.stdout).unwrap(),

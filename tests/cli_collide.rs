@@ -1,34 +1,17 @@
 //! `dhcd collide` end to end: files in, JSON out, equal to the exact oracle; bad input is a
 //! one-line error with a non-zero exit.
 
-use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use dhcd::narrow::brute_force_pairs;
 use dhcd::shapes::{icosphere, wave};
 use dhcd::Mesh;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("dhcd-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn write(mesh: &Mesh, path: &Path) {
-    let mut f = std::fs::File::create(path).unwrap();
-    dhcd::io::write_obj(mesh, &mut f).unwrap();
-}
-
-fn dhcd(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_dhcd"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use crate::support::{run_dhcd as dhcd, temp_dir, write_obj as write};
 
 #[test]
 fn collide_json_equals_brute_force_for_every_method() {
-    let dir = temp_dir("json");
+    let dir = temp_dir("collide-json");
     let a = icosphere(2, 1.0, [0.0; 3]);
     let b0 = icosphere(2, 0.9, [0.0; 3]);
     let b = Mesh::new(
@@ -76,7 +59,7 @@ fn collide_json_equals_brute_force_for_every_method() {
 
 #[test]
 fn collide_reports_bad_input_in_one_line() {
-    let dir = temp_dir("bad");
+    let dir = temp_dir("collide-bad");
     let good = dir.join("good.obj");
     write(&icosphere(0, 1.0, [0.0; 3]), &good);
     let cases: Vec<(&str, &str)> = vec![
@@ -135,7 +118,7 @@ fn collide_reports_bad_input_in_one_line() {
 fn closed_stdout_is_not_a_panic() {
     // A reader that stops early (`dhcd collide a b | head`) closes the pipe while dhcd is
     // still writing: dhcd must end quietly, not panic in `println!`.
-    let dir = temp_dir("pipe");
+    let dir = temp_dir("collide-pipe");
     let a = icosphere(3, 1.0, [0.0; 3]);
     let pa = dir.join("a.obj");
     write(&a, &pa);

@@ -1,12 +1,11 @@
 //! `dhcd::experiment` and `dhcd experiment`: schema of the report, determinism (seed and
 //! thread count), the command line and its files, bad flags.
 
-use std::path::PathBuf;
-use std::process::Command;
-
 use dhcd::experiment::{output, run, Config, Report};
 use dhcd::sim::{pawn_mesh_with, PAWN_HEIGHT};
 use dhcd::Counters;
+
+use crate::support::{run_dhcd as dhcd, temp_dir};
 
 /// A coarse pawn scene run long enough for the pawns to touch, with minimal timing work.
 fn small(frames: usize, threads: usize) -> Config {
@@ -151,22 +150,9 @@ fn bad_configs_are_errors() {
     }
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("dhcd-test-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
-
-fn dhcd(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_dhcd"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 #[test]
 fn cli_writes_every_file() {
-    let dir = temp_dir("cli");
+    let dir = temp_dir("experiment-cli");
     let out = dhcd(&[
         "experiment",
         "--frames",
@@ -194,7 +180,7 @@ fn cli_writes_every_file() {
 
 #[test]
 fn cli_bad_flags_fail_cleanly() {
-    let dir = temp_dir("bad");
+    let dir = temp_dir("experiment-bad");
     let missing = dir.join("missing.obj");
     for args in [
         vec!["experiment", "--frames", "0"],

@@ -12,3 +12,4 @@ mod narrow;
 mod scene;
 mod self_collision;
 mod sim;
+mod support;
