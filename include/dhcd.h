@@ -71,7 +71,8 @@ typedef struct DhcdSceneContacts {
  * failing call on this thread. */
 const char *dhcd_last_error_message(void);
 
-/* Hierarchies of single objects. */
+/* Hierarchies of single objects. levels: 0 for the adaptive default tree (leaves of at
+ * most 8 triangles), 1..16 for the paper's fixed depth (the paper uses 5). */
 int dhcd_hierarchy_new(int method, uint32_t levels, const float *positions,
                        size_t vertex_count, const uint32_t *triangles,
                        size_t triangle_count, DhcdHierarchy **out);

@@ -126,6 +126,7 @@ impl From<Error> for Fail {
             Error::MethodMismatch { .. } => DHCD_ERR_WRONG_KIND,
             Error::UnknownObject(_) => DHCD_ERR_UNKNOWN_OBJECT,
             Error::InvalidLevels { .. }
+            | Error::InvalidLeafSize { .. }
             | Error::InvalidOption(_)
             | Error::Io { .. }
             | Error::Parse { .. } => DHCD_ERR_INVALID_ARGUMENT,
@@ -247,9 +248,10 @@ fn method_code(m: Method) -> c_int {
     }
 }
 
+/// `levels == 0`: the adaptive default tree; otherwise the paper's fixed depth.
 fn options(levels: u32) -> Options {
     Options {
-        levels: levels as usize,
+        levels: (levels != 0).then_some(levels as usize),
         ..Options::default()
     }
 }
@@ -319,7 +321,8 @@ pub extern "C" fn dhcd_last_error_message() -> *const c_char {
 
 /// Builds the hierarchy of a mesh: `positions` holds `3 * vertex_count` floats (x, y, z per
 /// vertex), `triangles` `3 * triangle_count` vertex indices. `method` is a
-/// `DHCD_METHOD_*`, `levels` the region tree's levels (the paper's choice: 5). On success
+/// `DHCD_METHOD_*`, `levels` the region tree's fixed depth (the paper's choice: 5), or 0
+/// for the adaptive default tree. On success
 /// `*out` is a new handle to release with `dhcd_hierarchy_free`.
 ///
 /// # Safety
@@ -542,12 +545,7 @@ pub unsafe extern "C" fn dhcd_scene_new(
             return Err(null("out"));
         }
         let m = method(method_)?;
-        if levels == 0 || levels as usize > crate::tree::MAX_LEVELS {
-            return Err(Error::InvalidLevels {
-                got: levels as usize,
-            }
-            .into());
-        }
+        options(levels).shape().check()?;
         let s = Box::new(DhcdScene {
             scene: Scene::new(m, options(levels)),
         });

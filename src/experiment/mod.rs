@@ -36,7 +36,7 @@ use crate::mesh::Mesh;
 use crate::par::Par;
 use crate::sim::{pawn_scene, scene_with_mesh, ObjectContact, SimConfig, Simulation};
 use crate::traverse::Workspace;
-use crate::tree::{RegionTree, DEFAULT_LEVELS};
+use crate::tree::{RegionTree, TreeShape, PAPER_LEVELS};
 
 pub use cost::{Constant, Costs, Spread};
 
@@ -90,7 +90,7 @@ impl Default for Config {
     fn default() -> Self {
         Self {
             frames: 100,
-            levels: DEFAULT_LEVELS,
+            levels: PAPER_LEVELS,
             methods: Method::ALL.to_vec(),
             threads: 1,
             seed: 1,
@@ -334,7 +334,7 @@ pub fn run(
         .collect::<Result<_, _>>()?;
     let trees: Vec<Arc<RegionTree>> = meshes
         .iter()
-        .map(|m| RegionTree::build(m, config.levels).map(Arc::new))
+        .map(|m| RegionTree::build(m, TreeShape::Levels(config.levels)).map(Arc::new))
         .collect::<Result<_, _>>()?;
     let pairs = object_pairs(n);
 
