@@ -9,8 +9,9 @@ use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
 use crate::mesh::Mesh;
 use crate::par::Par;
-use crate::self_collide::self_collide_with;
-use crate::traverse::{broad_phase, collide_with, narrow_phase, Contacts, Workspace};
+use crate::traverse::{
+    broad_phase, collide_with, narrow_phase, self_collide_with, Contacts, Workspace,
+};
 use crate::tree::RegionTree;
 
 /// A hierarchy of a kind chosen at run time.
