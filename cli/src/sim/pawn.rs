@@ -10,8 +10,8 @@
 
 use std::f64::consts::PI;
 
-use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use dhcd::error::{Error, Result};
+use dhcd::mesh::Mesh;
 
 /// Rings of the paper-sized pawn (excluding the two poles).
 pub const PAWN_RINGS: usize = 32;

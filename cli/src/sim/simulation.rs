@@ -48,8 +48,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::ObjectContact;
-use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use dhcd::error::{Error, Result};
+use dhcd::mesh::Mesh;
 
 /// Parameters of [`Simulation`]. The defaults are tuned for the pawn scene: the pawns touch
 /// after about ten frames, dent each other and stay pressed together for hundreds of frames.

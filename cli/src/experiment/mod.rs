@@ -21,22 +21,21 @@
 //! Results do not depend on the thread count (counters and contacts; times do).
 
 pub mod cost;
-#[cfg(feature = "cli")]
 pub mod output;
 
 use std::sync::Arc;
 use std::time::Instant;
 
-use crate::any::AnyHierarchy;
-use crate::bv::Method;
-use crate::counters::Counters;
-use crate::error::Error;
-use crate::hierarchy::Refit;
-use crate::mesh::Mesh;
-use crate::par::Par;
 use crate::sim::{pawn_scene, scene_with_mesh, ObjectContact, SimConfig, Simulation};
-use crate::traverse::Workspace;
-use crate::tree::{RegionTree, DEFAULT_LEVELS};
+use dhcd::any::AnyHierarchy;
+use dhcd::bv::Method;
+use dhcd::counters::Counters;
+use dhcd::error::Error;
+use dhcd::hierarchy::Refit;
+use dhcd::mesh::Mesh;
+use dhcd::par::Par;
+use dhcd::traverse::Workspace;
+use dhcd::tree::{RegionTree, DEFAULT_LEVELS};
 
 pub use cost::{Constant, Costs, Spread};
 

@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use dhcd::experiment::{self, output, Config, Phase};
 use dhcd::Method;
+use dhcd_cli::experiment::{self, output, Config, Phase};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(clap::Args, Debug)]

@@ -6,10 +6,10 @@ use std::collections::BTreeSet;
 use std::ffi::CStr;
 use std::ptr::{null, null_mut};
 
-use dhcd::capi::*;
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
 use dhcd::shapes::{icosphere, translated, wave};
 use dhcd::Mesh;
+use dhcd_capi::*;
 
 fn flat(mesh: &Mesh) -> (Vec<f32>, Vec<u32>) {
     (
@@ -391,12 +391,12 @@ fn last_error_is_per_thread() {
 }
 
 /// `include/dhcd.h` is hand-written: it must declare exactly the `dhcd_*` functions that
-/// `src/capi.rs` exports, and the same `DHCD_*` constants with the same values.
+/// `capi/src/lib.rs` exports, and the same `DHCD_*` constants with the same values.
 #[test]
 fn header_matches_exports() {
     let root = env!("CARGO_MANIFEST_DIR");
-    let header = std::fs::read_to_string(format!("{root}/include/dhcd.h")).unwrap();
-    let source = std::fs::read_to_string(format!("{root}/src/capi.rs")).unwrap();
+    let header = std::fs::read_to_string(format!("{root}/../include/dhcd.h")).unwrap();
+    let source = std::fs::read_to_string(format!("{root}/src/lib.rs")).unwrap();
     let declared: BTreeSet<String> = header
         .lines()
         .filter(|l| !l.trim_start().starts_with(['*', '/', '#']))

@@ -1,9 +1,9 @@
-//! `dhcd::experiment` and `dhcd experiment`: schema of the report, determinism (seed and
+//! `dhcd_cli::experiment` and `dhcd experiment`: schema of the report, determinism (seed and
 //! thread count), the command line and its files, bad flags.
 
-use dhcd::experiment::{output, run, Config, Report};
-use dhcd::sim::{pawn_mesh_with, PAWN_HEIGHT};
 use dhcd::Counters;
+use dhcd_cli::experiment::{output, run, Config, Report};
+use dhcd_cli::sim::{pawn_mesh_with, PAWN_HEIGHT};
 
 use crate::support::{run_dhcd as dhcd, temp_dir};
 

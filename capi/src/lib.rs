@@ -1,4 +1,5 @@
-//! The C ABI (`include/dhcd.h`; see `docs/LINKING_FROM_C.md`).
+//! The C ABI of dhcd (`include/dhcd.h`; see `docs/LINKING_FROM_C.md`): the only `unsafe` code
+//! of the project outside the SIMD kernels.
 //!
 //! Conventions:
 //! - every fallible function returns an `int`: [`DHCD_OK`] (0) or a negative `DHCD_ERR_*`
@@ -19,15 +20,15 @@ use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use crate::any::AnyHierarchy;
-use crate::bv::Method;
-use crate::counters::Counters;
-use crate::error::Error;
-use crate::hierarchy::Options;
-use crate::mesh::Mesh;
-use crate::par::Par;
-use crate::scene::{ObjectId, Scene};
-use crate::traverse::{Contacts, Workspace};
+use dhcd::any::AnyHierarchy;
+use dhcd::bv::Method;
+use dhcd::counters::Counters;
+use dhcd::error::Error;
+use dhcd::hierarchy::Options;
+use dhcd::mesh::Mesh;
+use dhcd::par::Par;
+use dhcd::scene::{ObjectId, Scene};
+use dhcd::traverse::{Contacts, Workspace};
 
 pub const DHCD_OK: c_int = 0;
 /// A required pointer argument is null.
@@ -542,7 +543,7 @@ pub unsafe extern "C" fn dhcd_scene_new(
             return Err(null("out"));
         }
         let m = method(method_)?;
-        if levels == 0 || levels as usize > crate::tree::MAX_LEVELS {
+        if levels == 0 || levels as usize > dhcd::tree::MAX_LEVELS {
             return Err(Error::InvalidLevels {
                 got: levels as usize,
             }

@@ -4,8 +4,8 @@ use glam::DVec3;
 
 use super::pawn::pawn_mesh;
 use super::simulation::{splitmix64, SimConfig, Simulation};
-use crate::error::Result;
-use crate::mesh::Mesh;
+use dhcd::error::Result;
+use dhcd::mesh::Mesh;
 
 /// Number of objects in [`pawn_scene`] and [`scene_with_mesh`] (the paper's eight pawns).
 pub const SCENE_OBJECTS: usize = 8;

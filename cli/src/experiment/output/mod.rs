@@ -1,4 +1,4 @@
-//! Report writers (behind the `cli` feature): `report.json`, `report.md`, the SVG figures,
+//! Report writers: `report.json`, `report.md`, the SVG figures,
 //! and the summary table printed by `dhcd experiment`.
 
 pub mod svg;
@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use serde_json::{json, Value};
 
 use super::{cost::Constant, MethodReport, Report};
-use crate::bv::Method;
-use crate::error::{Error, Result};
+use dhcd::bv::Method;
+use dhcd::error::{Error, Result};
 
 /// Files written by [`write_all`], in order.
 pub const FILES: [&str; 8] = [
