@@ -30,6 +30,7 @@ use dhcd::par::Par;
 use dhcd::scene::{ObjectId, Scene};
 use dhcd::traverse::{Contacts, Workspace};
 
+/// Success.
 pub const DHCD_OK: c_int = 0;
 /// A required pointer argument is null.
 pub const DHCD_ERR_NULL: c_int = -1;
@@ -101,7 +102,7 @@ pub struct DhcdHierarchy {
     ws: Workspace,
 }
 
-/// Opaque: a [`Scene`].
+/// Opaque: a scene of many objects.
 pub struct DhcdScene {
     scene: Scene,
 }
@@ -228,7 +229,7 @@ unsafe fn write<T>(ptr: *mut T, value: T, what: &str) -> Result<(), Fail> {
     Ok(())
 }
 
-fn method(m: c_int) -> Result<Method, Fail> {
+fn method_of(m: c_int) -> Result<Method, Fail> {
     match m {
         DHCD_METHOD_DH => Ok(Method::Dh),
         DHCD_METHOD_SPHERE => Ok(Method::Sphere),
@@ -327,7 +328,7 @@ pub extern "C" fn dhcd_last_error_message() -> *const c_char {
 /// The arrays must hold the stated number of elements; `out` must be valid for a write.
 #[no_mangle]
 pub unsafe extern "C" fn dhcd_hierarchy_new(
-    method_: c_int,
+    method: c_int,
     levels: u32,
     positions: *const f32,
     vertex_count: usize,
@@ -339,7 +340,7 @@ pub unsafe extern "C" fn dhcd_hierarchy_new(
         if out.is_null() {
             return Err(null("out"));
         }
-        let m = method(method_)?;
+        let m = method_of(method)?;
         // SAFETY: the caller's contract on the arrays.
         let mesh = unsafe { mesh(positions, vertex_count, triangles, triangle_count)? };
         let h = AnyHierarchy::new(m, &mesh, options(levels))?;
@@ -534,7 +535,7 @@ pub unsafe extern "C" fn dhcd_contacts_free(c: *mut DhcdContacts) {
 /// `out` null or valid for a write.
 #[no_mangle]
 pub unsafe extern "C" fn dhcd_scene_new(
-    method_: c_int,
+    method: c_int,
     levels: u32,
     out: *mut *mut DhcdScene,
 ) -> c_int {
@@ -542,7 +543,7 @@ pub unsafe extern "C" fn dhcd_scene_new(
         if out.is_null() {
             return Err(null("out"));
         }
-        let m = method(method_)?;
+        let m = method_of(method)?;
         if levels == 0 || levels as usize > dhcd::tree::MAX_LEVELS {
             return Err(Error::InvalidLevels {
                 got: levels as usize,
