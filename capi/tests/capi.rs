@@ -2,7 +2,6 @@
 //! mismatched lengths, wrong kind, unknown ids), and `include/dhcd.h` declares exactly the
 //! exported functions and constants.
 
-use std::collections::BTreeSet;
 use std::ffi::CStr;
 use std::ptr::{null, null_mut};
 
