@@ -26,6 +26,13 @@
 #include <stdlib.h>
 
 /**
+ * Hierarchy kinds (`method` arguments).
+ */
+#define DHCD_METHOD_DH 0
+#define DHCD_METHOD_SPHERE 1
+#define DHCD_METHOD_AABB 2
+
+/**
  * Success.
  */
 #define DHCD_OK 0
@@ -71,12 +78,6 @@
  * A bug in dhcd (a caught panic).
  */
 #define DHCD_ERR_PANIC -8
-
-#define DHCD_METHOD_DH 0
-
-#define DHCD_METHOD_SPHERE 1
-
-#define DHCD_METHOD_AABB 2
 
 /**
  * Opaque: one object's hierarchy (and its query scratch).

@@ -33,6 +33,7 @@ pub mod detail;
 pub mod error;
 pub mod hierarchy;
 pub mod io;
+pub mod kinds;
 pub mod mesh;
 pub mod narrow;
 pub mod par;

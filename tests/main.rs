@@ -3,6 +3,7 @@
 
 mod hierarchies;
 mod io;
+mod kinds;
 mod narrow;
 mod scene;
 mod self_collision;

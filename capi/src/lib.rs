@@ -51,9 +51,9 @@ pub const DHCD_ERR_STALE_CONTACT: c_int = -7;
 /// A bug in dhcd (a caught panic).
 pub const DHCD_ERR_PANIC: c_int = -8;
 
-pub const DHCD_METHOD_DH: c_int = 0;
-pub const DHCD_METHOD_SPHERE: c_int = 1;
-pub const DHCD_METHOD_AABB: c_int = 2;
+// The kinds' numbers (`DHCD_METHOD_DH` = 0, ...) are not constants here: they are
+// `Method::code()`, from the library's table of kinds, and the header's `DHCD_METHOD_*`
+// defines are generated from that table with the rest of the header (capi/tests/capi.rs).
 
 /// Counted work of a query (the cost model's `N_V`, `N_P`, `N_U`, and the contacts).
 #[repr(C)]
@@ -127,10 +127,19 @@ impl From<Error> for Fail {
             Error::WrongVertexCount { .. } => DHCD_ERR_LENGTH_MISMATCH,
             Error::MethodMismatch { .. } => DHCD_ERR_WRONG_KIND,
             Error::UnknownObject(_) => DHCD_ERR_UNKNOWN_OBJECT,
+            Error::StaleContact { .. } => DHCD_ERR_STALE_CONTACT,
             Error::InvalidLevels { .. }
-            | Error::InvalidOption(_)
+            | Error::UnknownMethod(_)
+            | Error::UnknownRefit(_)
+            | Error::NodeOutOfRange { .. }
+            | Error::NotALeaf { .. }
+            | Error::TreeMismatch { .. }
+            | Error::TriangleOutOfRange { .. }
             | Error::Io { .. }
             | Error::Parse { .. } => DHCD_ERR_INVALID_ARGUMENT,
+            // `Error` is non-exhaustive: a variant added later is a bad argument until it
+            // gets a code of its own.
+            _ => DHCD_ERR_INVALID_ARGUMENT,
         };
         Fail(code, e.to_string())
     }
@@ -230,23 +239,16 @@ unsafe fn write<T>(ptr: *mut T, value: T, what: &str) -> Result<(), Fail> {
 }
 
 fn method_of(m: c_int) -> Result<Method, Fail> {
-    match m {
-        DHCD_METHOD_DH => Ok(Method::Dh),
-        DHCD_METHOD_SPHERE => Ok(Method::Sphere),
-        DHCD_METHOD_AABB => Ok(Method::Aabb),
-        _ => Err(Fail(
+    Method::from_code(m).ok_or_else(|| {
+        let names: Vec<String> = Method::ALL
+            .iter()
+            .map(|m| format!("DHCD_METHOD_{}", m.name().to_uppercase()))
+            .collect();
+        Fail(
             DHCD_ERR_INVALID_ARGUMENT,
-            format!("unknown method {m} (expected DHCD_METHOD_DH, _SPHERE or _AABB)"),
-        )),
-    }
-}
-
-fn method_code(m: Method) -> c_int {
-    match m {
-        Method::Dh => DHCD_METHOD_DH,
-        Method::Sphere => DHCD_METHOD_SPHERE,
-        Method::Aabb => DHCD_METHOD_AABB,
-    }
+            format!("unknown method {m} (expected one of {})", names.join(", ")),
+        )
+    })
 }
 
 fn options(levels: u32) -> Options {
@@ -378,7 +380,7 @@ pub unsafe extern "C" fn dhcd_hierarchy_method(h: *const DhcdHierarchy, out: *mu
         // SAFETY: null or a live handle (caller's contract); only read.
         let h = unsafe { h.as_ref() }.ok_or_else(|| null("hierarchy"))?;
         // SAFETY: caller's contract on `out`.
-        unsafe { write(out, method_code(h.h.method()), "out") }
+        unsafe { write(out, h.h.method().code(), "out") }
     })
 }
 
@@ -492,12 +494,7 @@ pub unsafe extern "C" fn dhcd_contact_segments(
         if segments.is_null() {
             return Err(null("segments"));
         }
-        let segs = a.h.contact_segments(&b.h, pairs).map_err(|e| match e {
-            Error::InvalidOption(m) if m.contains("do not intersect") => {
-                Fail(DHCD_ERR_STALE_CONTACT, m)
-            }
-            e => e.into(),
-        })?;
+        let segs = a.h.contact_segments(&b.h, pairs)?;
         for (k, s) in segs.iter().enumerate() {
             let flat = [s[0][0], s[0][1], s[0][2], s[1][0], s[1][1], s[1][2]];
             // SAFETY: `segments` has room for `6 * count` floats (caller's contract) and

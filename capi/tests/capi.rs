@@ -7,7 +7,11 @@ use std::ptr::{null, null_mut};
 
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
 use dhcd::shapes::{icosphere, translated, wave};
-use dhcd::Mesh;
+use dhcd::{Mesh, Method};
+
+const DHCD_METHOD_DH: i32 = Method::Dh.code();
+const DHCD_METHOD_SPHERE: i32 = Method::Sphere.code();
+const DHCD_METHOD_AABB: i32 = Method::Aabb.code();
 use dhcd_capi::*;
 
 fn flat(mesh: &Mesh) -> (Vec<f32>, Vec<u32>) {
@@ -335,6 +339,11 @@ fn bad_arguments_are_error_codes() {
         );
         let mut s = null_mut();
         assert_eq!(dhcd_scene_new(-1, 5, &mut s), DHCD_ERR_INVALID_ARGUMENT);
+        assert!(
+            last_error().contains("DHCD_METHOD_AABB"),
+            "{}",
+            last_error()
+        );
         assert_eq!(
             dhcd_scene_new(DHCD_METHOD_DH, 99, &mut s),
             DHCD_ERR_INVALID_ARGUMENT
@@ -395,7 +404,14 @@ fn last_error_is_per_thread() {
 #[test]
 fn header_is_generated() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let config = cbindgen::Config::from_file(root.join("cbindgen.toml")).unwrap();
+    let mut config = cbindgen::Config::from_file(root.join("cbindgen.toml")).unwrap();
+    // The kinds' numbers, from the library's table of kinds.
+    let mut kinds = String::from("\n/**\n * Hierarchy kinds (`method` arguments).\n */");
+    for m in Method::ALL {
+        let name = m.name().to_uppercase();
+        kinds += &format!("\n#define DHCD_METHOD_{name} {}", m.code());
+    }
+    config.after_includes = Some(kinds);
     let mut generated = Vec::new();
     cbindgen::Builder::new()
         .with_config(config)

@@ -3,7 +3,8 @@
 //!
 //! The kind is a compile-time policy ([`BvKind`]); node data lives in structure-of-arrays
 //! buffers (one array per record field, padded to [`PAD`] entries) so that one SIMD load
-//! covers a block of nodes. [`Method`] names a kind where it is chosen at run time.
+//! covers a block of nodes. [`Method`] names a kind where it is chosen at run time; every
+//! kind is a row of the table in [`crate::kinds`].
 
 mod aabb;
 mod dh;
@@ -12,6 +13,8 @@ mod sphere;
 pub use aabb::{Aabb, AabbNode, AabbNodes};
 pub use dh::{Dh, DhNode, DhNodes};
 pub use sphere::{Sphere, SphereNode, SphereNodes};
+
+pub use crate::kinds::Method;
 
 use crate::points::Points;
 use crate::tree::RegionTree;
@@ -48,63 +51,13 @@ pub(crate) fn padded(n: usize) -> usize {
     n.div_ceil(PAD).max(1) * PAD
 }
 
-/// The hierarchy kinds, for choosing one at run time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Method {
-    Dh,
-    Sphere,
-    Aabb,
-}
-
-impl Method {
-    pub const ALL: [Method; 3] = [Method::Dh, Method::Sphere, Method::Aabb];
-
-    /// The name used on the command line and in reports: `dh`, `sphere`, `aabb`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Dh => "dh",
-            Method::Sphere => "sphere",
-            Method::Aabb => "aabb",
-        }
-    }
-
-    /// Size of one node record: 8, 16 or 24 bytes.
-    pub fn bytes_per_node(self) -> usize {
-        match self {
-            Method::Dh => std::mem::size_of::<DhNode>(),
-            Method::Sphere => std::mem::size_of::<SphereNode>(),
-            Method::Aabb => std::mem::size_of::<AabbNode>(),
-        }
-    }
-}
-
-impl std::fmt::Display for Method {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Method {
-    type Err = crate::Error;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "dh" => Ok(Method::Dh),
-            "sphere" | "sbv" => Ok(Method::Sphere),
-            "aabb" => Ok(Method::Aabb),
-            _ => Err(crate::Error::InvalidOption(format!(
-                "unknown method {s:?} (expected dh, sphere or aabb)"
-            ))),
-        }
-    }
-}
-
 mod sealed {
     pub trait Sealed {}
 }
 
 /// A bounding-volume kind: its node record, its SoA buffers, how to fit a node to the
-/// current pose, and the batch overlap test. Sealed: the three kinds are the set the
-/// library compares.
+/// current pose, and the batch overlap test. Sealed: the kinds are the rows of the table in
+/// [`crate::kinds`], the set the library compares.
 pub trait BvKind:
     sealed::Sealed + Copy + Default + Send + Sync + std::fmt::Debug + 'static
 {
