@@ -133,7 +133,8 @@ const char *dhcd_last_error_message(void);
 /**
  * Builds the hierarchy of a mesh: `positions` holds `3 * vertex_count` floats (x, y, z per
  * vertex), `triangles` `3 * triangle_count` vertex indices. `method` is a
- * `DHCD_METHOD_*`, `levels` the region tree's levels (the paper's choice: 5). On success
+ * `DHCD_METHOD_*`, `levels` the region tree's fixed depth (the paper's choice: 5), or 0
+ * for the adaptive default tree. On success
  * `*out` is a new handle to release with `dhcd_hierarchy_free`.
  *
  * # Safety

@@ -38,7 +38,7 @@ macro_rules! pairwise {
 
 impl AnyHierarchy {
     pub fn new(method: Method, mesh: &Mesh, options: Options) -> Result<Self> {
-        let tree = Arc::new(RegionTree::build(mesh, options.levels)?);
+        let tree = Arc::new(RegionTree::build(mesh, options.shape())?);
         Self::with_tree(method, tree, mesh, options.refit)
     }
 

@@ -37,6 +37,8 @@ pub enum Error {
     WrongVertexCount { expected: usize, got: usize },
     #[error("levels must be between 1 and {max}, got {got}", max = crate::tree::MAX_LEVELS)]
     InvalidLevels { got: usize },
+    #[error("leaf size must be between 1 and {max}, got {got}", max = crate::tree::MAX_LEAF_SIZE)]
+    InvalidLeafSize { got: usize },
     #[error("cannot collide a {a} hierarchy with a {b} hierarchy")]
     MethodMismatch {
         a: crate::bv::Method,

@@ -7,7 +7,7 @@ use crate::bv::{BvKind, Method};
 use crate::error::{Error, Result};
 use crate::mesh::{check_positions, Mesh};
 use crate::points::Points;
-use crate::tree::{RegionTree, DEFAULT_LEVELS};
+use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
 
 /// When bounding volumes follow a deformation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -39,16 +39,40 @@ impl std::str::FromStr for Refit {
 /// Build options of a hierarchy.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Options {
-    /// Levels of the region tree (root = level 0); the paper uses 5.
-    pub levels: usize,
+    /// A fixed depth for the region tree (root = level 0; the paper uses 5), or `None`
+    /// (the default) for an adaptive tree whose leaves hold at most `leaf_size` triangles.
+    pub levels: Option<usize>,
+    /// Largest number of triangles in a leaf of an adaptive tree (ignored with `levels`).
+    pub leaf_size: usize,
     pub refit: Refit,
 }
 
 impl Default for Options {
     fn default() -> Self {
         Self {
-            levels: DEFAULT_LEVELS,
+            levels: None,
+            leaf_size: DEFAULT_LEAF_SIZE,
             refit: Refit::Lazy,
+        }
+    }
+}
+
+impl Options {
+    /// The paper's setting: a fixed depth of 5 levels, lazy refit.
+    pub fn paper() -> Self {
+        Self {
+            levels: Some(PAPER_LEVELS),
+            ..Self::default()
+        }
+    }
+
+    /// The region tree these options ask for.
+    pub fn shape(&self) -> TreeShape {
+        match self.levels {
+            Some(levels) => TreeShape::Levels(levels),
+            None => TreeShape::Adaptive {
+                leaf_size: self.leaf_size,
+            },
         }
     }
 }
@@ -124,7 +148,7 @@ impl<K: BvKind> Hierarchy<K> {
     /// Builds the region tree over `mesh` (its positions are the rest pose) and fits `K`'s
     /// volumes to it.
     pub fn new(mesh: &Mesh, options: Options) -> Result<Self> {
-        let tree = Arc::new(RegionTree::build(mesh, options.levels)?);
+        let tree = Arc::new(RegionTree::build(mesh, options.shape())?);
         Self::with_tree(tree, mesh, options.refit)
     }
 

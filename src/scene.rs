@@ -229,6 +229,12 @@ impl Scene {
         Ok(each!(&self.objects, v => v[i].self_collision))
     }
 
+    /// The object's region tree.
+    pub fn tree(&self, id: ObjectId) -> Result<&std::sync::Arc<crate::tree::RegionTree>> {
+        let i = self.index(id)?;
+        Ok(each!(&self.objects, v => v[i].h.tree()))
+    }
+
     /// Root box `[min, max]` of the object's current pose (what the broad phase compares).
     pub fn bounds(&self, id: ObjectId) -> Result<[[f32; 3]; 2]> {
         let i = self.index(id)?;

@@ -35,7 +35,7 @@ fn pairs_of<K: BvKind>(a: &Mesh, b: &Mesh, options: Options) -> Vec<[u32; 2]> {
 fn assert_exact(a: &Mesh, b: &Mesh, levels: usize) -> Vec<[u32; 2]> {
     let expected = brute_force_pairs(a, b);
     let options = Options {
-        levels,
+        levels: Some(levels),
         ..Options::default()
     };
     for_each_kind!(K => assert_eq!(
@@ -127,7 +127,11 @@ fn degenerate_triangles_at_build() {
 fn deforming_sequence<K: BvKind>(refit: Refit, steps: usize) -> Vec<Vec<[u32; 2]>> {
     let a = icosphere(2, 1.0, [0.0, 0.0, 0.0]);
     let b = icosphere(2, 0.8, [0.0, 0.0, 0.0]);
-    let options = Options { levels: 5, refit };
+    let options = Options {
+        levels: Some(5),
+        refit,
+        ..Options::default()
+    };
     let mut ha = Hierarchy::<K>::new(&a, options).unwrap();
     let mut hb = Hierarchy::<K>::new(&b, options).unwrap();
     let mut all = Vec::new();
@@ -198,9 +202,9 @@ fn record_sizes_and_memory() {
     assert_eq!(std::mem::size_of::<dhcd::bv::SphereNode>(), 16);
     assert_eq!(std::mem::size_of::<dhcd::bv::AabbNode>(), 24);
     let m = icosphere(3, 1.0, [0.0; 3]);
-    let dh = Hierarchy::<Dh>::new(&m, Options::default()).unwrap();
-    let sp = Hierarchy::<Sphere>::new(&m, Options::default()).unwrap();
-    let bx = Hierarchy::<Aabb>::new(&m, Options::default()).unwrap();
+    let dh = Hierarchy::<Dh>::new(&m, Options::paper()).unwrap();
+    let sp = Hierarchy::<Sphere>::new(&m, Options::paper()).unwrap();
+    let bx = Hierarchy::<Aabb>::new(&m, Options::paper()).unwrap();
     assert_eq!(dh.bv_bytes(), 8 * dh.node_count());
     assert_eq!(sp.bv_bytes(), 16 * dh.node_count());
     assert_eq!(bx.bv_bytes(), 24 * dh.node_count());
@@ -211,7 +215,8 @@ fn record_sizes_and_memory() {
 #[test]
 fn shared_tree_gives_identical_regions() {
     let m = icosphere(2, 1.0, [0.0; 3]);
-    let tree = std::sync::Arc::new(RegionTree::build(&m, 4).unwrap());
+    let tree =
+        std::sync::Arc::new(RegionTree::build(&m, dhcd::tree::TreeShape::Levels(4)).unwrap());
     let dh = Hierarchy::<Dh>::with_tree(tree.clone(), &m, Refit::Lazy).unwrap();
     let bx = Hierarchy::<Aabb>::with_tree(tree.clone(), &m, Refit::Lazy).unwrap();
     assert!(std::sync::Arc::ptr_eq(dh.tree(), bx.tree()));
@@ -298,7 +303,7 @@ fn bad_mesh_input_is_a_typed_error() {
             Hierarchy::<Dh>::new(
                 &m,
                 Options {
-                    levels,
+                    levels: Some(levels),
                     ..Options::default()
                 }
             )

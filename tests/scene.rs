@@ -57,7 +57,7 @@ fn sequence(method: Method, par: Par, levels: usize) -> Vec<SceneContacts> {
     let mut scene = Scene::new(
         method,
         Options {
-            levels,
+            levels: Some(levels),
             ..Options::default()
         },
     );
@@ -180,7 +180,7 @@ fn ids_are_never_reused_and_unknown_ids_are_errors() {
     assert!(Scene::new(
         Method::Dh,
         Options {
-            levels: 0,
+            levels: Some(0),
             ..Options::default()
         }
     )

@@ -59,7 +59,11 @@ fn check<K: BvKind>(rest: &Mesh, posed: &[[f32; 3]], options: Options) -> Vec<[u
 fn check_all(rest: &Mesh, posed: &[[f32; 3]], levels: usize) -> usize {
     let mut found = 0;
     for refit in [Refit::Lazy, Refit::Eager, Refit::EagerBottomUp] {
-        let options = Options { levels, refit };
+        let options = Options {
+            levels: Some(levels),
+            refit,
+            ..Options::default()
+        };
         for_each_kind!(K => found = check::<K>(rest, posed, options).len());
     }
     found
@@ -127,7 +131,7 @@ fn single_triangle_and_shared_vertices() {
     .unwrap();
     for levels in [1, 2, 3] {
         let options = Options {
-            levels,
+            levels: Some(levels),
             ..Options::default()
         };
         let expected = brute_force_self_pairs(&m);

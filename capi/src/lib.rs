@@ -135,6 +135,7 @@ impl From<Error> for Fail {
             | Error::NotALeaf { .. }
             | Error::TreeMismatch { .. }
             | Error::TriangleOutOfRange { .. }
+            | Error::InvalidLeafSize { .. }
             | Error::Io { .. }
             | Error::Parse { .. } => DHCD_ERR_INVALID_ARGUMENT,
             // `Error` is non-exhaustive: a variant added later is a bad argument until it
@@ -251,9 +252,10 @@ fn method_of(m: c_int) -> Result<Method, Fail> {
     })
 }
 
+/// `levels == 0`: the adaptive default tree; otherwise the paper's fixed depth.
 fn options(levels: u32) -> Options {
     Options {
-        levels: levels as usize,
+        levels: (levels != 0).then_some(levels as usize),
         ..Options::default()
     }
 }
@@ -323,7 +325,8 @@ pub extern "C" fn dhcd_last_error_message() -> *const c_char {
 
 /// Builds the hierarchy of a mesh: `positions` holds `3 * vertex_count` floats (x, y, z per
 /// vertex), `triangles` `3 * triangle_count` vertex indices. `method` is a
-/// `DHCD_METHOD_*`, `levels` the region tree's levels (the paper's choice: 5). On success
+/// `DHCD_METHOD_*`, `levels` the region tree's fixed depth (the paper's choice: 5), or 0
+/// for the adaptive default tree. On success
 /// `*out` is a new handle to release with `dhcd_hierarchy_free`.
 ///
 /// # Safety
@@ -541,12 +544,7 @@ pub unsafe extern "C" fn dhcd_scene_new(
             return Err(null("out"));
         }
         let m = method_of(method)?;
-        if levels == 0 || levels as usize > dhcd::tree::MAX_LEVELS {
-            return Err(Error::InvalidLevels {
-                got: levels as usize,
-            }
-            .into());
-        }
+        options(levels).shape().check()?;
         let s = Box::new(DhcdScene {
             scene: Scene::new(m, options(levels)),
         });

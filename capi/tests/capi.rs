@@ -135,7 +135,7 @@ fn scene_equals_rust_scene() {
     let mut rust = dhcd::Scene::new(
         dhcd::Method::Sphere,
         dhcd::Options {
-            levels: 4,
+            levels: Some(4),
             ..Default::default()
         },
     );
@@ -334,7 +334,7 @@ fn bad_arguments_are_error_codes() {
             DHCD_ERR_INVALID_ARGUMENT
         );
         assert_eq!(
-            dhcd_hierarchy_new(DHCD_METHOD_DH, 0, p.as_ptr(), nv, t.as_ptr(), nt, &mut h),
+            dhcd_hierarchy_new(DHCD_METHOD_DH, 17, p.as_ptr(), nv, t.as_ptr(), nt, &mut h),
             DHCD_ERR_INVALID_ARGUMENT
         );
         let mut s = null_mut();

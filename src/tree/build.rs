@@ -1,22 +1,27 @@
-//! Top-down octree construction over the rest pose.
+//! Top-down construction of the region tree over the rest pose.
+//!
+//! Every split separates triangles: a node's run is cut into up to [`MAX_CHILDREN`] parts by
+//! repeated binary splits of the largest part, each at the median (by count) of its
+//! centroids along the longest axis of their bounding box. A median cut cannot be pushed
+//! aside by far-away outliers (a midpoint cut can leave every triangle on one side), and the
+//! longest axis never cuts a near-flat mesh along its noise (which interleaves children
+//! whose bounds never shrink). Ties in the median are broken by triangle index, so even
+//! coincident centroids are separated and the build is deterministic.
 
-use super::{RegionTree, MAX_LEVELS};
-use crate::error::{Error, Result};
+use super::{RegionTree, TreeShape, MAX_CHILDREN};
+use crate::error::Result;
 use crate::mesh::Mesh;
 
 const UNSET: u32 = u32::MAX;
 
 impl RegionTree {
-    /// Builds the region tree of `mesh` (its current positions are the rest pose) with at
-    /// most `levels` levels (root = level 0; the paper uses 5).
+    /// Builds the region tree of `mesh` (its current positions are the rest pose).
     ///
-    /// A node is split into the non-empty octants of the bounding box of its triangles'
-    /// centroids (each triangle goes to the octant of its centroid); it is a leaf when it
-    /// is at the last level, holds one triangle, or all its centroids coincide.
-    pub fn build(mesh: &Mesh, levels: usize) -> Result<Self> {
-        if levels == 0 || levels > MAX_LEVELS {
-            return Err(Error::InvalidLevels { got: levels });
-        }
+    /// [`TreeShape::Adaptive`] splits every node holding more than `leaf_size` triangles;
+    /// [`TreeShape::Levels`] splits every node of two or more triangles above the last of
+    /// `levels` levels (the paper's fixed depth).
+    pub fn build(mesh: &Mesh, shape: TreeShape) -> Result<Self> {
+        shape.check()?;
         let tri_count = mesh.triangle_count();
         let centroids: Vec<[f64; 3]> = (0..tri_count)
             .map(|t| {
@@ -26,16 +31,17 @@ impl RegionTree {
             .collect();
 
         // Breadth-first: each node owns the run `order[start..end]` of the working triangle
-        // array; splitting a node stably partitions its run among its children, so every
-        // node's triangles stay contiguous in the final order.
+        // array; splitting a node permutes its run into its children's consecutive runs, so
+        // every node's triangles stay contiguous in the final order.
         let mut order: Vec<u32> = (0..tri_count as u32).collect();
-        let mut scratch: Vec<u32> = Vec::with_capacity(tri_count);
         let mut tri_start = vec![0u32];
         let mut tri_end = vec![tri_count as u32];
         let mut depth = vec![0u8];
+        let mut parent = vec![UNSET];
         let mut first_child = vec![0u32];
         let mut child_count = vec![0u8];
         let mut level_start = vec![0u32];
+        let mut parts = Vec::with_capacity(MAX_CHILDREN);
 
         let mut n = 0;
         while n < tri_start.len() {
@@ -47,38 +53,17 @@ impl RegionTree {
             if level_start.len() <= d {
                 level_start.push(n as u32);
             }
-            if d + 1 < levels && e - s > 1 {
-                let octs = octants(&order[s..e], &centroids);
-                let mut counts = [0usize; 8];
-                for &o in &octs {
-                    counts[o as usize] += 1;
-                }
-                if counts.iter().filter(|&&c| c > 0).count() > 1 {
-                    // Counting sort by octant (stable).
-                    let mut offs = [0usize; 8];
-                    let mut acc = 0;
-                    for k in 0..8 {
-                        offs[k] = acc;
-                        acc += counts[k];
-                    }
-                    scratch.clear();
-                    scratch.resize(e - s, 0);
-                    for (i, &o) in octs.iter().enumerate() {
-                        scratch[offs[o as usize]] = order[s + i];
-                        offs[o as usize] += 1;
-                    }
-                    order[s..e].copy_from_slice(&scratch);
-                    first_child[n] = tri_start.len() as u32;
-                    let mut start = s;
-                    for &c in counts.iter().filter(|&&c| c > 0) {
-                        tri_start.push(start as u32);
-                        tri_end.push((start + c) as u32);
-                        depth.push(d as u8 + 1);
-                        first_child.push(0);
-                        child_count.push(0);
-                        start += c;
-                        child_count[n] += 1;
-                    }
+            if shape.splits(e - s, d) {
+                split(&mut order[s..e], &centroids, shape, &mut parts);
+                first_child[n] = tri_start.len() as u32;
+                child_count[n] = parts.len() as u8;
+                for &(ps, pe) in &parts {
+                    tri_start.push((s + ps) as u32);
+                    tri_end.push((s + pe) as u32);
+                    depth.push(d as u8 + 1);
+                    parent.push(n as u32);
+                    first_child.push(0);
+                    child_count.push(0);
                 }
             }
             n += 1;
@@ -128,11 +113,13 @@ impl RegionTree {
             borrowed.extend_from_slice(&node_borrowed);
         }
         borrowed_start.push(borrowed.len() as u32);
+        let tri_vertex = std::array::from_fn(|k| tris.iter().map(|t| t[k]).collect());
 
         let tree = RegionTree {
-            levels,
+            shape,
             first_child,
             child_count,
+            parent,
             depth,
             tri_start,
             tri_end,
@@ -142,6 +129,7 @@ impl RegionTree {
             borrowed,
             level_start,
             tris,
+            tri_vertex,
             tri_order: order,
             vert_order,
             vert_slot,
@@ -152,24 +140,73 @@ impl RegionTree {
     }
 }
 
-/// Octant (bit 0: x, bit 1: y, bit 2: z above the midpoint) of each triangle's centroid,
-/// relative to the bounding box of the centroids of `tris`.
-fn octants(tris: &[u32], centroids: &[[f64; 3]]) -> Vec<u8> {
+impl TreeShape {
+    /// Whether a node of `count` triangles at depth `depth` is split.
+    fn splits(self, count: usize, depth: usize) -> bool {
+        match self {
+            TreeShape::Adaptive { leaf_size } => count > leaf_size,
+            TreeShape::Levels(levels) => depth + 1 < levels && count > 1,
+        }
+    }
+
+    /// Whether a part of `count` triangles, inside a node being split, is cut again.
+    fn cuts(self, count: usize) -> bool {
+        match self {
+            TreeShape::Adaptive { leaf_size } => count > leaf_size,
+            TreeShape::Levels(_) => count > 1,
+        }
+    }
+}
+
+/// Permutes `run` (triangle ids) into up to [`MAX_CHILDREN`] consecutive parts and writes
+/// their `(start, end)` offsets, in order, into `parts`. Always at least two parts
+/// (`run` has at least two triangles).
+fn split(
+    run: &mut [u32],
+    centroids: &[[f64; 3]],
+    shape: TreeShape,
+    parts: &mut Vec<(usize, usize)>,
+) {
+    debug_assert!(run.len() >= 2);
+    parts.clear();
+    parts.push((0, run.len()));
+    while parts.len() < MAX_CHILDREN {
+        // The largest part, if it is still to be cut (the first among equals).
+        let Some((i, &(s, e))) = parts
+            .iter()
+            .enumerate()
+            .filter(|(_, &(s, e))| shape.cuts(e - s))
+            .max_by_key(|(i, &(s, e))| (e - s, std::cmp::Reverse(*i)))
+        else {
+            break;
+        };
+        let mid = s + median_cut(&mut run[s..e], centroids);
+        parts[i] = (s, mid);
+        parts.insert(i + 1, (mid, e));
+    }
+}
+
+/// Reorders `run` so that its first `len / 2` triangles have centroids at or below the
+/// median along the longest axis of the centroids' box (ties by triangle id); returns
+/// `len / 2`.
+fn median_cut(run: &mut [u32], centroids: &[[f64; 3]]) -> usize {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for &t in tris {
+    for &t in run.iter() {
         let c = centroids[t as usize];
         for k in 0..3 {
             lo[k] = lo[k].min(c[k]);
             hi[k] = hi[k].max(c[k]);
         }
     }
-    let mid: [f64; 3] = std::array::from_fn(|k| lo[k] + 0.5 * (hi[k] - lo[k]));
-    tris.iter()
-        .map(|&t| {
-            let c = centroids[t as usize];
-            // `>`: an axis of zero extent never splits.
-            (c[0] > mid[0]) as u8 | ((c[1] > mid[1]) as u8) << 1 | ((c[2] > mid[2]) as u8) << 2
-        })
-        .collect()
+    let axis = (0..3)
+        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])).then(b.cmp(&a)))
+        .unwrap_or(0);
+    let mid = run.len() / 2;
+    run.select_nth_unstable_by(mid, |&a, &b| {
+        centroids[a as usize][axis]
+            .total_cmp(&centroids[b as usize][axis])
+            .then(a.cmp(&b))
+    });
+    mid
 }

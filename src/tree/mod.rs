@@ -1,8 +1,10 @@
-//! The region tree: one octree topology over the rest pose, shared by all three
-//! bounding-volume kinds so that they bound identical regions.
+//! The region tree: one topology over the rest pose, shared by all three bounding-volume
+//! kinds so that they bound identical regions. Each node has up to [`MAX_CHILDREN`]
+//! children (an octree's fan-out, so one SIMD block tests a node against all of them).
 //!
 //! Layout (all indices are `u32`):
-//! - nodes are numbered breadth-first, root `0`; the children of a node are contiguous;
+//! - nodes are numbered breadth-first, root `0`; the children of a node are contiguous
+//!   (a *sibling group*);
 //! - triangles are reordered so that every node's triangles are one contiguous run
 //!   `tri_range(n)` of the internal triangle array (leaves own triangles);
 //! - vertices are reordered by first appearance in that triangle order, so a node's vertex
@@ -17,17 +19,62 @@ pub use validate::TreeError;
 
 use std::ops::Range;
 
-/// Largest supported number of levels (root = level 0).
+use crate::error::{Error, Result};
+
+/// Largest supported number of levels of a fixed-depth tree (root = level 0).
 pub const MAX_LEVELS: usize = 16;
-/// The paper's choice: five levels.
-pub const DEFAULT_LEVELS: usize = 5;
+/// The paper's choice of fixed depth: five levels.
+pub const PAPER_LEVELS: usize = 5;
+/// Most children of a node: one block of the wide node tests.
+pub const MAX_CHILDREN: usize = 8;
+/// Default largest number of triangles in a leaf of an adaptive tree (chosen by
+/// measurement on real simulation frames: `docs/PERFORMANCE.md`).
+pub const DEFAULT_LEAF_SIZE: usize = 8;
+/// Largest accepted leaf size (larger leaves only make the narrow phase quadratic).
+pub const MAX_LEAF_SIZE: usize = 4096;
+
+/// How far the region tree is subdivided.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TreeShape {
+    /// Split every node holding more than `leaf_size` triangles (the default: the depth
+    /// follows the mesh).
+    Adaptive { leaf_size: usize },
+    /// The paper's fixed depth: split every node of two or more triangles above the last
+    /// of this many levels (root = level 0).
+    Levels(usize),
+}
+
+impl Default for TreeShape {
+    fn default() -> Self {
+        TreeShape::Adaptive {
+            leaf_size: DEFAULT_LEAF_SIZE,
+        }
+    }
+}
+
+impl TreeShape {
+    /// A typed error for a depth or leaf size out of range.
+    pub fn check(self) -> Result<()> {
+        match self {
+            TreeShape::Levels(levels) if levels == 0 || levels > MAX_LEVELS => {
+                Err(Error::InvalidLevels { got: levels })
+            }
+            TreeShape::Adaptive { leaf_size } if leaf_size == 0 || leaf_size > MAX_LEAF_SIZE => {
+                Err(Error::InvalidLeafSize { got: leaf_size })
+            }
+            _ => Ok(()),
+        }
+    }
+}
 
 /// The shared region hierarchy (topology and reordering only; no bounding volumes).
 #[derive(Clone, Debug)]
 pub struct RegionTree {
-    levels: usize,
+    shape: TreeShape,
     first_child: Vec<u32>,
     child_count: Vec<u8>,
+    /// Parent of each node (`u32::MAX` for the root).
+    parent: Vec<u32>,
     depth: Vec<u8>,
     tri_start: Vec<u32>,
     tri_end: Vec<u32>,
@@ -37,6 +84,8 @@ pub struct RegionTree {
     borrowed: Vec<u32>,
     level_start: Vec<u32>,
     tris: Vec<[u32; 3]>,
+    /// `tris` as three arrays of corner indices (the narrow phase's shared-vertex mask).
+    tri_vertex: [Vec<u32>; 3],
     tri_order: Vec<u32>,
     vert_order: Vec<u32>,
     vert_slot: Vec<u32>,
@@ -44,9 +93,21 @@ pub struct RegionTree {
 }
 
 impl RegionTree {
-    /// Number of levels requested at build (the actual depth may be smaller).
+    /// How the tree was subdivided.
+    pub fn shape(&self) -> TreeShape {
+        self.shape
+    }
+
+    /// Number of levels of the built tree (root = level 0; same as [`depth_count`]).
+    ///
+    /// [`depth_count`]: RegionTree::depth_count
     pub fn levels(&self) -> usize {
-        self.levels
+        self.depth_count()
+    }
+
+    /// Number of leaves.
+    pub fn leaf_count(&self) -> usize {
+        self.child_count.iter().filter(|&&c| c == 0).count()
     }
 
     pub fn node_count(&self) -> usize {
@@ -72,6 +133,13 @@ impl RegionTree {
     pub fn children(&self, n: usize) -> Range<usize> {
         let f = self.first_child[n] as usize;
         f..f + self.child_count[n] as usize
+    }
+
+    /// The parent of `n`, `None` for the root.
+    #[inline]
+    pub fn parent(&self, n: usize) -> Option<usize> {
+        let p = self.parent[n];
+        (p != u32::MAX).then_some(p as usize)
     }
 
     #[inline]
@@ -116,6 +184,12 @@ impl RegionTree {
         &self.tris
     }
 
+    /// Corner `k` of every internal triangle (`triangles()[t][k] == tri_vertex(k)[t]`).
+    #[inline]
+    pub fn tri_vertex(&self, k: usize) -> &[u32] {
+        &self.tri_vertex[k]
+    }
+
     /// Internal triangle index -> the caller's triangle index.
     #[inline]
     pub fn tri_order(&self) -> &[u32] {
@@ -153,6 +227,7 @@ impl RegionTree {
         use std::mem::size_of_val;
         size_of_val(&self.first_child[..])
             + size_of_val(&self.child_count[..])
+            + size_of_val(&self.parent[..])
             + size_of_val(&self.depth[..])
             + size_of_val(&self.tri_start[..])
             + size_of_val(&self.tri_end[..])

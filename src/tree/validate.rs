@@ -1,6 +1,6 @@
 //! Structural invariants of the region tree.
 
-use super::RegionTree;
+use super::{RegionTree, TreeShape, MAX_CHILDREN};
 use crate::mesh::Mesh;
 
 /// A broken structural invariant of a [`RegionTree`] (a bug in dhcd, never bad input).
@@ -29,8 +29,20 @@ impl RegionTree {
         {
             return fail(0, "triangle or vertex count differs from the mesh");
         }
-        if self.depth_count() > self.levels {
-            return fail(0, "deeper than the requested levels");
+        if let TreeShape::Levels(levels) = self.shape {
+            if self.depth_count() > levels {
+                return fail(0, "deeper than the requested levels");
+            }
+        }
+        if self.parent[0] != u32::MAX {
+            return fail(0, "the root has a parent");
+        }
+        for (k, corner) in self.tri_vertex.iter().enumerate() {
+            if corner.len() != self.tris.len()
+                || corner.iter().zip(&self.tris).any(|(&v, t)| t[k] != v)
+            {
+                return fail(0, format!("tri_vertex({k}) differs from the triangles"));
+            }
         }
         if self.tri_range(0) != (0..self.tris.len()) {
             return fail(0, "root does not own every triangle");
@@ -55,6 +67,18 @@ impl RegionTree {
                 if self.tri_range(n).is_empty() {
                     return fail(n, "empty region");
                 }
+                let count = self.tri_range(n).len();
+                if let TreeShape::Adaptive { leaf_size } = self.shape {
+                    if self.is_leaf(n) == (count > leaf_size) {
+                        return fail(
+                            n,
+                            format!("{count} triangles but leaf = {}", self.is_leaf(n)),
+                        );
+                    }
+                }
+                if self.child_count[n] as usize > MAX_CHILDREN || self.child_count[n] == 1 {
+                    return fail(n, "a split must make 2 to MAX_CHILDREN children");
+                }
                 if self.is_leaf(n) {
                     for t in self.tri_range(n) {
                         if std::mem::replace(&mut covered[t], true) {
@@ -64,7 +88,7 @@ impl RegionTree {
                 } else {
                     let mut next = self.tri_range(n).start;
                     for c in self.children(n) {
-                        if c >= nodes || self.depth(c) != d + 1 {
+                        if c >= nodes || self.depth(c) != d + 1 || self.parent(c) != Some(n) {
                             return fail(
                                 n,
                                 format!("child {c} out of range or at the wrong depth"),

@@ -23,5 +23,6 @@ pub fn run(args: CollideArgs) -> dhcd::Result<()> {
     let mut a = AnyHierarchy::new(q.method, &mesh_a, q.options())?;
     let mut b = AnyHierarchy::new(q.method, &mesh_b, q.options())?;
     let contacts = a.collide(&mut b, &mut Workspace::default(), Par::Seq)?;
-    q.report("contacts", &contacts.pairs, contacts.counters)
+    let levels = a.tree().levels().max(b.tree().levels());
+    q.report("contacts", levels, &contacts.pairs, contacts.counters)
 }

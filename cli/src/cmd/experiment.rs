@@ -14,7 +14,7 @@ pub struct ExperimentArgs {
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     frames: u64,
     /// Levels of the region trees (root = level 0).
-    #[arg(long, default_value_t = dhcd::tree::DEFAULT_LEVELS)]
+    #[arg(long, default_value_t = dhcd::tree::PAPER_LEVELS)]
     levels: usize,
     /// Methods to compare, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = Method::ALL, value_parser = super::method_parser(), ignore_case = true)]

@@ -40,5 +40,9 @@ pub fn run(args: SceneArgs) -> dhcd::Result<()> {
         scene.len(),
         contacts.per_pair.len()
     );
-    q.report(&what, &contacts.pairs, contacts.counters)
+    let mut levels = 0;
+    for id in scene.ids() {
+        levels = levels.max(scene.tree(id)?.levels());
+    }
+    q.report(&what, levels, &contacts.pairs, contacts.counters)
 }

@@ -19,5 +19,10 @@ pub fn run(args: SelfArgs) -> dhcd::Result<()> {
     let mesh = dhcd::io::load(&args.mesh)?;
     let mut h = AnyHierarchy::new(q.method, &mesh, q.options())?;
     let contacts = h.self_collide(&mut Workspace::default(), Par::Seq);
-    q.report("self-contacts", &contacts.pairs, contacts.counters)
+    q.report(
+        "self-contacts",
+        h.tree().levels(),
+        &contacts.pairs,
+        contacts.counters,
+    )
 }

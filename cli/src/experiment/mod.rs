@@ -35,7 +35,7 @@ use dhcd::hierarchy::Refit;
 use dhcd::mesh::Mesh;
 use dhcd::par::Par;
 use dhcd::traverse::Workspace;
-use dhcd::tree::{RegionTree, DEFAULT_LEVELS};
+use dhcd::tree::{RegionTree, TreeShape, PAPER_LEVELS};
 
 pub use cost::{Constant, Costs, Spread};
 
@@ -99,7 +99,7 @@ impl Default for Config {
     fn default() -> Self {
         Self {
             frames: 100,
-            levels: DEFAULT_LEVELS,
+            levels: PAPER_LEVELS,
             methods: Method::ALL.to_vec(),
             threads: 1,
             seed: 1,
@@ -344,7 +344,7 @@ pub fn run(
         .collect::<Result<_, _>>()?;
     let trees: Vec<Arc<RegionTree>> = meshes
         .iter()
-        .map(|m| RegionTree::build(m, config.levels).map(Arc::new))
+        .map(|m| RegionTree::build(m, TreeShape::Levels(config.levels)).map(Arc::new))
         .collect::<Result<_, _>>()?;
     let pairs = object_pairs(n);
 
