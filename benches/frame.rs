@@ -10,7 +10,7 @@
 //!   (divide by the printed `N_P` per frame for the cost per triangle pair).
 //!
 //! Scenes: `icospheres` (two overlapping 5,120-triangle icospheres, deformed by
-//! `dhcd::shapes::wave`) and `pawns8` (`dhcd::sim::pawn_scene`: eight 6,976-triangle pawns
+//! `dhcd::shapes::wave`) and `pawns8` (`dhcd_cli::sim::pawn_scene`: eight 6,976-triangle pawns
 //! pushed into each other by the mass-spring simulator, all 28 pairs per frame; simulated
 //! once in the setup, with dhcd's contacts fed back, and frames `PAWN_WARMUP..` kept). A
 //! cycle of `FRAMES` frames is computed once and each iteration applies the next one (lazy
@@ -86,7 +86,7 @@ impl Scene {
 
 /// The pawn scene: simulated once, contacts from dhcd (DH) fed back every frame.
 fn pawns() -> Scene {
-    use dhcd::sim::{pawn_scene, ObjectContact, SimConfig};
+    use dhcd_cli::sim::{pawn_scene, ObjectContact, SimConfig};
     let mut sim = pawn_scene(&SimConfig::default()).expect("pawn scene");
     let n = sim.object_count();
     let meshes: Vec<Mesh> = (0..n).map(|o| sim.mesh(o)).collect();

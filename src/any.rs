@@ -3,10 +3,11 @@
 
 use std::sync::Arc;
 
-use crate::bv::{Aabb, Dh, Method, Sphere};
+use crate::bv::Method;
 use crate::counters::Counters;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
+use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
 use crate::mesh::Mesh;
 use crate::par::Par;
 use crate::traverse::{
@@ -14,37 +15,25 @@ use crate::traverse::{
 };
 use crate::tree::RegionTree;
 
-/// A hierarchy of a kind chosen at run time.
-#[derive(Clone, Debug)]
-pub enum AnyHierarchy {
-    Dh(Hierarchy<Dh>),
-    Sphere(Hierarchy<Sphere>),
-    Aabb(Hierarchy<Aabb>),
-}
+kinds!(crate::kinds::kind_enum {
+    /// A hierarchy of a kind chosen at run time: one variant per row of the table of kinds
+    /// ([`crate::kinds`]).
+    #[derive(Clone, Debug)]
+    #[non_exhaustive]
+    pub enum AnyHierarchy(Hierarchy)
+});
 
 macro_rules! each {
     ($self:expr, $h:ident => $e:expr) => {
-        match $self {
-            AnyHierarchy::Dh($h) => $e,
-            AnyHierarchy::Sphere($h) => $e,
-            AnyHierarchy::Aabb($h) => $e,
-        }
+        match_kind!(AnyHierarchy, $self, $h => $e)
     };
 }
 
 /// Applies `$e` to two hierarchies of the same kind (bound as `$a`, `$b`); a
-/// [`Error::MethodMismatch`] when the kinds differ.
+/// [`crate::Error::MethodMismatch`] when the kinds differ.
 macro_rules! pairwise {
     ($x:expr, $y:expr, $a:ident, $b:ident => $e:expr) => {
-        match ($x, $y) {
-            (AnyHierarchy::Dh($a), AnyHierarchy::Dh($b)) => Ok($e),
-            (AnyHierarchy::Sphere($a), AnyHierarchy::Sphere($b)) => Ok($e),
-            (AnyHierarchy::Aabb($a), AnyHierarchy::Aabb($b)) => Ok($e),
-            (a, b) => Err(Error::MethodMismatch {
-                a: a.method(),
-                b: b.method(),
-            }),
-        }
+        match_kind_pair!(AnyHierarchy, $x, $y, $a, $b => $e)
     };
 }
 
@@ -60,15 +49,7 @@ impl AnyHierarchy {
         mesh: &Mesh,
         refit: Refit,
     ) -> Result<Self> {
-        Ok(match method {
-            Method::Dh => Self::Dh(Hierarchy::with_tree(tree, mesh, refit)?),
-            Method::Sphere => Self::Sphere(Hierarchy::with_tree(tree, mesh, refit)?),
-            Method::Aabb => Self::Aabb(Hierarchy::with_tree(tree, mesh, refit)?),
-        })
-    }
-
-    pub fn method(&self) -> Method {
-        each!(self, h => h.method())
+        Ok(with_kind!(method, K => Hierarchy::<K>::with_tree(tree, mesh, refit)?.into()))
     }
 
     pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {

@@ -28,11 +28,9 @@ impl<'h, K: BvKind> OriginalCorners<'h, K> {
     }
 
     pub(crate) fn get(&self, t: u32) -> Result<[[f32; 3]; 3]> {
-        let i = *self.slot.get(t as usize).ok_or_else(|| {
-            Error::InvalidOption(format!(
-                "contact names triangle {t}, but the mesh has only {} triangles",
-                self.slot.len()
-            ))
+        let i = *self.slot.get(t as usize).ok_or(Error::TriangleOutOfRange {
+            triangle: t.into(),
+            triangle_count: self.slot.len(),
         })?;
         let p = self.h.points();
         Ok(self.h.tree().triangles()[i as usize].map(|v| p.get(v as usize)))
@@ -42,8 +40,9 @@ impl<'h, K: BvKind> OriginalCorners<'h, K> {
 /// The intersection segment of every contact `[ta, tb]` (original indices) between `a` and
 /// `b`, in their current poses, in the order of `pairs`.
 ///
-/// Errors if a triangle index is out of range, or if a pair does not intersect in the
-/// current pose (contacts from an earlier pose).
+/// Errors: [`Error::TriangleOutOfRange`] for an index the mesh does not have,
+/// [`Error::StaleContact`] for a pair that does not intersect in the current pose (contacts
+/// from an earlier pose).
 ///
 /// ```
 /// use dhcd::{bv::Aabb, collide, detail::contact_segments, Hierarchy, Mesh, Options};
@@ -77,9 +76,5 @@ pub fn self_contact_segments<K: BvKind>(
 }
 
 pub(crate) fn segment(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], pair: [u32; 2]) -> Result<Segment> {
-    intersection_segment(a, b).ok_or_else(|| {
-        Error::InvalidOption(format!(
-            "triangles {pair:?} do not intersect in the current pose (stale contacts?)"
-        ))
-    })
+    intersection_segment(a, b).ok_or(Error::StaleContact { pair })
 }

@@ -5,13 +5,14 @@ use std::sync::Arc;
 
 use crate::bv::{BvKind, Method};
 use crate::error::{Error, Result};
-use crate::lazy::LazySoa;
 use crate::mesh::{check_positions, Mesh};
 use crate::points::Points;
 use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
+use dhcd_kernels::lazy::LazySoa;
 
 /// When bounding volumes follow a deformation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Refit {
     /// The paper's lazy evaluation: a node is refitted just before its first overlap test
     /// after a position update, and only if it is tested at all.
@@ -31,9 +32,7 @@ impl std::str::FromStr for Refit {
             "lazy" => Ok(Refit::Lazy),
             "eager" => Ok(Refit::Eager),
             "bottom-up" | "eager-bottom-up" => Ok(Refit::EagerBottomUp),
-            _ => Err(Error::InvalidOption(format!(
-                "unknown refit mode {s:?} (expected lazy, eager or bottom-up)"
-            ))),
+            _ => Err(Error::UnknownRefit(s.to_owned())),
         }
     }
 }
@@ -210,13 +209,12 @@ impl<K: BvKind> Hierarchy<K> {
         if tree.vertex_total() != mesh.vertex_count()
             || tree.triangle_total() != mesh.triangle_count()
         {
-            return Err(Error::InvalidOption(format!(
-                "region tree of {} vertices / {} triangles does not fit a mesh of {} / {}",
-                tree.vertex_total(),
-                tree.triangle_total(),
-                mesh.vertex_count(),
-                mesh.triangle_count()
-            )));
+            return Err(Error::TreeMismatch {
+                tree_vertices: tree.vertex_total(),
+                tree_triangles: tree.triangle_total(),
+                mesh_vertices: mesh.vertex_count(),
+                mesh_triangles: mesh.triangle_count(),
+            });
         }
         let points = Points::gather(mesh.positions(), tree.vert_order());
         let nodes = K::build(&tree, &points);
@@ -254,13 +252,13 @@ impl<K: BvKind> Hierarchy<K> {
 
     /// Refits the stale sibling groups of the nodes `ids` (each group once), as the lazy
     /// traversal does, counting the nodes fitted as updates. A node id out of range is an
-    /// [`Error::InvalidOption`] and nothing is refitted.
+    /// [`Error::NodeOutOfRange`] and nothing is refitted.
     pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) -> Result<()> {
         if let Some(&n) = ids.iter().find(|&&n| n as usize >= self.node_count()) {
-            return Err(Error::InvalidOption(format!(
-                "refit_nodes: node {n} out of range (the hierarchy has {} nodes)",
-                self.node_count()
-            )));
+            return Err(Error::NodeOutOfRange {
+                node: n,
+                node_count: self.node_count(),
+            });
         }
         let mut groups: Vec<usize> = ids
             .iter()

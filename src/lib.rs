@@ -20,27 +20,26 @@
 //! assert!(collide(&mut a, &mut b).pairs.is_empty());
 //! # Ok::<(), dhcd::Error>(())
 //! ```
-// Unsafe code lives only in the C ABI (`capi`), every block with a `// SAFETY:` comment.
-#![deny(unsafe_code)]
+//!
+//! This crate is the kernel library only; the C ABI (`dhcd-capi`), the command line with the
+//! paper's experiment and its simulator (`dhcd-cli`) and the Python package are crates of
+//! their own on top of it.
+#![forbid(unsafe_code)]
 
 pub mod any;
 pub mod bv;
-#[allow(unsafe_code)]
-pub mod capi;
 pub mod counters;
 pub mod detail;
 pub mod error;
-pub mod experiment;
 pub mod hierarchy;
 pub mod io;
-mod lazy;
+pub mod kinds;
 pub mod mesh;
 pub mod narrow;
 pub mod par;
 pub mod points;
 pub mod scene;
 pub mod shapes;
-pub mod sim;
 pub mod traverse;
 pub mod tree;
 

@@ -6,6 +6,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 /// How a query or refit runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Par {
     /// On the calling thread.
     #[default]

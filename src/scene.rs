@@ -22,11 +22,12 @@
 
 use rayon::prelude::*;
 
-use crate::bv::{Aabb, BvKind, Dh, Method, Sphere};
+use crate::bv::{BvKind, Method};
 use crate::counters::Counters;
 use crate::detail::{segment, OriginalCorners, Segment};
 use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, Options};
+use crate::kinds::{kinds, match_kind, with_kind};
 use crate::mesh::Mesh;
 use crate::par::Par;
 use crate::traverse::{collide_with, self_collide_with, Contacts, Workspace};
@@ -96,20 +97,17 @@ impl<K: BvKind> Object<K> {
     }
 }
 
-#[derive(Clone, Debug)]
-enum Objects {
-    Dh(Vec<Object<Dh>>),
-    Sphere(Vec<Object<Sphere>>),
-    Aabb(Vec<Object<Aabb>>),
-}
+/// The objects of one kind, sorted by id.
+type Objs<K> = Vec<Object<K>>;
+
+kinds!(crate::kinds::kind_enum {
+    #[derive(Clone, Debug)]
+    enum Objects(Objs)
+});
 
 macro_rules! each {
     ($self:expr, $v:ident => $e:expr) => {
-        match $self {
-            Objects::Dh($v) => $e,
-            Objects::Sphere($v) => $e,
-            Objects::Aabb($v) => $e,
-        }
+        match_kind!(Objects, $self, $v => $e)
     };
 }
 
@@ -146,11 +144,7 @@ pub struct Scene {
 impl Scene {
     /// An empty scene whose objects get hierarchies of kind `method` built with `options`.
     pub fn new(method: Method, options: Options) -> Self {
-        let objects = match method {
-            Method::Dh => Objects::Dh(Vec::new()),
-            Method::Sphere => Objects::Sphere(Vec::new()),
-            Method::Aabb => Objects::Aabb(Vec::new()),
-        };
+        let objects = with_kind!(method, K => Objs::<K>::new().into());
         Self {
             options,
             next_id: 0,
@@ -159,11 +153,7 @@ impl Scene {
     }
 
     pub fn method(&self) -> Method {
-        match self.objects {
-            Objects::Dh(_) => Method::Dh,
-            Objects::Sphere(_) => Method::Sphere,
-            Objects::Aabb(_) => Method::Aabb,
-        }
+        self.objects.method()
     }
 
     pub fn options(&self) -> Options {
@@ -265,12 +255,13 @@ impl Scene {
             let mut out = Vec::with_capacity(contacts.pairs.len());
             for &[oa, ta, ob, tb] in &contacts.pairs {
                 let (ia, ib) = (self.index(ObjectId(oa))?, self.index(ObjectId(ob))?);
-                let tri = |t: u64| {
-                    u32::try_from(t).map_err(|_| {
-                        Error::InvalidOption(format!("triangle index {t} out of range"))
+                let tri = |t: u64, i: usize| {
+                    u32::try_from(t).map_err(|_| Error::TriangleOutOfRange {
+                        triangle: t,
+                        triangle_count: v[i].h.tree().triangle_total(),
                     })
                 };
-                let (ta, tb) = (tri(ta)?, tri(tb)?);
+                let (ta, tb) = (tri(ta, ia)?, tri(tb, ib)?);
                 for i in [ia, ib] {
                     if cache[i].is_none() {
                         cache[i] = Some(OriginalCorners::new(&v[i].h));

@@ -187,7 +187,8 @@ pub fn broad_phase<K: BvKind>(
 
 /// The narrow phase alone: exact tests of every triangle pair of the given leaf pairs (node
 /// ids, as left in a [`Workspace`] by [`broad_phase`]). Counts `prim_tests` and `contacts`.
-/// A pair naming a node that is not a leaf of its hierarchy is an [`Error::InvalidOption`].
+/// A pair naming a node beyond its hierarchy is an [`Error::NodeOutOfRange`], one naming an
+/// internal node an [`Error::NotALeaf`].
 pub fn narrow_phase<K: BvKind>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
@@ -196,11 +197,14 @@ pub fn narrow_phase<K: BvKind>(
 ) -> Result<Contacts> {
     for &[la, lb] in leaves {
         for (h, n) in [(a, la), (b, lb)] {
-            if n as usize >= h.node_count() || !h.tree().is_leaf(n as usize) {
-                return Err(Error::InvalidOption(format!(
-                    "narrow_phase: node {n} is not a leaf (the hierarchy has {} nodes)",
-                    h.node_count()
-                )));
+            if n as usize >= h.node_count() {
+                return Err(Error::NodeOutOfRange {
+                    node: n,
+                    node_count: h.node_count(),
+                });
+            }
+            if !h.tree().is_leaf(n as usize) {
+                return Err(Error::NotALeaf { node: n });
             }
         }
     }

@@ -1,15 +1,9 @@
-//! One integration-test binary; each module is a suite.
+//! One integration-test binary; each module is a suite. (The CLI, experiment and simulator
+//! suites live in `cli/tests/`, the C ABI's in `capi/tests/`.)
 
-mod capi;
-#[cfg(feature = "cli")]
-mod cli;
-#[cfg(feature = "cli")]
-mod cli_collide;
-mod experiment;
 mod hierarchies;
 mod io;
+mod kinds;
 mod narrow;
 mod scene;
 mod self_collision;
-mod sim;
-mod support;

@@ -267,7 +267,22 @@ fn stale_contacts_are_an_error_for_segments() {
     scene
         .update_positions(b, &dhcd::shapes::translated(m.positions(), [9.0, 0.0, 0.0]))
         .unwrap();
-    assert!(scene.contact_segments(&c).is_err());
+    assert!(matches!(
+        scene.contact_segments(&c),
+        Err(Error::StaleContact { .. })
+    ));
+    // Triangle indices the mesh does not have, within u32 and beyond it.
+    for t in [m.triangle_count() as u64, u64::MAX] {
+        let mut bad = c.clone();
+        bad.pairs[0][1] = t;
+        assert_eq!(
+            scene.contact_segments(&bad),
+            Err(Error::TriangleOutOfRange {
+                triangle: t,
+                triangle_count: m.triangle_count()
+            })
+        );
+    }
     scene.remove(a).unwrap();
     assert_eq!(scene.contact_segments(&c), Err(Error::UnknownObject(0)));
 }

@@ -4,7 +4,9 @@
 use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
 use dhcd::narrow::brute_force_self_pairs;
 use dhcd::shapes::{grid, icosphere, wave};
-use dhcd::{self_collide, self_collide_with, Hierarchy, Mesh, Options, Par, Refit, Workspace};
+use dhcd::{
+    for_each_kind, self_collide, self_collide_with, Hierarchy, Mesh, Options, Par, Refit, Workspace,
+};
 
 fn with_positions(mesh: &Mesh, positions: Vec<[f32; 3]>) -> Mesh {
     Mesh::new(positions, mesh.triangles().to_vec()).unwrap()
@@ -62,9 +64,7 @@ fn check_all(rest: &Mesh, posed: &[[f32; 3]], levels: usize) -> usize {
             refit,
             ..Options::default()
         };
-        found = check::<Dh>(rest, posed, options).len();
-        check::<Sphere>(rest, posed, options);
-        check::<Aabb>(rest, posed, options);
+        for_each_kind!(K => found = check::<K>(rest, posed, options).len());
     }
     found
 }

@@ -27,6 +27,7 @@
 // iterator forms clippy suggests hide that layout.
 #![allow(clippy::needless_range_loop)]
 
+pub mod lazy;
 pub mod narrow;
 pub mod overlap;
 pub mod refit;

@@ -1,9 +1,9 @@
 //! Axis-aligned bounding boxes: min/max over the region's vertices (exact in f32).
 
 use super::{group_buffers, refit_groups, sealed, slot, BvKind, Method};
-use crate::lazy::LazySoa;
 use crate::points::Points;
 use crate::tree::RegionTree;
+use dhcd_kernels::lazy::LazySoa;
 use dhcd_kernels::{overlap, refit};
 
 /// The box node record: min and max corners — 24 bytes.

@@ -4,7 +4,7 @@
 //! The kind is a compile-time policy ([`BvKind`]); node data lives in structure-of-arrays
 //! buffers (one array per record field) whose sibling groups are contiguous, so one SIMD
 //! load covers the children of a node. [`Method`] names a kind where it is chosen at run
-//! time.
+//! time; every kind is a row of the table in [`crate::kinds`].
 
 mod aabb;
 mod dh;
@@ -14,9 +14,11 @@ pub use aabb::{Aabb, AabbNode, AabbNodes};
 pub use dh::{Dh, DhNode, DhNodes};
 pub use sphere::{Sphere, SphereNode, SphereNodes};
 
-use crate::lazy::LazySoa;
+pub use crate::kinds::Method;
+
 use crate::points::Points;
 use crate::tree::RegionTree;
+use dhcd_kernels::lazy::LazySoa;
 
 /// Relative inflation of every computed radius. Radii and overlap tests are evaluated in
 /// f32; each is off by a few ulps. Growing radii by 16 ulps keeps every sphere test
@@ -42,63 +44,14 @@ pub(crate) fn conservative_sum(a: f32, b: f32) -> f32 {
     ((a + b) * RADIUS_INFLATION).max(MIN_RADIUS)
 }
 
-/// The hierarchy kinds, for choosing one at run time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Method {
-    Dh,
-    Sphere,
-    Aabb,
-}
-
-impl Method {
-    pub const ALL: [Method; 3] = [Method::Dh, Method::Sphere, Method::Aabb];
-
-    /// The name used on the command line and in reports: `dh`, `sphere`, `aabb`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Dh => "dh",
-            Method::Sphere => "sphere",
-            Method::Aabb => "aabb",
-        }
-    }
-
-    /// Size of one node record: 8, 16 or 24 bytes.
-    pub fn bytes_per_node(self) -> usize {
-        match self {
-            Method::Dh => std::mem::size_of::<DhNode>(),
-            Method::Sphere => std::mem::size_of::<SphereNode>(),
-            Method::Aabb => std::mem::size_of::<AabbNode>(),
-        }
-    }
-}
-
-impl std::fmt::Display for Method {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Method {
-    type Err = crate::Error;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "dh" => Ok(Method::Dh),
-            "sphere" | "sbv" => Ok(Method::Sphere),
-            "aabb" => Ok(Method::Aabb),
-            _ => Err(crate::Error::InvalidOption(format!(
-                "unknown method {s:?} (expected dh, sphere or aabb)"
-            ))),
-        }
-    }
-}
-
 mod sealed {
     pub trait Sealed {}
 }
 
 /// A bounding-volume kind: its node record, its SoA buffers, how to fit a node to the
-/// current pose, and the wide overlap test. Sealed: the three kinds are the set the library
-/// compares; everything generic over them is monomorphised (no per-node dispatch).
+/// current pose, and the wide overlap test. Sealed: the kinds are the rows of the table in
+/// [`crate::kinds`], the set the library compares; everything generic over them is
+/// monomorphised (no per-node dispatch).
 ///
 /// Node bounds live in [`LazySoa`] buffers grouped by *sibling group* (the children of one
 /// node, [`RegionTree::group_nodes`]): a group is fitted as a whole, just before its first

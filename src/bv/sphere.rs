@@ -3,9 +3,9 @@
 
 use super::{conservative_radius, conservative_sum, dist2_f64, group_buffers, refit_groups, slot};
 use super::{sealed, BvKind, Method};
-use crate::lazy::LazySoa;
 use crate::points::Points;
 use crate::tree::RegionTree;
+use dhcd_kernels::lazy::LazySoa;
 use dhcd_kernels::{overlap, refit};
 
 /// The sphere node record: centre and radius — 16 bytes.

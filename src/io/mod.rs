@@ -33,6 +33,7 @@ pub use stl::parse_stl;
 
 /// The mesh file formats `dhcd` reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Format {
     /// Wavefront OBJ (text).
     Obj,

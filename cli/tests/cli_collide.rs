@@ -24,7 +24,8 @@ fn collide_json_equals_brute_force_for_every_method() {
     write(&b, &pb);
     let expected = brute_force_pairs(&a, &b);
     assert!(!expected.is_empty());
-    for (method, bytes) in [("dh", 8), ("sphere", 16), ("aabb", 24)] {
+    for m in dhcd::Method::ALL {
+        let (method, bytes) = (m.name(), m.bytes_per_node());
         for levels in ["1", "5"] {
             let out = dhcd(&[
                 "collide",

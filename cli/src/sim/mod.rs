@@ -23,6 +23,45 @@ pub use pawn::{pawn_mesh, pawn_mesh_with, PAWN_HEIGHT, PAWN_RINGS, PAWN_SEGMENTS
 pub use scene::{pawn_scene, scene_with_mesh, SCENE_OBJECTS};
 pub use simulation::{SimConfig, Simulation};
 
+/// What the simulator rejects: a parameter out of its range, an unstable configuration, an
+/// empty scene, or a mesh the library rejects.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimError {
+    #[error("{name} must be {expected}, got {value}")]
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        expected: &'static str,
+    },
+    #[error("shape_stiffness {stiffness} is unstable at substep {substep} s; use more substeps")]
+    Unstable { stiffness: f64, substep: f64 },
+    #[error("a simulation needs at least one object")]
+    NoObjects,
+    #[error("too many objects ({0})")]
+    TooManyObjects(usize),
+    #[error(transparent)]
+    Mesh(#[from] dhcd::Error),
+}
+
+/// A [`SimError::InvalidParameter`] unless `ok`.
+pub(crate) fn check(
+    ok: bool,
+    name: &'static str,
+    value: f64,
+    expected: &'static str,
+) -> Result<(), SimError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(SimError::InvalidParameter {
+            name,
+            value,
+            expected,
+        })
+    }
+}
+
 /// One intersecting triangle pair between two objects, as reported by the collision kernel.
 ///
 /// Triangle indices are indices into the objects' original meshes. The order of a list of

@@ -6,8 +6,8 @@ use serde_json::json;
 
 #[derive(clap::Args, Debug)]
 pub struct QueryArgs {
-    /// Bounding-volume hierarchy: dh, sphere or aabb.
-    #[arg(long, default_value = "dh")]
+    /// Bounding-volume hierarchy.
+    #[arg(long, default_value_t = Method::Dh, value_parser = super::method_parser(), ignore_case = true)]
     pub method: Method,
     /// A fixed depth for the region tree (root = level 0; the paper uses 5). Default: an
     /// adaptive tree.

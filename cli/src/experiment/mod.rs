@@ -21,30 +21,39 @@
 //! Results do not depend on the thread count (counters and contacts; times do).
 
 pub mod cost;
-#[cfg(feature = "cli")]
 pub mod output;
 
 use std::sync::Arc;
 use std::time::Instant;
 
-use crate::any::AnyHierarchy;
-use crate::bv::Method;
-use crate::counters::Counters;
-use crate::error::Error;
-use crate::hierarchy::Refit;
-use crate::mesh::Mesh;
-use crate::par::Par;
-use crate::sim::{pawn_scene, scene_with_mesh, ObjectContact, SimConfig, Simulation};
-use crate::traverse::Workspace;
-use crate::tree::{RegionTree, TreeShape, PAPER_LEVELS};
+use crate::sim::{pawn_scene, scene_with_mesh, ObjectContact, SimConfig, SimError, Simulation};
+use dhcd::any::AnyHierarchy;
+use dhcd::bv::Method;
+use dhcd::counters::Counters;
+use dhcd::error::Error;
+use dhcd::hierarchy::Refit;
+use dhcd::mesh::Mesh;
+use dhcd::par::Par;
+use dhcd::traverse::Workspace;
+use dhcd::tree::{RegionTree, TreeShape, PAPER_LEVELS};
 
 pub use cost::{Constant, Costs, Spread};
 
 /// What can stop the experiment.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ExperimentError {
     #[error(transparent)]
     Dhcd(#[from] Error),
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// A count of the [`Config`] that must be at least 1 (frames, threads, repetitions).
+    #[error("{0} must be at least 1")]
+    ZeroCount(&'static str),
+    #[error("at least one method is needed")]
+    NoMethods,
+    #[error("method {0} is listed twice")]
+    DuplicateMethod(Method),
     /// Two methods found different contacts on the same frames: impossible for exact
     /// conservative hierarchies, so a bug in dhcd.
     #[error(
@@ -113,24 +122,24 @@ impl Config {
         }
     }
 
-    fn check(&self) -> Result<(), Error> {
-        let bad = |m: String| Err(Error::InvalidOption(m));
-        if self.frames == 0 {
-            return bad("frames must be at least 1".into());
-        }
-        if self.threads == 0 {
-            return bad("threads must be at least 1".into());
+    fn check(&self) -> Result<(), ExperimentError> {
+        let counts = [
+            ("frames", self.frames),
+            ("threads", self.threads),
+            ("timing_reps", self.timing_reps),
+            ("calibration_reps", self.calibration_reps),
+            ("calibration_frames", self.calibration_frames),
+        ];
+        if let Some((name, _)) = counts.into_iter().find(|&(_, n)| n == 0) {
+            return Err(ExperimentError::ZeroCount(name));
         }
         if self.methods.is_empty() {
-            return bad("at least one method is needed".into());
+            return Err(ExperimentError::NoMethods);
         }
-        for (k, m) in self.methods.iter().enumerate() {
-            if self.methods[..k].contains(m) {
-                return bad(format!("method {m} is listed twice"));
+        for (k, &m) in self.methods.iter().enumerate() {
+            if self.methods[..k].contains(&m) {
+                return Err(ExperimentError::DuplicateMethod(m));
             }
-        }
-        if self.timing_reps == 0 || self.calibration_reps == 0 || self.calibration_frames == 0 {
-            return bad("repetition counts must be at least 1".into());
         }
         Ok(())
     }
@@ -138,6 +147,7 @@ impl Config {
 
 /// The phases of [`run`], for progress reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Phase {
     Simulate,
     /// Measurement, with the calibration interleaved.

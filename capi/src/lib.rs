@@ -1,4 +1,5 @@
-//! The C ABI (`include/dhcd.h`; see `docs/LINKING_FROM_C.md`).
+//! The C ABI of dhcd (`include/dhcd.h`; see `docs/LINKING_FROM_C.md`): the only `unsafe` code
+//! of the project outside the SIMD kernels.
 //!
 //! Conventions:
 //! - every fallible function returns an `int`: [`DHCD_OK`] (0) or a negative `DHCD_ERR_*`
@@ -19,16 +20,17 @@ use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use crate::any::AnyHierarchy;
-use crate::bv::Method;
-use crate::counters::Counters;
-use crate::error::Error;
-use crate::hierarchy::Options;
-use crate::mesh::Mesh;
-use crate::par::Par;
-use crate::scene::{ObjectId, Scene};
-use crate::traverse::{Contacts, Workspace};
+use dhcd::any::AnyHierarchy;
+use dhcd::bv::Method;
+use dhcd::counters::Counters;
+use dhcd::error::Error;
+use dhcd::hierarchy::Options;
+use dhcd::mesh::Mesh;
+use dhcd::par::Par;
+use dhcd::scene::{ObjectId, Scene};
+use dhcd::traverse::{Contacts, Workspace};
 
+/// Success.
 pub const DHCD_OK: c_int = 0;
 /// A required pointer argument is null.
 pub const DHCD_ERR_NULL: c_int = -1;
@@ -49,9 +51,9 @@ pub const DHCD_ERR_STALE_CONTACT: c_int = -7;
 /// A bug in dhcd (a caught panic).
 pub const DHCD_ERR_PANIC: c_int = -8;
 
-pub const DHCD_METHOD_DH: c_int = 0;
-pub const DHCD_METHOD_SPHERE: c_int = 1;
-pub const DHCD_METHOD_AABB: c_int = 2;
+// The kinds' numbers (`DHCD_METHOD_DH` = 0, ...) are not constants here: they are
+// `Method::code()`, from the library's table of kinds, and the header's `DHCD_METHOD_*`
+// defines are generated from that table with the rest of the header (capi/tests/capi.rs).
 
 /// Counted work of a query (the cost model's `N_V`, `N_P`, `N_U`, and the contacts).
 #[repr(C)]
@@ -100,7 +102,7 @@ pub struct DhcdHierarchy {
     ws: Workspace,
 }
 
-/// Opaque: a [`Scene`].
+/// Opaque: a scene of many objects.
 pub struct DhcdScene {
     scene: Scene,
 }
@@ -125,11 +127,20 @@ impl From<Error> for Fail {
             Error::WrongVertexCount { .. } => DHCD_ERR_LENGTH_MISMATCH,
             Error::MethodMismatch { .. } => DHCD_ERR_WRONG_KIND,
             Error::UnknownObject(_) => DHCD_ERR_UNKNOWN_OBJECT,
+            Error::StaleContact { .. } => DHCD_ERR_STALE_CONTACT,
             Error::InvalidLevels { .. }
+            | Error::UnknownMethod(_)
+            | Error::UnknownRefit(_)
+            | Error::NodeOutOfRange { .. }
+            | Error::NotALeaf { .. }
+            | Error::TreeMismatch { .. }
+            | Error::TriangleOutOfRange { .. }
             | Error::InvalidLeafSize { .. }
-            | Error::InvalidOption(_)
             | Error::Io { .. }
             | Error::Parse { .. } => DHCD_ERR_INVALID_ARGUMENT,
+            // `Error` is non-exhaustive: a variant added later is a bad argument until it
+            // gets a code of its own.
+            _ => DHCD_ERR_INVALID_ARGUMENT,
         };
         Fail(code, e.to_string())
     }
@@ -228,24 +239,17 @@ unsafe fn write<T>(ptr: *mut T, value: T, what: &str) -> Result<(), Fail> {
     Ok(())
 }
 
-fn method(m: c_int) -> Result<Method, Fail> {
-    match m {
-        DHCD_METHOD_DH => Ok(Method::Dh),
-        DHCD_METHOD_SPHERE => Ok(Method::Sphere),
-        DHCD_METHOD_AABB => Ok(Method::Aabb),
-        _ => Err(Fail(
+fn method_of(m: c_int) -> Result<Method, Fail> {
+    Method::from_code(m).ok_or_else(|| {
+        let names: Vec<String> = Method::ALL
+            .iter()
+            .map(|m| format!("DHCD_METHOD_{}", m.name().to_uppercase()))
+            .collect();
+        Fail(
             DHCD_ERR_INVALID_ARGUMENT,
-            format!("unknown method {m} (expected DHCD_METHOD_DH, _SPHERE or _AABB)"),
-        )),
-    }
-}
-
-fn method_code(m: Method) -> c_int {
-    match m {
-        Method::Dh => DHCD_METHOD_DH,
-        Method::Sphere => DHCD_METHOD_SPHERE,
-        Method::Aabb => DHCD_METHOD_AABB,
-    }
+            format!("unknown method {m} (expected one of {})", names.join(", ")),
+        )
+    })
 }
 
 /// `levels == 0`: the adaptive default tree; otherwise the paper's fixed depth.
@@ -329,7 +333,7 @@ pub extern "C" fn dhcd_last_error_message() -> *const c_char {
 /// The arrays must hold the stated number of elements; `out` must be valid for a write.
 #[no_mangle]
 pub unsafe extern "C" fn dhcd_hierarchy_new(
-    method_: c_int,
+    method: c_int,
     levels: u32,
     positions: *const f32,
     vertex_count: usize,
@@ -341,7 +345,7 @@ pub unsafe extern "C" fn dhcd_hierarchy_new(
         if out.is_null() {
             return Err(null("out"));
         }
-        let m = method(method_)?;
+        let m = method_of(method)?;
         // SAFETY: the caller's contract on the arrays.
         let mesh = unsafe { mesh(positions, vertex_count, triangles, triangle_count)? };
         let h = AnyHierarchy::new(m, &mesh, options(levels))?;
@@ -379,7 +383,7 @@ pub unsafe extern "C" fn dhcd_hierarchy_method(h: *const DhcdHierarchy, out: *mu
         // SAFETY: null or a live handle (caller's contract); only read.
         let h = unsafe { h.as_ref() }.ok_or_else(|| null("hierarchy"))?;
         // SAFETY: caller's contract on `out`.
-        unsafe { write(out, method_code(h.h.method()), "out") }
+        unsafe { write(out, h.h.method().code(), "out") }
     })
 }
 
@@ -493,12 +497,7 @@ pub unsafe extern "C" fn dhcd_contact_segments(
         if segments.is_null() {
             return Err(null("segments"));
         }
-        let segs = a.h.contact_segments(&b.h, pairs).map_err(|e| match e {
-            Error::InvalidOption(m) if m.contains("do not intersect") => {
-                Fail(DHCD_ERR_STALE_CONTACT, m)
-            }
-            e => e.into(),
-        })?;
+        let segs = a.h.contact_segments(&b.h, pairs)?;
         for (k, s) in segs.iter().enumerate() {
             let flat = [s[0][0], s[0][1], s[0][2], s[1][0], s[1][1], s[1][2]];
             // SAFETY: `segments` has room for `6 * count` floats (caller's contract) and
@@ -536,7 +535,7 @@ pub unsafe extern "C" fn dhcd_contacts_free(c: *mut DhcdContacts) {
 /// `out` null or valid for a write.
 #[no_mangle]
 pub unsafe extern "C" fn dhcd_scene_new(
-    method_: c_int,
+    method: c_int,
     levels: u32,
     out: *mut *mut DhcdScene,
 ) -> c_int {
@@ -544,7 +543,7 @@ pub unsafe extern "C" fn dhcd_scene_new(
         if out.is_null() {
             return Err(null("out"));
         }
-        let m = method(method_)?;
+        let m = method_of(method)?;
         options(levels).shape().check()?;
         let s = Box::new(DhcdScene {
             scene: Scene::new(m, options(levels)),

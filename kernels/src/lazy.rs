@@ -2,7 +2,7 @@
 //! filled lazily, at most once per *epoch*, by whichever thread needs them first, and read
 //! by any number of threads afterwards.
 //!
-//! This is what lets the lazy refit run inside a parallel traversal: node bounds are
+//! In `dhcd`, this is what lets the lazy refit run inside a parallel traversal: node bounds are
 //! refitted one sibling group at a time (the block a wide test reads), triangle data one
 //! leaf at a time, each exactly once per step whatever the thread count, so the work done
 //! (and `N_U`) does not depend on scheduling. It is a `OnceLock` per group without the
@@ -15,10 +15,9 @@
 //! epoch, and the data of a current group is not written again before `&mut self` advances
 //! the epoch.
 //!
-//! Unsafe code is confined to this module; the invariants it relies on are checked at
-//! construction (groups are disjoint and in range) or held by the borrow checker (`&mut`
-//! for everything that writes outside a claim).
-#![allow(unsafe_code)]
+//! It lives in this crate so that the API crate can forbid unsafe code: the invariants it
+//! relies on are checked at construction (groups are disjoint and in range) or held by the
+//! borrow checker (`&mut` for everything that writes outside a claim).
 
 use std::cell::UnsafeCell;
 use std::ops::Range;

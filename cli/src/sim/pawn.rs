@@ -10,8 +10,8 @@
 
 use std::f64::consts::PI;
 
-use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use super::{check, SimError};
+use dhcd::mesh::Mesh;
 
 /// Rings of the paper-sized pawn (excluding the two poles).
 pub const PAWN_RINGS: usize = 32;
@@ -35,22 +35,21 @@ pub fn pawn_mesh() -> Mesh {
 /// similar heights everywhere (no slivers where the profile is nearly horizontal).
 ///
 /// Errors if `rings < 2`, `segments < 3`, or `height` is not finite and positive.
-pub fn pawn_mesh_with(rings: usize, segments: usize, height: f32) -> Result<Mesh> {
-    if rings < 2 {
-        return Err(Error::InvalidOption(format!(
-            "pawn needs at least 2 rings, got {rings}"
-        )));
-    }
-    if segments < 3 {
-        return Err(Error::InvalidOption(format!(
-            "pawn needs at least 3 segments, got {segments}"
-        )));
-    }
-    if !(height.is_finite() && height > 0.0) {
-        return Err(Error::InvalidOption(format!(
-            "pawn height must be positive and finite, got {height}"
-        )));
-    }
+pub fn pawn_mesh_with(rings: usize, segments: usize, height: f32) -> Result<Mesh, SimError> {
+    check(rings >= 2, "pawn rings", rings as f64, "at least 2")?;
+    check(
+        segments >= 3,
+        "pawn segments",
+        segments as f64,
+        "at least 3",
+    )?;
+    let finite_positive = height.is_finite() && height > 0.0;
+    check(
+        finite_positive,
+        "pawn height",
+        height.into(),
+        "finite and positive",
+    )?;
     let profile = resample_by_arc_length(&pawn_profile(), rings + 2);
     let h = f64::from(height);
 
@@ -84,7 +83,7 @@ pub fn pawn_mesh_with(rings: usize, segments: usize, height: f32) -> Result<Mesh
     for j in 0..segments {
         triangles.push([top, ring(rings - 1, j + 1), ring(rings - 1, j)]);
     }
-    Mesh::new(positions, triangles)
+    Ok(Mesh::new(positions, triangles)?)
 }
 
 /// The pawn's profile `(radius, height)` for a pawn of height 1, densely sampled from the

@@ -1,5 +1,5 @@
 /* dhcd from C: build meshes, deform, collide, self-collide, a scene; check and print.
- * Exits non-zero on any mismatch. Built and run by tests/c/run.sh. */
+ * Exits non-zero on any mismatch. Built and run by capi/tests/c/run.sh. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -4,14 +4,14 @@ use glam::DVec3;
 
 use super::pawn::pawn_mesh;
 use super::simulation::{splitmix64, SimConfig, Simulation};
-use crate::error::Result;
-use crate::mesh::Mesh;
+use super::SimError;
+use dhcd::mesh::Mesh;
 
 /// Number of objects in [`pawn_scene`] and [`scene_with_mesh`] (the paper's eight pawns).
 pub const SCENE_OBJECTS: usize = 8;
 
 /// Eight copies of [`pawn_mesh`] in two rows of four (see [`scene_with_mesh`]).
-pub fn pawn_scene(config: &SimConfig) -> Result<Simulation> {
+pub fn pawn_scene(config: &SimConfig) -> Result<Simulation, SimError> {
     scene_with_mesh(pawn_mesh(), config)
 }
 
@@ -25,7 +25,7 @@ pub fn pawn_scene(config: &SimConfig) -> Result<Simulation> {
 /// object ends up touching two to three neighbours. The seeded turn keeps the copies from
 /// being exact translates of each other (identical, perfectly aligned tessellations would
 /// make touching triangles coplanar far more often than in any real scene).
-pub fn scene_with_mesh(mesh: Mesh, config: &SimConfig) -> Result<Simulation> {
+pub fn scene_with_mesh(mesh: Mesh, config: &SimConfig) -> Result<Simulation, SimError> {
     let (lo, hi) = bounds(mesh.positions());
     let centre = DVec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
     let extent = hi - lo;

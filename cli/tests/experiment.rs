@@ -1,9 +1,9 @@
-//! `dhcd::experiment` and `dhcd experiment`: schema of the report, determinism (seed and
+//! `dhcd_cli::experiment` and `dhcd experiment`: schema of the report, determinism (seed and
 //! thread count), the command line and its files, bad flags.
 
-use dhcd::experiment::{output, run, Config, Report};
-use dhcd::sim::{pawn_mesh_with, PAWN_HEIGHT};
 use dhcd::Counters;
+use dhcd_cli::experiment::{output, run, Config, Report};
+use dhcd_cli::sim::{pawn_mesh_with, PAWN_HEIGHT};
 
 use crate::support::{run_dhcd as dhcd, temp_dir};
 
@@ -52,7 +52,7 @@ fn report_schema_and_contacts_agree() {
     let methods = json["methods"].as_object().unwrap();
     assert_eq!(
         methods.keys().collect::<Vec<_>>(),
-        ["dh", "sphere", "aabb"],
+        dhcd::Method::ALL.map(|m| m.name()),
         "methods in order"
     );
     for (name, m) in methods {
@@ -88,9 +88,9 @@ fn report_schema_and_contacts_agree() {
             }
         }
     }
-    assert_eq!(methods["dh"]["bytes_per_node"], 8);
-    assert_eq!(methods["sphere"]["bytes_per_node"], 16);
-    assert_eq!(methods["aabb"]["bytes_per_node"], 24);
+    for m in dhcd::Method::ALL {
+        assert_eq!(methods[m.name()]["bytes_per_node"], m.bytes_per_node());
+    }
     // Contacts per step are identical across methods, and the pawns do touch.
     let per_method: Vec<Vec<u64>> = report
         .methods

@@ -26,10 +26,10 @@
 
 use std::time::Instant;
 
-use crate::any::AnyHierarchy;
-use crate::counters::Counters;
-use crate::par::Par;
-use crate::traverse::Workspace;
+use dhcd::any::AnyHierarchy;
+use dhcd::counters::Counters;
+use dhcd::par::Par;
+use dhcd::traverse::Workspace;
 
 use super::{two_mut, ExperimentError};
 

@@ -1,12 +1,12 @@
-//! Tests of `dhcd::sim`: the pawn mesh, the simulator's stability, determinism and contact
+//! Tests of `dhcd_cli::sim`: the pawn mesh, the simulator's stability, determinism and contact
 //! response, and the eight-object scene.
 
 use std::collections::HashMap;
 
-use dhcd::sim::{
+use dhcd::Mesh;
+use dhcd_cli::sim::{
     pawn_mesh, pawn_mesh_with, pawn_scene, scene_with_mesh, ObjectContact, SimConfig, Simulation,
 };
-use dhcd::Mesh;
 use glam::DVec3;
 
 fn v(p: [f32; 3]) -> DVec3 {

@@ -48,8 +48,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::ObjectContact;
-use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use super::{check, SimError};
+use dhcd::mesh::Mesh;
 
 /// Parameters of [`Simulation`]. The defaults are tuned for the pawn scene: the pawns touch
 /// after about ten frames, dent each other and stay pressed together for hundreds of frames.
@@ -134,7 +134,7 @@ impl Default for SimConfig {
 }
 
 impl SimConfig {
-    fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<(), SimError> {
         let non_negative = [
             ("edge_stiffness", self.edge_stiffness),
             ("bend_stiffness", self.bend_stiffness),
@@ -153,11 +153,12 @@ impl SimConfig {
             ("drive_radius", self.drive_radius),
         ];
         for (name, value) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(Error::InvalidOption(format!(
-                    "{name} must be finite and non-negative, got {value}"
-                )));
-            }
+            check(
+                value.is_finite() && value >= 0.0,
+                name,
+                value,
+                "finite and non-negative",
+            )?;
         }
         let positive = [
             ("frame_dt", self.frame_dt),
@@ -165,27 +166,28 @@ impl SimConfig {
             ("max_speed", self.max_speed),
         ];
         for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(Error::InvalidOption(format!(
-                    "{name} must be finite and positive, got {value}"
-                )));
-            }
+            check(
+                value.is_finite() && value > 0.0,
+                name,
+                value,
+                "finite and positive",
+            )?;
         }
-        if !(0.0..=1.0).contains(&self.contact_body_share) {
-            return Err(Error::InvalidOption(format!(
-                "contact_body_share must be in 0..=1, got {}",
-                self.contact_body_share
-            )));
-        }
-        if self.substeps == 0 {
-            return Err(Error::InvalidOption("substeps must be at least 1".into()));
-        }
-        let h = self.frame_dt / f64::from(self.substeps);
+        let share = self.contact_body_share;
+        check(
+            (0.0..=1.0).contains(&share),
+            "contact_body_share",
+            share,
+            "in 0..=1",
+        )?;
+        let substeps = f64::from(self.substeps);
+        check(self.substeps >= 1, "substeps", substeps, "at least 1")?;
+        let h = self.frame_dt / substeps;
         if h * h * self.shape_stiffness > 0.5 {
-            return Err(Error::InvalidOption(format!(
-                "shape_stiffness {} is unstable at substep {h} s; use more substeps",
-                self.shape_stiffness
-            )));
+            return Err(SimError::Unstable {
+                stiffness: self.shape_stiffness,
+                substep: h,
+            });
         }
         Ok(())
     }
@@ -256,15 +258,13 @@ pub struct Simulation {
 impl Simulation {
     /// Builds springs, masses and rest shapes for `objects` (their current positions are the
     /// rest shapes) at rest. Errors if there are no objects or the config is invalid.
-    pub fn new(objects: Vec<Mesh>, config: SimConfig) -> Result<Self> {
+    pub fn new(objects: Vec<Mesh>, config: SimConfig) -> Result<Self, SimError> {
         config.validate()?;
         if objects.is_empty() {
-            return Err(Error::InvalidOption(
-                "a simulation needs at least one object".into(),
-            ));
+            return Err(SimError::NoObjects);
         }
         if objects.len() > u32::MAX as usize {
-            return Err(Error::InvalidOption("too many objects".into()));
+            return Err(SimError::TooManyObjects(objects.len()));
         }
         let h = config.frame_dt / f64::from(config.substeps);
         let mut scale: f64 = 0.0;

@@ -43,7 +43,7 @@ fn self_json_equals_brute_force() {
     let path = write_obj("crumpled.obj", &crumpled);
     let expected = brute_force_self_pairs(&crumpled);
     assert!(!expected.is_empty());
-    for method in ["dh", "sphere", "aabb"] {
+    for method in dhcd::Method::ALL.map(|m| m.name()) {
         let (code, out, err) = dhcd(&[
             "self",
             path.to_str().unwrap(),

@@ -63,6 +63,14 @@ pub fn run() -> i32 {
     }
 }
 
+/// Parses a hierarchy kind: the names (and aliases) of the library's table of kinds, which
+/// `--help` lists.
+pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = dhcd::Method> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    let values = dhcd::Method::ALL.map(|m| PossibleValue::new(m.name()).aliases(m.aliases()));
+    PossibleValuesParser::new(values).try_map(|name| name.parse::<dhcd::Method>())
+}
+
 /// Writes `text` to standard output. A reader that went away (broken pipe, as in
 /// `dhcd collide a.obj b.obj | head`) is not an error: there is nobody left to tell.
 pub fn emit(text: &str) -> dhcd::Result<()> {

@@ -1,4 +1,4 @@
-//! Report writers (behind the `cli` feature): `report.json`, `report.md`, the SVG figures,
+//! Report writers: `report.json`, `report.md`, the SVG figures,
 //! and the summary table printed by `dhcd experiment`.
 
 pub mod svg;
@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use serde_json::{json, Value};
 
 use super::{cost::Constant, MethodReport, Report};
-use crate::bv::Method;
-use crate::error::{Error, Result};
+use dhcd::bv::Method;
+use dhcd::error::{Error, Result};
 
 /// Files written by [`write_all`], in order.
 pub const FILES: [&str; 8] = [
@@ -24,20 +24,13 @@ pub const FILES: [&str; 8] = [
     "predicted_vs_measured.svg",
 ];
 
-fn color(m: Method) -> &'static str {
-    match m {
-        Method::Dh => "#d62728",
-        Method::Sphere => "#1f77b4",
-        Method::Aabb => "#2ca02c",
-    }
-}
+/// Colours of the methods' curves, by position in [`Method::ALL`] (wrapping around).
+const PALETTE: [&str; 6] = [
+    "#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
+];
 
-fn label(m: Method) -> &'static str {
-    match m {
-        Method::Dh => "DH",
-        Method::Sphere => "sphere (SBV)",
-        Method::Aabb => "AABB",
-    }
+fn color(m: Method) -> &'static str {
+    PALETTE[m.index() % PALETTE.len()]
 }
 
 fn spread_json(c: &Constant) -> Value {
@@ -215,7 +208,7 @@ pub fn markdown(r: &Report) -> String {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {} | {} | {} | {} |",
-            label(m.method),
+            m.method.label(),
             t.bv_tests,
             t.prim_tests,
             t.bv_updates,
@@ -240,7 +233,7 @@ pub fn markdown(r: &Report) -> String {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {:.0} ns (range {:.0}–{:.0}) |",
-            label(m.method),
+            m.method.label(),
             spread_cell(&c.c_v),
             spread_cell(&c.c_p),
             spread_cell(&c.c_u),
@@ -260,7 +253,7 @@ pub fn markdown(r: &Report) -> String {
             let _ = writeln!(
                 md,
                 "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} |",
-                label(m.method),
+                m.method.label(),
                 f.frame,
                 f.counters.bv_tests,
                 f.counters.prim_tests,
@@ -290,7 +283,7 @@ pub fn markdown(r: &Report) -> String {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-            label(m.method),
+            m.method.label(),
             ms(t.bv_tests as f64 * c.c_v.value),
             ms(t.prim_tests as f64 * c.c_p.value),
             ms(t.bv_updates as f64 * c.c_u.value),
@@ -314,7 +307,7 @@ pub fn markdown(r: &Report) -> String {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} |",
-            label(m.method),
+            m.method.label(),
             m.bytes_per_node,
             m.bytes_per_hierarchy,
             m.bytes_all_hierarchies
@@ -344,7 +337,7 @@ fn per_step(r: &Report, f: impl Fn(&MethodReport, usize) -> f64) -> Vec<svg::Ser
     r.methods
         .iter()
         .map(|m| svg::Series {
-            name: label(m.method),
+            name: m.method.label(),
             color: color(m.method),
             dashed: false,
             values: (0..m.steps.len()).map(|i| f(m, i)).collect(),
@@ -359,7 +352,7 @@ pub fn figures(r: &Report) -> Vec<(&'static str, String)> {
     let mut pvm = Vec::new();
     for m in &r.methods {
         pvm.push(svg::Series {
-            name: label(m.method),
+            name: m.method.label(),
             color: color(m.method),
             dashed: false,
             values: m.steps.iter().map(|s| s.time_ns() / 1e6).collect(),

@@ -1,7 +1,7 @@
 //! The `dhcd` command line: `collide`, `experiment`, `self`, `scene`.
 
-mod cli;
+mod cmd;
 
 fn main() {
-    std::process::exit(cli::run());
+    std::process::exit(cmd::run());
 }

@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use dhcd::experiment::{self, output, Config, Phase};
 use dhcd::Method;
+use dhcd_cli::experiment::{self, output, Config, Phase};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(clap::Args, Debug)]
@@ -16,8 +16,8 @@ pub struct ExperimentArgs {
     /// Levels of the region trees (root = level 0).
     #[arg(long, default_value_t = dhcd::tree::PAPER_LEVELS)]
     levels: usize,
-    /// Methods to compare, comma-separated: dh, sphere, aabb.
-    #[arg(long, value_delimiter = ',', default_value = "dh,sphere,aabb")]
+    /// Methods to compare, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = Method::ALL, value_parser = super::method_parser(), ignore_case = true)]
     methods: Vec<Method>,
     /// Threads of each query (1: sequential). Counters and contacts do not depend on it.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1024))]

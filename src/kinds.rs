@@ -1,0 +1,250 @@
+//! The one table of bounding-volume kinds.
+//!
+//! Every run-time mapping of a kind follows from the rows of [`kinds!`]: the [`Method`] enum
+//! with its names (command line, Python, JSON reports), report labels and C ABI numbers, and
+//! the dispatch of [`AnyHierarchy`](crate::AnyHierarchy) and [`Scene`](crate::Scene). A
+//! fourth kind is one file in `bv/` implementing [`BvKind`] plus one row here.
+//!
+//! The table is a macro that hands its rows to a callback macro, so each user generates its
+//! code (an enum with a variant per kind, a `match` with an arm per kind) from the same rows.
+
+use crate::bv::BvKind;
+use crate::error::Error;
+
+/// `kinds!(path::to::callback { args })` calls `callback! { { args } rows }` with one row
+/// `(Kind, number, "name", [aliases], "label")` per kind: `Kind` is the kind's type in [`crate::bv`] and its [`Method`] variant;
+/// `number` its stable number in the C ABI (`DHCD_METHOD_*`); `"name"` its name on the
+/// command line, in Python and in JSON reports; `aliases` other names accepted when parsing;
+/// `"label"` its name in human-readable reports.
+///
+/// Exported (hidden) only because [`for_each_kind!`](crate::for_each_kind) expands to it.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __kinds {
+    ($($callback:tt)::+ { $($args:tt)* }) => {
+        $($callback)::+! { { $($args)* }
+            (Dh, 0, "dh", [], "DH")
+            (Sphere, 1, "sphere", ["sbv"], "sphere (SBV)")
+            (Aabb, 2, "aabb", [], "AABB")
+        }
+    };
+}
+pub(crate) use crate::__kinds as kinds;
+
+/// Runs `expr` once per kind of the table, in table order, with the type `K` naming the kind:
+/// generic code (tests, benchmarks) covers every kind, a kind added later included.
+///
+/// ```
+/// use dhcd::{bv::BvKind, for_each_kind, Hierarchy, Options};
+/// let mesh = dhcd::shapes::icosphere(1, 1.0, [0.0; 3]);
+/// let mut bytes = Vec::new();
+/// for_each_kind!(K => bytes.push(Hierarchy::<K>::new(&mesh, Options::default())?.bytes_per_node()));
+/// assert_eq!(bytes, [8, 16, 24]);
+/// # Ok::<(), dhcd::Error>(())
+/// ```
+#[macro_export]
+macro_rules! for_each_kind {
+    ($k:ident => $e:expr) => {
+        $crate::__kinds!($crate::__for_each_kind_arms { $k, $e })
+    };
+}
+
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __for_each_kind_arms {
+    ({ $k:ident, $e:expr } $(($kind:ident, $($rest:tt)*))*) => {
+        $({
+            type $k = $crate::bv::$kind;
+            $e;
+        })*
+    };
+}
+
+macro_rules! define_method {
+    ({} $(($kind:ident, $code:literal, $name:literal, [$($alias:literal),*], $label:literal))*) => {
+        /// A bounding-volume kind chosen at run time: one variant per row of the table of
+        /// kinds (see [`crate::kinds`]).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        #[non_exhaustive]
+        pub enum Method {
+            $(
+                #[doc = concat!("`", $name, "`: [`", stringify!($kind), "`](crate::bv::", stringify!($kind), ").")]
+                $kind,
+            )*
+        }
+
+        impl Method {
+            /// Every kind, in table order.
+            pub const ALL: [Method; [$($code),*].len()] = [$(Method::$kind),*];
+
+            /// The name on the command line, in Python and in JSON reports.
+            pub const fn name(self) -> &'static str {
+                match self { $(Method::$kind => $name,)* }
+            }
+
+            /// Other names accepted by [`Method::from_name`] (e.g. `sbv`, the paper's name).
+            pub const fn aliases(self) -> &'static [&'static str] {
+                match self { $(Method::$kind => &[$($alias),*],)* }
+            }
+
+            /// The name in human-readable reports.
+            pub const fn label(self) -> &'static str {
+                match self { $(Method::$kind => $label,)* }
+            }
+
+            /// The kind's number in the C ABI (`DHCD_METHOD_*`); stable across versions.
+            pub const fn code(self) -> i32 {
+                match self { $(Method::$kind => $code,)* }
+            }
+
+            /// The kind with C ABI number `code`.
+            pub const fn from_code(code: i32) -> Option<Method> {
+                match code {
+                    $($code => Some(Method::$kind),)*
+                    _ => None,
+                }
+            }
+
+            /// Size of one node record in bytes (8, 16, 24 for DH, sphere, AABB).
+            pub fn bytes_per_node(self) -> usize {
+                match self {
+                    $(Method::$kind => std::mem::size_of::<<crate::bv::$kind as BvKind>::Record>(),)*
+                }
+            }
+        }
+
+        // Each kind's `BvKind::METHOD` is its own row.
+        $(const _: () = assert!(matches!(<crate::bv::$kind as BvKind>::METHOD, Method::$kind));)*
+    };
+}
+kinds!(define_method {});
+
+impl Method {
+    /// The kind named `name` (case-insensitive; a name or an alias).
+    pub fn from_name(name: &str) -> Option<Method> {
+        let name = name.to_ascii_lowercase();
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == name || m.aliases().contains(&name.as_str()))
+    }
+
+    /// The names of all kinds, for messages: `dh, sphere, aabb`.
+    pub fn names() -> String {
+        Method::ALL.map(Method::name).join(", ")
+    }
+
+    /// Position in [`Method::ALL`] (e.g. to pick a colour from a palette).
+    pub fn index(self) -> usize {
+        Method::ALL.iter().position(|&m| m == self).unwrap_or(0)
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Method::from_name(s).ok_or_else(|| Error::UnknownMethod(s.to_owned()))
+    }
+}
+
+/// Defines `$vis enum $name` with one variant per kind, each holding `$wrap<Kind>` (a type
+/// alias or type with one parameter), plus `From<$wrap<Kind>>` and `method()`.
+macro_rules! kind_enum {
+    ({ $(#[$attr:meta])* $vis:vis enum $name:ident($wrap:ident) } $(($kind:ident, $($rest:tt)*))*) => {
+        $(#[$attr])*
+        $vis enum $name {
+            $($kind($wrap<crate::bv::$kind>),)*
+        }
+
+        $(impl From<$wrap<crate::bv::$kind>> for $name {
+            fn from(x: $wrap<crate::bv::$kind>) -> Self {
+                $name::$kind(x)
+            }
+        })*
+
+        impl $name {
+            /// The kind of the hierarchies inside.
+            $vis fn method(&self) -> crate::kinds::Method {
+                match self { $($name::$kind(_) => crate::kinds::Method::$kind,)* }
+            }
+        }
+    };
+}
+pub(crate) use kind_enum;
+
+/// `match_kind!(Enum, value, x => expr)`: `expr` with `x` bound to the contents of whichever
+/// variant `value` (an `Enum` defined by [`kind_enum!`], or a reference to one) holds.
+macro_rules! match_kind {
+    ($name:ident, $value:expr, $x:ident => $e:expr) => {
+        $crate::kinds::kinds!($crate::kinds::match_kind_arms {
+            $name,
+            $value,
+            $x,
+            $e
+        })
+    };
+}
+pub(crate) use match_kind;
+
+macro_rules! match_kind_arms {
+    ({ $name:ident, $value:expr, $x:ident, $e:expr } $(($kind:ident, $($rest:tt)*))*) => {
+        match $value {
+            $($name::$kind($x) => $e,)*
+        }
+    };
+}
+pub(crate) use match_kind_arms;
+
+/// `match_kind_pair!(Enum, a, b, x, y => expr)`: `Ok(expr)` with `x`, `y` bound to the
+/// contents of `a` and `b` when they hold the same kind, else [`Error::MethodMismatch`].
+macro_rules! match_kind_pair {
+    ($name:ident, $a:expr, $b:expr, $x:ident, $y:ident => $e:expr) => {
+        $crate::kinds::kinds!($crate::kinds::match_kind_pair_arms {
+            $name,
+            $a,
+            $b,
+            $x,
+            $y,
+            $e
+        })
+    };
+}
+pub(crate) use match_kind_pair;
+
+macro_rules! match_kind_pair_arms {
+    ({ $name:ident, $a:expr, $b:expr, $x:ident, $y:ident, $e:expr } $(($kind:ident, $($rest:tt)*))*) => {
+        match ($a, $b) {
+            $(($name::$kind($x), $name::$kind($y)) => Ok($e),)*
+            (a, b) => Err($crate::error::Error::MethodMismatch {
+                a: a.method(),
+                b: b.method(),
+            }),
+        }
+    };
+}
+pub(crate) use match_kind_pair_arms;
+
+/// `with_kind!(method, K => expr)`: `expr` with the type `K` naming the kind `method` names.
+macro_rules! with_kind {
+    ($method:expr, $k:ident => $e:expr) => {
+        $crate::kinds::kinds!($crate::kinds::with_kind_arms { $method, $k, $e })
+    };
+}
+pub(crate) use with_kind;
+
+macro_rules! with_kind_arms {
+    ({ $method:expr, $k:ident, $e:expr } $(($kind:ident, $($rest:tt)*))*) => {
+        match $method {
+            $($crate::kinds::Method::$kind => {
+                type $k = $crate::bv::$kind;
+                $e
+            })*
+        }
+    };
+}
+pub(crate) use with_kind_arms;
