@@ -3,8 +3,9 @@
 //! - `kernels/{sphere,aabb}_block/{scalar,simd}`: 4,096 wide node tests (one volume against
 //!   a block of 8, the children of an octree node), as the traversal calls them: the SIMD
 //!   body inside one dispatch (`*_with`), never dispatched per test. Throughput in BV pairs.
-//! - `kernels/{box,share,plane}_row/{scalar,simd}`: 1,024 narrow-phase rows (one triangle
-//!   against 8 or 64), throughput in triangle pairs.
+//! - `kernels/leaf_candidates{,_self}/{scalar,simd}`: the narrow phase's filter (boxes,
+//!   shared vertices, separating planes) on 1,024 pairs of leaves of 8 nearby triangles,
+//!   throughput in triangle pairs.
 //! - `kernels/<refit reduction>/{scalar,dispatched}/<n>`: refit reductions over `n` points.
 //!
 //! Inputs come from a seeded RNG and are generated once.
@@ -12,7 +13,7 @@
 //!     cargo bench --bench kernels -- --warm-up-time 1 --measurement-time 3
 #![allow(clippy::needless_range_loop)]
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use dhcd_kernels::narrow::{self, PlaneProbe};
+use dhcd_kernels::narrow::{self, Pairing, TriSoa};
 use dhcd_kernels::overlap::{self, AabbSoa, SphereSoa};
 use dhcd_kernels::pulp::{Simd, WithSimd};
 use dhcd_kernels::refit;
@@ -23,8 +24,9 @@ const SIZES: [usize; 2] = [1024, 16384];
 /// Blocks per node-test bench, and the block size (an octree's children).
 const BLOCKS: usize = 4096;
 const BLOCK: usize = 8;
-/// Rows per row-filter bench.
-const ROWS: usize = 1024;
+/// Leaf pairs per narrow-filter bench, and triangles per leaf.
+const LEAF_PAIRS: usize = 1024;
+const LEAF: usize = 8;
 
 /// xorshift64*.
 struct Rng(u64);
@@ -164,165 +166,102 @@ fn block_benches(c: &mut Criterion) {
     }
 }
 
-/// `ROWS` probe triangles and rows of 64 nearby triangles (boxes, corners, indices).
-struct Rows {
-    probes: Vec<[[f32; 3]; 3]>,
-    corner: Vec<[[Vec<f32>; 3]; 3]>,
-    boxes: Vec<[Vec<f32>; 6]>,
-    vertex: Vec<[Vec<u32>; 3]>,
+/// `LEAF_PAIRS` pairs of leaves of 8 nearby triangles (SoA, with corner indices), as
+/// the narrow phase meets them.
+struct LeafPairs {
+    corner: [[Vec<f32>; 3]; 3],
+    lo: [Vec<f32>; 3],
+    hi: [Vec<f32>; 3],
+    vertex: [Vec<u32>; 3],
 }
 
-impl Rows {
+impl LeafPairs {
     fn new(rng: &mut Rng) -> Self {
-        let tri = |rng: &mut Rng| {
+        let n = 2 * LEAF_PAIRS * LEAF;
+        let mut tris = Vec::with_capacity(n);
+        for _ in 0..LEAF_PAIRS {
             let c = [0; 3].map(|_| rng.f32_in(-1.0, 1.0));
-            [0; 3].map(|_| [0, 1, 2].map(|k| c[k] + rng.f32_in(-0.3, 0.3)))
-        };
-        let probes: Vec<_> = (0..ROWS).map(|_| tri(rng)).collect();
-        let rows: Vec<Vec<[[f32; 3]; 3]>> = (0..ROWS)
-            .map(|_| (0..narrow::MAX_ROW).map(|_| tri(rng)).collect())
-            .collect();
-        let corner = rows
-            .iter()
-            .map(|r| {
-                core::array::from_fn(|c| {
-                    core::array::from_fn(|k| r.iter().map(|t| t[c][k]).collect())
-                })
-            })
-            .collect();
-        let boxes = rows
-            .iter()
-            .map(|r| {
-                core::array::from_fn(|f| {
-                    r.iter()
-                        .map(|t| {
-                            let k = f % 3;
-                            if f < 3 {
-                                t[0][k].min(t[1][k]).min(t[2][k])
-                            } else {
-                                t[0][k].max(t[1][k]).max(t[2][k])
-                            }
-                        })
-                        .collect()
-                })
-            })
-            .collect();
-        let vertex = (0..ROWS)
-            .map(|_| [0; 3].map(|_| (0..narrow::MAX_ROW).map(|_| rng.below(4000)).collect()))
-            .collect();
-        Rows {
-            probes,
-            corner,
-            boxes,
-            vertex,
-        }
-    }
-    fn aabb(&self, k: usize, n: usize) -> AabbSoa<'_> {
-        let b = &self.boxes[k];
-        AabbSoa {
-            min_x: &b[0][..n],
-            min_y: &b[1][..n],
-            min_z: &b[2][..n],
-            max_x: &b[3][..n],
-            max_y: &b[4][..n],
-            max_z: &b[5][..n],
-        }
-    }
-    fn corners(&self, k: usize) -> [[&[f32]; 3]; 3] {
-        let c = &self.corner[k];
-        core::array::from_fn(|i| core::array::from_fn(|a| &c[i][a][..]))
-    }
-    fn vertices(&self, k: usize) -> [&[u32]; 3] {
-        let v = &self.vertex[k];
-        [&v[0][..], &v[1][..], &v[2][..]]
-    }
-    fn probe_box(&self, k: usize) -> ([f32; 3], [f32; 3]) {
-        let t = &self.probes[k];
-        (
-            [0, 1, 2].map(|a| t[0][a].min(t[1][a]).min(t[2][a])),
-            [0, 1, 2].map(|a| t[0][a].max(t[1][a]).max(t[2][a])),
-        )
-    }
-}
-
-#[derive(Clone, Copy)]
-enum RowKernel {
-    Box(usize),
-    Share,
-    Plane,
-}
-
-struct AllRows<'a> {
-    rows: &'a Rows,
-    kernel: RowKernel,
-    probes: &'a [PlaneProbe],
-}
-
-impl WithSimd for AllRows<'_> {
-    type Output = u32;
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> u32 {
-        let r = self.rows;
-        let mut hits = 0;
-        for k in 0..ROWS {
-            hits += match self.kernel {
-                RowKernel::Box(n) => {
-                    let (lo, hi) = r.probe_box(k);
-                    narrow::box_row_with(simd, lo, hi, r.aabb(k, n), n)
-                }
-                RowKernel::Share => {
-                    narrow::share_row_with(simd, [7, 70, 700], r.vertices(k), narrow::MAX_ROW)
-                }
-                RowKernel::Plane => {
-                    narrow::plane_row_with(simd, &self.probes[k], r.corners(k), u64::MAX)
-                }
+            for _ in 0..2 * LEAF {
+                let t: [[f32; 3]; 3] =
+                    [0; 3].map(|_| [0, 1, 2].map(|k| c[k] + rng.f32_in(-0.3, 0.3)));
+                tris.push(t);
             }
-            .count_ones();
         }
-        hits
+        LeafPairs {
+            corner: core::array::from_fn(|c| {
+                core::array::from_fn(|k| tris.iter().map(|t| t[c][k]).collect())
+            }),
+            lo: core::array::from_fn(|k| {
+                tris.iter()
+                    .map(|t| t[0][k].min(t[1][k]).min(t[2][k]))
+                    .collect()
+            }),
+            hi: core::array::from_fn(|k| {
+                tris.iter()
+                    .map(|t| t[0][k].max(t[1][k]).max(t[2][k]))
+                    .collect()
+            }),
+            vertex: core::array::from_fn(|_| (0..n).map(|_| rng.below(4000)).collect()),
+        }
+    }
+    /// Leaf `l` (of `2 * LEAF_PAIRS`).
+    fn leaf(&self, l: usize) -> TriSoa<'_> {
+        let r = l * LEAF..(l + 1) * LEAF;
+        let c = &self.corner;
+        TriSoa {
+            corner: core::array::from_fn(|i| core::array::from_fn(|k| &c[i][k][r.clone()])),
+            lo: core::array::from_fn(|k| &self.lo[k][r.clone()]),
+            hi: core::array::from_fn(|k| &self.hi[k][r.clone()]),
+            vertex: core::array::from_fn(|k| &self.vertex[k][r.clone()]),
+        }
     }
 }
 
-fn row_benches(c: &mut Criterion) {
-    let rows = Rows::new(&mut Rng::new(2));
-    let probes: Vec<PlaneProbe> = rows.probes.iter().map(PlaneProbe::new).collect();
-    for (name, kernel, n) in [
-        ("box_row_8", RowKernel::Box(8), 8),
-        ("box_row_64", RowKernel::Box(64), 64),
-        ("share_row", RowKernel::Share, 64),
-        ("plane_row", RowKernel::Plane, 64),
+struct AllLeafPairs<'a> {
+    leaves: &'a LeafPairs,
+    pairing: Pairing,
+}
+
+impl WithSimd for AllLeafPairs<'_> {
+    type Output = u64;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> u64 {
+        let mut rows = [0u64; LEAF];
+        let mut n = 0;
+        for p in 0..LEAF_PAIRS {
+            let (a, b) = (self.leaves.leaf(2 * p), self.leaves.leaf(2 * p + 1));
+            n += narrow::leaf_candidates_with(simd, a, LEAF, b, LEAF, self.pairing, &mut rows);
+            n += rows.iter().map(|r| r.count_ones() as u64).sum::<u64>();
+        }
+        n
+    }
+}
+
+fn leaf_benches(c: &mut Criterion) {
+    let leaves = LeafPairs::new(&mut Rng::new(2));
+    for (name, pairing) in [
+        ("leaf_candidates", Pairing::All),
+        ("leaf_candidates_self", Pairing::NoSharedVertex),
     ] {
         let mut g = c.benchmark_group(format!("kernels/{name}"));
-        g.throughput(Throughput::Elements((ROWS * n) as u64));
+        g.throughput(Throughput::Elements((LEAF_PAIRS * LEAF * LEAF) as u64));
         g.bench_function("scalar", |bench| {
             bench.iter(|| {
-                let mut hits = 0;
-                for k in 0..ROWS {
-                    hits += match kernel {
-                        RowKernel::Box(n) => {
-                            let (lo, hi) = rows.probe_box(k);
-                            narrow::box_row_scalar(lo, hi, rows.aabb(k, n), n)
-                        }
-                        RowKernel::Share => narrow::share_row_scalar(
-                            [7, 70, 700],
-                            rows.vertices(k),
-                            narrow::MAX_ROW,
-                        ),
-                        RowKernel::Plane => {
-                            narrow::plane_row_scalar(&probes[k], rows.corners(k), u64::MAX)
-                        }
-                    }
-                    .count_ones();
+                let mut rows = [0u64; LEAF];
+                let mut n = 0;
+                for p in 0..LEAF_PAIRS {
+                    let (a, b) = (leaves.leaf(2 * p), leaves.leaf(2 * p + 1));
+                    n += narrow::leaf_candidates_scalar(a, LEAF, b, LEAF, pairing, &mut rows);
+                    n += rows.iter().map(|r| r.count_ones() as u64).sum::<u64>();
                 }
-                black_box(hits)
+                black_box(n)
             })
         });
         g.bench_function("simd", |bench| {
             bench.iter(|| {
-                black_box(dhcd_kernels::arch().dispatch(AllRows {
-                    rows: black_box(&rows),
-                    kernel,
-                    probes: &probes,
+                black_box(dhcd_kernels::arch().dispatch(AllLeafPairs {
+                    leaves: black_box(&leaves),
+                    pairing,
                 }))
             })
         });
@@ -396,5 +335,5 @@ fn refit_benches(c: &mut Criterion) {
     );
 }
 
-criterion_group!(benches, block_benches, row_benches, refit_benches);
+criterion_group!(benches, block_benches, leaf_benches, refit_benches);
 criterion_main!(benches);

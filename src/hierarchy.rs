@@ -9,6 +9,7 @@ use crate::mesh::{check_positions, Mesh};
 use crate::points::Points;
 use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
 use dhcd_kernels::lazy::LazySoa;
+use dhcd_kernels::narrow::TriSoa;
 
 /// When bounding volumes follow a deformation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -119,36 +120,7 @@ pub(crate) struct TriCache {
 pub(crate) struct LeafTris<'a> {
     /// Number of triangles (the slices are longer: padding).
     pub(crate) len: usize,
-    pub(crate) corner: [[&'a [f32]; 3]; 3],
-    pub(crate) boxes: dhcd_kernels::overlap::AabbSoa<'a>,
-}
-
-impl<'a> LeafTris<'a> {
-    #[inline]
-    pub(crate) fn corners(&self, i: usize) -> [[f32; 3]; 3] {
-        let c = &self.corner;
-        [
-            [c[0][0][i], c[0][1][i], c[0][2][i]],
-            [c[1][0][i], c[1][1][i], c[1][2][i]],
-            [c[2][0][i], c[2][1][i], c[2][2][i]],
-        ]
-    }
-
-    /// Slots `range` of the leaf (for rows of leaves larger than one row).
-    #[inline]
-    pub(crate) fn slice(&self, range: std::ops::Range<usize>) -> Self {
-        let c = &self.corner;
-        let s = |v: &'a [f32]| -> &'a [f32] { &v[range.clone()] };
-        LeafTris {
-            len: self.len.saturating_sub(range.start).min(range.len()),
-            corner: [
-                [s(c[0][0]), s(c[0][1]), s(c[0][2])],
-                [s(c[1][0]), s(c[1][1]), s(c[1][2])],
-                [s(c[2][0]), s(c[2][1]), s(c[2][2])],
-            ],
-            boxes: self.boxes.slice(range.clone()),
-        }
-    }
+    pub(crate) soa: TriSoa<'a>,
 }
 
 impl TriCache {
@@ -161,7 +133,12 @@ impl TriCache {
 
     /// Leaf `leaf`'s triangles in the current pose, gathered first if stale.
     #[inline]
-    pub(crate) fn leaf<'a>(&'a self, tree: &RegionTree, p: &Points, leaf: usize) -> LeafTris<'a> {
+    pub(crate) fn leaf<'a>(
+        &'a self,
+        tree: &'a RegionTree,
+        p: &Points,
+        leaf: usize,
+    ) -> LeafTris<'a> {
         let g = tree.leaf_rank(leaf).expect("a leaf");
         let tris = tree.tri_range(leaf);
         let (f, _) = self.data.get_or_fill(g, |_, fields| {
@@ -178,18 +155,19 @@ impl TriCache {
                 }
             }
         });
-        let [c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z, min_x, min_y, min_z, max_x, max_y, max_z] =
-            f;
+        let [c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z, lx, ly, lz, hx, hy, hz] = f;
+        let slots = tree.leaf_slots(g);
         LeafTris {
             len: tris.len(),
-            corner: [[c0x, c0y, c0z], [c1x, c1y, c1z], [c2x, c2y, c2z]],
-            boxes: dhcd_kernels::overlap::AabbSoa {
-                min_x,
-                min_y,
-                min_z,
-                max_x,
-                max_y,
-                max_z,
+            soa: TriSoa {
+                corner: [[c0x, c0y, c0z], [c1x, c1y, c1z], [c2x, c2y, c2z]],
+                lo: [lx, ly, lz],
+                hi: [hx, hy, hz],
+                vertex: [
+                    &tree.slot_vertex(0)[slots.clone()],
+                    &tree.slot_vertex(1)[slots.clone()],
+                    &tree.slot_vertex(2)[slots],
+                ],
             },
         }
     }

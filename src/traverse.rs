@@ -30,7 +30,7 @@ use crate::bv::BvKind;
 use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
-use crate::narrow::leaves::{leaf_pair, LeafSide, Pairing};
+use crate::narrow::leaves::{leaf_pair, LeafSide, Leaves};
 use crate::par::Par;
 
 /// Result of a query: contacts as `[triangle of A, triangle of B]` in the caller's original
@@ -416,25 +416,18 @@ impl<K: BvKind> Walk<'_, K> {
             return;
         }
         fn side<K: BvKind>(h: &Hierarchy<K>, leaf: usize) -> LeafSide<'_> {
-            let t = h.tree();
-            let slots = t.leaf_slots(t.leaf_rank(leaf).unwrap_or_default());
             LeafSide {
                 tris: h.leaf_tris(leaf),
-                order: &t.tri_order()[t.tri_range(leaf)],
-                vertex: [
-                    &t.slot_vertex(0)[slots.clone()],
-                    &t.slot_vertex(1)[slots.clone()],
-                    &t.slot_vertex(2)[slots],
-                ],
+                order: &h.tree().tri_order()[h.tree().tri_range(leaf)],
             }
         }
-        let pairing = match (self.self_query, x == y) {
-            (false, _) => Pairing::Objects,
-            (true, false) => Pairing::SelfLeaves,
-            (true, true) => Pairing::SelfLeaf,
+        let leaves = match (self.self_query, x == y) {
+            (false, _) => Leaves::Objects,
+            (true, false) => Leaves::SelfDistinct,
+            (true, true) => Leaves::SelfSame,
         };
         let (sa, sb) = (side(self.a, x), side(self.b, y));
-        out.counters.prim_tests += leaf_pair(simd, &sa, &sb, pairing, &mut out.pairs);
+        out.counters.prim_tests += leaf_pair(simd, &sa, &sb, leaves, &mut out.pairs);
     }
 
     /// Depth-first from each of `seeds`.

@@ -80,16 +80,6 @@ pub(crate) mod lanes {
         }
     }
 
-    /// [`load_prefix`] for `f64`.
-    #[inline(always)]
-    pub fn load_prefix_f64<S: Simd>(simd: S, v: &[f64]) -> S::f64s {
-        if v.len() == S::F64_LANES {
-            S::as_simd_f64s(v).0[0]
-        } else {
-            simd.partial_load_f64s(v)
-        }
-    }
-
     /// [`load_prefix`] for `u32`.
     #[inline(always)]
     pub fn load_prefix_u32<S: Simd>(simd: S, v: &[u32]) -> S::u32s {
@@ -142,37 +132,6 @@ pub(crate) mod lanes {
             Some(unsafe { core::mem::transmute_copy::<S, pulp::x86::V3>(&simd) })
         } else {
             None
-        }
-    }
-
-    /// [`mask_bits`] for `f64` comparison masks.
-    #[inline(always)]
-    pub fn mask_bits64<S: Simd>(simd: S, m: S::m64s) -> u32 {
-        use core::mem::size_of;
-        #[cfg(target_arch = "x86_64")]
-        if let Some(v3) = as_v3(simd) {
-            let v: pulp::f64x4 = bytemuck::cast(m);
-            return v3.avx._mm256_movemask_pd(bytemuck::cast(v)) as u32;
-        }
-        let _ = simd;
-        if size_of::<S::m64s>() == size_of::<S::u64s>() && S::F64_LANES > 1 {
-            let v: S::u64s = bytemuck::cast(m);
-            let lanes: &[u64] = bytemuck::cast_slice(core::slice::from_ref(&v));
-            let mut bits = 0;
-            for (k, &x) in lanes.iter().enumerate() {
-                bits |= ((x >> 63) as u32) << k;
-            }
-            bits
-        } else if size_of::<S::m64s>() == 1 {
-            let v: u8 = bytemuck::cast(m);
-            v as u32
-        } else if size_of::<S::m64s>() == 2 {
-            let v: u16 = bytemuck::cast(m);
-            v as u32
-        } else {
-            let v: S::u64s = bytemuck::cast(m);
-            let lanes: &[u64] = bytemuck::cast_slice(core::slice::from_ref(&v));
-            (lanes[0] & 1) as u32
         }
     }
 

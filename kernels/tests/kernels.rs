@@ -345,8 +345,29 @@ fn check_block_special_values<S: Simd>(simd: S) {
                     let got = overlap::aabb_block_with(simd, ba.0, ba.1, aabb_soa(&b), n);
                     assert_eq!(got, (want as u32) << pos, "{simd:?} box case {ci} n={n}");
                 }
-                let got = narrow::box_row_with(simd, ba.0, ba.1, aabb_soa(&b), n);
-                assert_eq!(got, (want as u64) << pos, "{simd:?} row case {ci} n={n}");
+                // As triangles: the degenerate triangle (lo, hi, lo) has exactly this box
+                // and certifies no plane, so the candidate bit is the box test (for boxes a
+                // triangle can have: ordered, no NaN).
+                let tri = |bx: B| [bx.0, bx.1, bx.0];
+                let ordered = |bx: B| (0..3).all(|k| bx.0[k] <= bx.1[k]);
+                if !(ordered(ba) && ordered(bb)) {
+                    continue;
+                }
+                let mut row = vec![tri(([10.0; 3], [11.0; 3])); n];
+                row[pos] = tri(bb);
+                let rb = Tris::new(&row, 0);
+                let ra = Tris::new(&[tri(ba)], 100);
+                let mut out = [0u64; 1];
+                narrow::leaf_candidates_with(
+                    simd,
+                    ra.soa(),
+                    1,
+                    rb.soa(),
+                    n,
+                    narrow::Pairing::All,
+                    &mut out,
+                );
+                assert_eq!(out[0], (want as u64) << pos, "{simd:?} row case {ci} n={n}");
             }
         }
     }
@@ -375,50 +396,49 @@ fn oversized_block_is_refused() {
 }
 
 // ---------------------------------------------------------------------------------------
-// narrow: row filters
+// narrow: leaf candidates
 
-fn check_box_and_share_rows<S: Simd>(simd: S) {
-    let mut rng = Rng::new(3);
-    for every in [0, 4] {
-        for n in block_sizes(S::F32_LANES, narrow::MAX_ROW) {
-            let len = n.next_multiple_of(8).min(narrow::MAX_ROW);
-            let b = boxes(&mut rng, len, every);
-            let p = boxes(&mut rng, 1, every);
-            let (lo, hi) = aabb_soa(&p).get(0);
-            let got = narrow::box_row_with(simd, lo, hi, aabb_soa(&b), n);
-            assert_eq!(
-                got,
-                narrow::box_row_scalar(lo, hi, aabb_soa(&b), n),
-                "{simd:?} box row n={n}"
-            );
-            assert_eq!(got & !low64(n), 0, "bits past n");
-            let idx: [Vec<u32>; 3] =
-                std::array::from_fn(|_| (0..len).map(|_| rng.below(40) as u32).collect());
-            for _ in 0..8 {
-                let v = [
-                    rng.below(40) as u32,
-                    rng.below(40) as u32,
-                    rng.below(40) as u32,
-                ];
-                let row = [&idx[0][..], &idx[1][..], &idx[2][..]];
-                let got = narrow::share_row_with(simd, v, row, n);
-                assert_eq!(
-                    got,
-                    narrow::share_row_scalar(v, row, n),
-                    "{simd:?} share n={n}"
-                );
-                for j in 0..len {
-                    let shares = j < n && (0..3).any(|c| v.contains(&idx[c][j]));
-                    assert_eq!(got >> j & 1 == 1, shares);
-                }
-            }
-        }
-    }
+/// Triangles in SoA form with corner indices `first + 3t, first + 3t + 1, first + 3t + 2`.
+struct Tris {
+    corner: [[Vec<f32>; 3]; 3],
+    lo: [Vec<f32>; 3],
+    hi: [Vec<f32>; 3],
+    vertex: [Vec<u32>; 3],
 }
 
-#[test]
-fn box_and_share_rows_match_reference_on_all_backends() {
-    on_all_backends!(check_box_and_share_rows);
+impl Tris {
+    fn new(tris: &[[[f32; 3]; 3]], first: u32) -> Self {
+        let n = tris.len() as u32;
+        Tris {
+            corner: std::array::from_fn(|c| {
+                std::array::from_fn(|k| tris.iter().map(|t| t[c][k]).collect())
+            }),
+            lo: std::array::from_fn(|k| {
+                tris.iter()
+                    .map(|t| t[0][k].min(t[1][k]).min(t[2][k]))
+                    .collect()
+            }),
+            hi: std::array::from_fn(|k| {
+                tris.iter()
+                    .map(|t| t[0][k].max(t[1][k]).max(t[2][k]))
+                    .collect()
+            }),
+            vertex: std::array::from_fn(|c| (0..n).map(|t| first + 3 * t + c as u32).collect()),
+        }
+    }
+    fn soa(&self) -> narrow::TriSoa<'_> {
+        let c = &self.corner;
+        narrow::TriSoa {
+            corner: std::array::from_fn(|i| std::array::from_fn(|k| &c[i][k][..])),
+            lo: [&self.lo[0][..], &self.lo[1][..], &self.lo[2][..]],
+            hi: [&self.hi[0][..], &self.hi[1][..], &self.hi[2][..]],
+            vertex: [
+                &self.vertex[0][..],
+                &self.vertex[1][..],
+                &self.vertex[2][..],
+            ],
+        }
+    }
 }
 
 fn low64(n: usize) -> u64 {
@@ -429,19 +449,8 @@ fn low64(n: usize) -> u64 {
     }
 }
 
-/// Nine coordinate arrays `[corner][axis]` of `n` triangles.
-type TriRow = [[Vec<f32>; 3]; 3];
-
-fn tri_row(tris: &[[[f32; 3]; 3]]) -> TriRow {
-    std::array::from_fn(|c| std::array::from_fn(|k| tris.iter().map(|t| t[c][k]).collect()))
-}
-
-fn row_view(r: &TriRow) -> [[&[f32]; 3]; 3] {
-    std::array::from_fn(|c| std::array::from_fn(|k| &r[c][k][..]))
-}
-
-/// Random triangles near the origin, some nearly coplanar with the probe, some degenerate,
-/// some sharing corners with it, some with special values.
+/// Random triangles around the probe, at `scale`: some nearly coplanar with it (points of
+/// its plane nudged by a few ulps), some degenerate, some with special values.
 fn nasty_triangles(
     rng: &mut Rng,
     probe: &[[f32; 3]; 3],
@@ -453,7 +462,6 @@ fn nasty_triangles(
             let mut t: [[f32; 3]; 3] =
                 std::array::from_fn(|_| std::array::from_fn(|_| rng.f32_in(-1.0, 1.0) * scale));
             match i % 6 {
-                // A point of the probe's plane, nudged by a few ulps.
                 1 | 2 => {
                     for c in 0..3 {
                         let (s, u) = (rng.f32_in(-1.0, 2.0), rng.f32_in(-1.0, 2.0));
@@ -472,11 +480,7 @@ fn nasty_triangles(
                         }
                     }
                 }
-                // Degenerate: collinear or a point.
-                3 => {
-                    t[2] = t[1];
-                }
-                // Shares a corner with the probe.
+                3 => t[2] = t[1],
                 4 => t[rng.below(3)] = probe[rng.below(3)],
                 5 if i % 5 == 0 => t[0][0] = [f32::NAN, f32::INFINITY, f32::MAX][rng.below(3)],
                 _ => {}
@@ -486,33 +490,165 @@ fn nasty_triangles(
         .collect()
 }
 
-fn check_plane_row<S: Simd>(simd: S) {
+fn random_tris(rng: &mut Rng, n: usize, scale: f32) -> Vec<[[f32; 3]; 3]> {
+    let probe: [[f32; 3]; 3] =
+        std::array::from_fn(|_| std::array::from_fn(|_| rng.f32_in(-1.0, 1.0) * scale));
+    nasty_triangles(rng, &probe, n, scale)
+}
+
+const PAIRINGS: [narrow::Pairing; 3] = [
+    narrow::Pairing::All,
+    narrow::Pairing::NoSharedVertex,
+    narrow::Pairing::NoSharedVertexUpper,
+];
+
+fn check_leaf_candidates<S: Simd>(simd: S) {
     let mut rng = Rng::new(4);
     for scale in [1.0, 1e-30, 1e30, 3e-3] {
-        for n in block_sizes(S::F64_LANES, narrow::MAX_ROW) {
-            let probe: [[f32; 3]; 3] =
-                std::array::from_fn(|_| std::array::from_fn(|_| rng.f32_in(-1.0, 1.0) * scale));
-            let tris = nasty_triangles(&mut rng, &probe, n, scale);
-            let row = tri_row(&tris);
-            let pp = narrow::PlaneProbe::new(&probe);
-            for candidates in [u64::MAX, 0, 0x5555_5555_5555_5555, rng.next_u64()] {
-                let want = narrow::plane_row_scalar(&pp, row_view(&row), candidates);
-                let got = narrow::plane_row_with(simd, &pp, row_view(&row), candidates);
-                assert_eq!(got, want, "{simd:?} plane row n={n} scale={scale}");
-                let inside = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
-                assert_eq!(got & !(candidates & inside), 0, "keeps only candidates");
+        for nb in block_sizes(S::F32_LANES, narrow::MAX_ROW) {
+            for na in [0, 1, 7, 9, 64] {
+                // Padded blocks, and corner indices that collide across the two blocks (the
+                // second block's indices overlap the first's) so that sharing happens.
+                let len_b = nb.next_multiple_of(8).min(narrow::MAX_ROW);
+                let a = Tris::new(&random_tris(&mut rng, na, scale), 0);
+                let b = Tris::new(
+                    &random_tris(&mut rng, len_b, scale),
+                    3 * rng.below(8) as u32,
+                );
+                for pairing in PAIRINGS {
+                    let mut want = vec![7u64; na + 1];
+                    let mut got = vec![9u64; na + 1];
+                    let cw = narrow::leaf_candidates_scalar(
+                        a.soa(),
+                        na,
+                        b.soa(),
+                        nb,
+                        pairing,
+                        &mut want,
+                    );
+                    let cg = narrow::leaf_candidates_with(
+                        simd,
+                        a.soa(),
+                        na,
+                        b.soa(),
+                        nb,
+                        pairing,
+                        &mut got,
+                    );
+                    assert_eq!(
+                        (cg, &got[..na]),
+                        (cw, &want[..na]),
+                        "{simd:?} na={na} nb={nb} {pairing:?} scale={scale}"
+                    );
+                    assert_eq!(got[na], 9, "wrote past na rows");
+                    assert!(
+                        got[..na].iter().all(|r| r & !low64(nb) == 0),
+                        "bits past nb"
+                    );
+                    if pairing == narrow::Pairing::NoSharedVertexUpper {
+                        assert!(got[..na]
+                            .iter()
+                            .enumerate()
+                            .all(|(i, r)| r & low64(i + 1) == 0));
+                    }
+                }
             }
         }
     }
 }
 
 #[test]
-fn plane_row_matches_reference_on_all_backends() {
-    on_all_backends!(check_plane_row);
+fn leaf_candidates_match_reference_on_all_backends() {
+    on_all_backends!(check_leaf_candidates);
 }
 
-/// Exact sign of orient3d in rationals (f32 inputs are exact in i128 after scaling... not
-/// in general): computed here with the robust crate, which is exact for f64 inputs.
+#[test]
+fn dispatched_leaf_candidates_match_reference() {
+    let mut rng = Rng::new(9);
+    for _ in 0..50 {
+        let (na, nb) = (rng.below(65), rng.below(65));
+        let a = Tris::new(&random_tris(&mut rng, na, 1.0), 0);
+        let b = Tris::new(&random_tris(&mut rng, nb, 1.0), 3 * rng.below(20) as u32);
+        for pairing in PAIRINGS {
+            let (mut want, mut got) = (vec![0; na], vec![0; na]);
+            assert_eq!(
+                narrow::leaf_candidates(a.soa(), na, b.soa(), nb, pairing, &mut got),
+                narrow::leaf_candidates_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want)
+            );
+            assert_eq!(got, want);
+        }
+    }
+}
+
+/// Counting: every allowed pair once (`N_P`), whatever the boxes and planes say.
+#[test]
+fn leaf_candidates_count_allowed_pairs() {
+    // A strip in the plane z = 0: neighbours' boxes touch (x = t + 1), the others are apart.
+    let tris: Vec<[[f32; 3]; 3]> = (0..10)
+        .map(|t| {
+            let x = 2.0 * t as f32;
+            [[x, 0.0, 0.0], [x + 2.0, 1.0, 0.0], [x, 1.0, 0.0]]
+        })
+        .collect();
+    let a = Tris::new(&tris, 0);
+    let mut shared = Tris::new(&tris, 0);
+    shared.vertex[1][3] = 0; // triangle 3 of b shares vertex 0 with triangle 0 of a
+    let mut out = [0u64; 10];
+    assert_eq!(
+        narrow::leaf_candidates(a.soa(), 10, a.soa(), 10, narrow::Pairing::All, &mut out),
+        100
+    );
+    // The same block: each triangle shares its own three indices with itself only.
+    assert_eq!(
+        narrow::leaf_candidates(
+            a.soa(),
+            10,
+            a.soa(),
+            10,
+            narrow::Pairing::NoSharedVertex,
+            &mut out
+        ),
+        90
+    );
+    assert_eq!(
+        narrow::leaf_candidates(
+            a.soa(),
+            10,
+            a.soa(),
+            10,
+            narrow::Pairing::NoSharedVertexUpper,
+            &mut out
+        ),
+        45
+    );
+    assert_eq!(
+        narrow::leaf_candidates(
+            a.soa(),
+            10,
+            shared.soa(),
+            10,
+            narrow::Pairing::NoSharedVertex,
+            &mut out
+        ),
+        89
+    );
+    // Coplanar neighbours in one plane, boxes overlapping: kept for the exact test.
+    narrow::leaf_candidates(
+        a.soa(),
+        10,
+        a.soa(),
+        10,
+        narrow::Pairing::NoSharedVertexUpper,
+        &mut out,
+    );
+    assert_eq!(
+        out[0], 0b10,
+        "touching neighbour 1 kept, far ones dropped by the boxes"
+    );
+}
+
+/// Exact sign of `orient3d` (the robust crate is exact for f64 inputs, and f32 converts
+/// exactly).
 fn exact_side(p: &[[f32; 3]; 3], d: [f32; 3]) -> i32 {
     let c = |v: [f32; 3]| robust::Coord3D {
         x: v[0] as f64,
@@ -523,41 +659,50 @@ fn exact_side(p: &[[f32; 3]; 3], d: [f32; 3]) -> i32 {
     (o > 0.0) as i32 - (o < 0.0) as i32
 }
 
-/// The filter drops a pair only when one triangle is strictly on one side of the other's
-/// plane, decided exactly: checked against exact orientations on adversarial inputs.
+/// The plane filter drops a pair only when one triangle is strictly on one side of the
+/// other's plane, decided exactly: checked against exact orientations on adversarial
+/// inputs, from subnormal-producing to overflow-producing scales.
 #[test]
-fn plane_row_drops_only_certainly_separated_pairs() {
+fn plane_filter_drops_only_certainly_separated_pairs() {
     let mut rng = Rng::new(5);
-    let mut dropped = 0;
-    let mut total = 0;
-    for round in 0..400 {
-        let scale = [1.0, 1e-20, 1e20, 7e-4][round % 4];
+    // Drops among the plain random pairs (every sixth of `nasty_triangles`).
+    let (mut dropped, mut total) = (0, 0);
+    for round in 0..3000 {
+        let scale = [1.0, 1e-20, 1e20, 7e-4, 1e-38, 3e-44, 1e35][round % 7];
         let probe: [[f32; 3]; 3] =
             std::array::from_fn(|_| std::array::from_fn(|_| rng.f32_in(-1.0, 1.0) * scale));
-        let tris = nasty_triangles(&mut rng, &probe, 64, scale);
-        let row = tri_row(&tris);
-        let keep = narrow::plane_row(&narrow::PlaneProbe::new(&probe), row_view(&row), u64::MAX);
-        for (j, t) in tris.iter().enumerate() {
+        for (i, t) in nasty_triangles(&mut rng, &probe, 16, scale)
+            .into_iter()
+            .enumerate()
+        {
             if t.iter().flatten().any(|v| !v.is_finite()) {
+                // No exact oracle for non-finite input (the library rejects it).
                 continue;
             }
-            total += 1;
-            if keep >> j & 1 == 1 {
+            let separated = narrow::plane_separated(&probe, &t);
+            // Local scales whose degree-3 products stay normal f32 (at 1e-20 they underflow,
+            // at 1e20 they overflow: the filter then certifies nothing, which is sound).
+            if i % 6 == 0 && (scale == 1.0 || scale == 7e-4) {
+                total += 1;
+                dropped += separated as usize;
+            }
+            if !separated {
                 continue;
             }
-            dropped += 1;
             let one_side = |p: &[[f32; 3]; 3], q: &[[f32; 3]; 3]| {
                 let s = q.map(|d| exact_side(p, d));
                 s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0)
             };
             assert!(
-                one_side(&probe, t) || one_side(t, &probe),
+                one_side(&probe, &t) || one_side(&t, &probe),
                 "dropped a pair that is not strictly separated: {probe:?} {t:?}"
             );
         }
     }
-    // The filter is useful, not only safe: most random pairs are dropped.
-    assert!(dropped * 3 > total, "dropped {dropped} of {total}");
+    // The filter is useful, not only safe: random pairs are separated by one of the planes
+    // with probability about 0.4.
+    assert!(dropped * 10 > 3 * total, "dropped {dropped} of {total}");
+    assert!(total > 1000);
 }
 
 // ---------------------------------------------------------------------------------------
