@@ -204,7 +204,7 @@ impl<'a> Tile<'a> {
     /// the length.
     pub fn new(data: &'a [f32], stride: usize) -> Self {
         assert!(
-            stride > 0 && data.len() % stride == 0,
+            stride > 0 && data.len().is_multiple_of(stride),
             "Tile: the length must be a multiple of the stride"
         );
         Self { data, stride }
