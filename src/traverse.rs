@@ -32,6 +32,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::narrow::leaves::{leaf_pair, LeafSide, Leaves};
 use crate::par::Par;
+use dhcd_kernels::narrow::MAX_ROW;
 
 /// Result of a query: contacts as `[triangle of A, triangle of B]` in the caller's original
 /// triangle indices, sorted ascending, and the counted work.
@@ -246,16 +247,32 @@ struct Walk<'h, K: BvKind> {
     narrow: bool,
 }
 
-/// What a walk produces: contacts, counters, and (broad phase only) leaf pairs.
-#[derive(Default)]
-struct Output {
+/// What a walk produces: contacts, counters, and (broad phase only) leaf pairs; with the
+/// narrow phase's scratch: its rows, and the last leaf of each side (the walk often meets
+/// one leaf against several in a row).
+struct Output<'h> {
     pairs: Vec<[u32; 2]>,
     counters: Counters,
     leaves: Vec<[u32; 2]>,
+    rows: [u64; MAX_ROW],
+    last: [Option<(usize, LeafSide<'h>)>; 2],
 }
 
-impl Output {
+impl Default for Output<'_> {
+    fn default() -> Self {
+        Self {
+            pairs: Vec::new(),
+            counters: Counters::default(),
+            leaves: Vec::new(),
+            rows: [0; MAX_ROW],
+            last: [None, None],
+        }
+    }
+}
+
+impl Output<'_> {
     fn merge(mut self, other: Self) -> Self {
+        self.last = [None, None];
         self.pairs.extend_from_slice(&other.pairs);
         self.leaves.extend_from_slice(&other.leaves);
         self.counters += other.counters;
@@ -263,7 +280,10 @@ impl Output {
     }
 
     fn finish(mut self) -> Contacts {
-        self.pairs.sort_unstable();
+        // PERF: one u64 key per pair sorts several times faster than the lexicographic
+        // comparison of `[u32; 2]`.
+        self.pairs
+            .sort_unstable_by_key(|&[a, b]| (u64::from(a) << 32) | u64::from(b));
         self.counters.contacts = self.pairs.len() as u64;
         Contacts {
             pairs: self.pairs,
@@ -272,7 +292,7 @@ impl Output {
     }
 }
 
-impl<K: BvKind> Walk<'_, K> {
+impl<'h, K: BvKind> Walk<'h, K> {
     fn run(&self, ws: &mut Workspace, parallel: bool) -> Contacts {
         ws.leaves.clear();
         let mut out = Output {
@@ -310,7 +330,8 @@ impl<K: BvKind> Walk<'_, K> {
                 .reduce(Output::default, Output::merge);
             out = out.merge(part);
             // Deterministic order of the collected leaf pairs (the broad-phase API).
-            out.leaves.sort_unstable();
+            out.leaves
+                .sort_unstable_by_key(|&[a, b]| (u64::from(a) << 32) | u64::from(b));
         }
         ws.leaves = std::mem::take(&mut out.leaves);
         out.finish()
@@ -318,7 +339,7 @@ impl<K: BvKind> Walk<'_, K> {
 
     /// The root entry: the roots' test (two objects) or the root self pair.
     #[inline(always)]
-    fn root<S: Simd>(&self, simd: S, out: &mut Output) -> Option<[u32; 2]> {
+    fn root<S: Simd>(&self, simd: S, out: &mut Output<'h>) -> Option<[u32; 2]> {
         if self.self_query {
             return Some([0, 0]);
         }
@@ -337,7 +358,7 @@ impl<K: BvKind> Walk<'_, K> {
         simd: S,
         [x, y]: [u32; 2],
         next: &mut Vec<[u32; 2]>,
-        out: &mut Output,
+        out: &mut Output<'h>,
     ) {
         let (x, y) = (x as usize, y as usize);
         let (ta, tb) = (self.a.tree(), self.b.tree());
@@ -410,15 +431,26 @@ impl<K: BvKind> Walk<'_, K> {
 
     /// An overlapping leaf pair: the narrow phase now, or collected (broad phase).
     #[inline(always)]
-    fn leaves<S: Simd>(&self, simd: S, x: usize, y: usize, out: &mut Output) {
+    fn leaves<S: Simd>(&self, simd: S, x: usize, y: usize, out: &mut Output<'h>) {
         if !self.narrow {
             out.leaves.push([x as u32, y as u32]);
             return;
         }
-        fn side<K: BvKind>(h: &Hierarchy<K>, leaf: usize) -> LeafSide<'_> {
-            LeafSide {
-                tris: h.leaf_tris(leaf),
-                order: &h.tree().tri_order()[h.tree().tri_range(leaf)],
+        fn side<'h, K: BvKind>(
+            h: &'h Hierarchy<K>,
+            leaf: usize,
+            last: &mut Option<(usize, LeafSide<'h>)>,
+        ) -> LeafSide<'h> {
+            match *last {
+                Some((n, s)) if n == leaf => s,
+                _ => {
+                    let s = LeafSide {
+                        tris: h.leaf_tris(leaf),
+                        order: &h.tree().tri_order()[h.tree().tri_range(leaf)],
+                    };
+                    *last = Some((leaf, s));
+                    s
+                }
             }
         }
         let leaves = match (self.self_query, x == y) {
@@ -426,8 +458,9 @@ impl<K: BvKind> Walk<'_, K> {
             (true, false) => Leaves::SelfDistinct,
             (true, true) => Leaves::SelfSame,
         };
-        let (sa, sb) = (side(self.a, x), side(self.b, y));
-        out.counters.prim_tests += leaf_pair(simd, &sa, &sb, leaves, &mut out.pairs);
+        let [la, lb] = &mut out.last;
+        let (sa, sb) = (side(self.a, x, la), side(self.b, y, lb));
+        out.counters.prim_tests += leaf_pair(simd, &sa, &sb, leaves, &mut out.rows, &mut out.pairs);
     }
 
     /// Depth-first from each of `seeds`.
@@ -437,7 +470,7 @@ impl<K: BvKind> Walk<'_, K> {
         simd: S,
         seeds: &[[u32; 2]],
         stack: &mut Vec<[u32; 2]>,
-        out: &mut Output,
+        out: &mut Output<'h>,
     ) {
         for &seed in seeds {
             stack.clear();
@@ -456,7 +489,7 @@ struct StartOp<'w, 'h, K: BvKind> {
     seeds: &'w mut Vec<[u32; 2]>,
     stack: &'w mut Vec<[u32; 2]>,
     seed_target: usize,
-    out: &'w mut Output,
+    out: &'w mut Output<'h>,
 }
 
 impl<K: BvKind> WithSimd for StartOp<'_, '_, K> {
@@ -488,7 +521,7 @@ struct WalkOp<'w, 'h, K: BvKind> {
     walk: &'w Walk<'h, K>,
     seeds: &'w [[u32; 2]],
     stack: &'w mut Vec<[u32; 2]>,
-    out: &'w mut Output,
+    out: &'w mut Output<'h>,
 }
 
 impl<K: BvKind> WithSimd for WalkOp<'_, '_, K> {
@@ -503,7 +536,7 @@ impl<K: BvKind> WithSimd for WalkOp<'_, '_, K> {
 struct NarrowOp<'w, 'h, K: BvKind> {
     walk: &'w Walk<'h, K>,
     leaves: &'w [[u32; 2]],
-    out: &'w mut Output,
+    out: &'w mut Output<'h>,
 }
 
 impl<K: BvKind> WithSimd for NarrowOp<'_, '_, K> {

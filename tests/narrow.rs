@@ -915,3 +915,39 @@ fn non_finite_inputs_do_not_panic() {
         let _ = intersection_segment(&seg, &a);
     }
 }
+
+/// The fast path (Guigue-Devillers on the generic case) against the general test on many
+/// configurations: small integer grids (shared vertices, vertices on planes, coplanar and
+/// degenerate triangles all frequent), a wide grid (mostly generic), and random floats in
+/// contact range. Seeded; no proptest shrinking needed (the inputs are printed).
+#[test]
+fn fast_path_equals_general_test_on_many_configurations() {
+    let mut x = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = move || {
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        x.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    };
+    let mut hits = 0;
+    for case in 0..300_000u32 {
+        let span = [3u64, 5, 64][case as usize % 3];
+        let mut tri = || -> Tri {
+            std::array::from_fn(|_| {
+                std::array::from_fn(|_| {
+                    if span == 64 {
+                        (next() >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+                    } else {
+                        (next() % span) as f32
+                    }
+                })
+            })
+        };
+        let (a, b) = (tri(), tri());
+        let want = dhcd::narrow::triangles_intersect_reference(&a, &b);
+        hits += want as u32;
+        assert_eq!(triangles_intersect(&a, &b), want, "{a:?} vs {b:?}");
+        assert_eq!(triangles_intersect(&b, &a), want, "{b:?} vs {a:?}");
+    }
+    assert!(hits > 30_000, "enough intersecting cases: {hits}");
+}

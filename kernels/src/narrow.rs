@@ -55,12 +55,10 @@ pub struct TriSoa<'a> {
 impl<'a> TriSoa<'a> {
     /// Panics unless `tile` has 15 fields and `vertex` 3 fields of the same stride.
     pub fn new(tile: Tile<'a>, vertex: &'a [u32]) -> Self {
-        assert_eq!(
-            tile.fields(),
-            15,
-            "TriSoa: 9 corner coordinates, 6 box bounds"
+        assert!(
+            tile.has_fields(15) && vertex.len() == 3 * tile.stride(),
+            "TriSoa: 9 corner coordinates and 6 box bounds, 3 corner indices"
         );
-        assert_eq!(vertex.len(), 3 * tile.stride(), "TriSoa: 3 corner indices");
         Self {
             tile,
             vertex,
@@ -112,6 +110,25 @@ impl<'a> TriSoa<'a> {
         ]
     }
 
+    /// The first `n` entries of every field, sliced once (hot loops then index without
+    /// re-slicing; `n` bounds every index).
+    #[inline(always)]
+    fn fields(&self, n: usize) -> Fields<'a> {
+        let s = self.tile.stride();
+        let o = self.offset;
+        let f = |k: usize| -> &'a [f32] { &self.tile.field(k)[o..o + n] };
+        Fields {
+            corner: [[f(0), f(1), f(2)], [f(3), f(4), f(5)], [f(6), f(7), f(8)]],
+            lo: [f(9), f(10), f(11)],
+            hi: [f(12), f(13), f(14)],
+            vertex: [
+                &self.vertex[o..o + n],
+                &self.vertex[s + o..s + o + n],
+                &self.vertex[2 * s + o..2 * s + o + n],
+            ],
+        }
+    }
+
     /// The triangles from `start` on.
     #[inline(always)]
     pub fn skip(&self, start: usize) -> TriSoa<'a> {
@@ -120,6 +137,26 @@ impl<'a> TriSoa<'a> {
             offset: self.offset + start,
             ..*self
         }
+    }
+}
+
+/// The fields of `n` triangles of a [`TriSoa`], each sliced to `n`.
+struct Fields<'a> {
+    corner: [[&'a [f32]; 3]; 3],
+    lo: [&'a [f32]; 3],
+    hi: [&'a [f32]; 3],
+    vertex: [&'a [u32]; 3],
+}
+
+impl Fields<'_> {
+    #[inline(always)]
+    fn corners(&self, t: usize) -> [[f32; 3]; 3] {
+        let c = &self.corner;
+        [
+            [c[0][0][t], c[0][1][t], c[0][2][t]],
+            [c[1][0][t], c[1][1][t], c[1][2][t]],
+            [c[2][0][t], c[2][1][t], c[2][2][t]],
+        ]
     }
 }
 
@@ -315,7 +352,9 @@ pub fn leaf_candidates_with<S: Simd>(
     for row in out[..na].iter_mut() {
         *row = 0;
     }
-    let len = b.len();
+    // B is read in whole vectors: its fields over the lanes covering `nb` (padding allowed).
+    let len = nb.next_multiple_of(S::F32_LANES).min(b.len());
+    let (fa, fb) = (a.fields(na), b.fields(len));
     let (err, tiny, two, zero) = (
         simd.splat_f32s(PLANE_ERR),
         simd.splat_f32s(PLANE_TINY),
@@ -331,10 +370,10 @@ pub fn leaf_candidates_with<S: Simd>(
         let mut bhi = [zero; 3];
         let mut bc = [[zero; 3]; 3];
         for k in 0..3 {
-            blo[k] = load_prefix(simd, &b.lo(k)[base..end]);
-            bhi[k] = load_prefix(simd, &b.hi(k)[base..end]);
+            blo[k] = load_prefix(simd, &fb.lo[k][base..end]);
+            bhi[k] = load_prefix(simd, &fb.hi[k][base..end]);
             for c in 0..3 {
-                bc[c][k] = load_prefix(simd, &b.corner(c, k)[base..end]);
+                bc[c][k] = load_prefix(simd, &fb.corner[c][k][base..end]);
             }
         }
         let (bn, bm) = plane_simd(simd, &bc);
@@ -342,9 +381,9 @@ pub fn leaf_candidates_with<S: Simd>(
             None
         } else {
             Some([
-                load_prefix_u32(simd, &b.vertex(0)[base..end]),
-                load_prefix_u32(simd, &b.vertex(1)[base..end]),
-                load_prefix_u32(simd, &b.vertex(2)[base..end]),
+                load_prefix_u32(simd, &fb.vertex[0][base..end]),
+                load_prefix_u32(simd, &fb.vertex[1][base..end]),
+                load_prefix_u32(simd, &fb.vertex[2][base..end]),
             ])
         };
         for i in 0..na {
@@ -356,26 +395,26 @@ pub fn leaf_candidates_with<S: Simd>(
             if valid == 0 {
                 continue;
             }
-            let mut hit = simd.less_than_or_equal_f32s(simd.splat_f32s(a.lo(0)[i]), bhi[0]);
+            let mut hit = simd.less_than_or_equal_f32s(simd.splat_f32s(fa.lo[0][i]), bhi[0]);
             hit = simd.and_m32s(
                 hit,
-                simd.less_than_or_equal_f32s(blo[0], simd.splat_f32s(a.hi(0)[i])),
+                simd.less_than_or_equal_f32s(blo[0], simd.splat_f32s(fa.hi[0][i])),
             );
             for k in 1..3 {
                 hit = simd.and_m32s(
                     hit,
-                    simd.less_than_or_equal_f32s(simd.splat_f32s(a.lo(k)[i]), bhi[k]),
+                    simd.less_than_or_equal_f32s(simd.splat_f32s(fa.lo[k][i]), bhi[k]),
                 );
                 hit = simd.and_m32s(
                     hit,
-                    simd.less_than_or_equal_f32s(blo[k], simd.splat_f32s(a.hi(k)[i])),
+                    simd.less_than_or_equal_f32s(blo[k], simd.splat_f32s(fa.hi[k][i])),
                 );
             }
             let mut bits = u64::from(mask_bits(simd, hit)) & valid;
             if let Some(bv) = &bv {
-                let mut share = simd.equal_u32s(simd.splat_u32s(a.vertex(0)[i]), bv[0]);
+                let mut share = simd.equal_u32s(simd.splat_u32s(fa.vertex[0][i]), bv[0]);
                 for k in 0..3 {
-                    let v = simd.splat_u32s(a.vertex(k)[i]);
+                    let v = simd.splat_u32s(fa.vertex[k][i]);
                     for (c, w) in bv.iter().enumerate() {
                         if k != 0 || c != 0 {
                             share = simd.or_m32s(share, simd.equal_u32s(v, *w));
@@ -391,7 +430,7 @@ pub fn leaf_candidates_with<S: Simd>(
             if bits == 0 {
                 continue;
             }
-            let ta = a.corners(i);
+            let ta = fa.corners(i);
             let (an, am) = plane(&ta);
             let pc = [
                 splat3(simd, ta[0]),

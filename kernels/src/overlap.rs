@@ -31,7 +31,7 @@ pub struct SphereSoa<'a> {
 impl<'a> SphereSoa<'a> {
     /// Panics unless `tile` has four fields.
     pub fn new(tile: Tile<'a>) -> Self {
-        assert_eq!(tile.fields(), 4, "SphereSoa: cx, cy, cz, r");
+        assert!(tile.has_fields(4), "SphereSoa: cx, cy, cz, r");
         Self { tile }
     }
 
@@ -79,7 +79,7 @@ pub struct AabbSoa<'a> {
 impl<'a> AabbSoa<'a> {
     /// Panics unless `tile` has six fields.
     pub fn new(tile: Tile<'a>) -> Self {
-        assert_eq!(tile.fields(), 6, "AabbSoa: min xyz, max xyz");
+        assert!(tile.has_fields(6), "AabbSoa: min xyz, max xyz");
         Self { tile }
     }
 

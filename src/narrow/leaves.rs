@@ -38,6 +38,7 @@ pub(crate) fn leaf_pair<S: Simd>(
     a: &LeafSide,
     b: &LeafSide,
     leaves: Leaves,
+    rows: &mut [u64; MAX_ROW],
     out: &mut Vec<[u32; 2]>,
 ) -> u64 {
     let (na, nb) = (a.tris.len, b.tris.len);
@@ -48,7 +49,7 @@ pub(crate) fn leaf_pair<S: Simd>(
     };
     if na <= MAX_ROW && nb <= MAX_ROW {
         // Adaptive trees: one block per leaf.
-        return blocks(simd, a, 0, na, b, 0, nb, pairing, out);
+        return blocks(simd, a, 0, na, b, 0, nb, pairing, rows, out);
     }
     // Leaves longer than a block (fixed-depth trees): blocks of MAX_ROW triangles.
     let mut counted = 0;
@@ -61,7 +62,7 @@ pub(crate) fn leaf_pair<S: Simd>(
                 p => p,
             };
             let (ra, rb) = ((na - a0).min(MAX_ROW), (nb - b0).min(MAX_ROW));
-            counted += blocks(simd, a, a0, ra, b, b0, rb, pairing, out);
+            counted += blocks(simd, a, a0, ra, b, b0, rb, pairing, rows, out);
         }
     }
     counted
@@ -79,10 +80,10 @@ fn blocks<S: Simd>(
     b0: usize,
     nb: usize,
     pairing: Pairing,
+    rows: &mut [u64; MAX_ROW],
     out: &mut Vec<[u32; 2]>,
 ) -> u64 {
     let (sa, sb) = (a.tris.soa.skip(a0), b.tris.soa.skip(b0));
-    let mut rows = [0u64; MAX_ROW];
     debug_assert!(na <= MAX_ROW);
     let counted = leaf_candidates_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
     for (i, &row) in rows[..na].iter().enumerate() {

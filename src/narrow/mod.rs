@@ -31,6 +31,12 @@ pub use oracle::{brute_force_pairs, brute_force_self_pairs};
 /// Whether the closed triangles share at least one point, decided exactly for the f32 inputs.
 #[inline]
 pub fn triangles_intersect(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
+    tritri::intersects(a, b)
+}
+
+/// [`triangles_intersect`] by the general edge-against-triangle test alone (no fast path):
+/// the reference the fast path is tested against, and the brute-force oracles' test.
+pub fn triangles_intersect_reference(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
     tritri::tri_tri(a, b, &mut tritri::Decide)
 }
 

@@ -1,6 +1,6 @@
 //! Brute-force oracles: every triangle pair through the exact test.
 
-use super::triangles_intersect;
+use super::triangles_intersect_reference as triangles_intersect;
 use crate::mesh::Mesh;
 
 /// Per-triangle closed boxes `[min, max]` (exact; only used to skip pairs cheaply).

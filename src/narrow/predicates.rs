@@ -53,6 +53,70 @@ pub(crate) fn orient3d(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
     orient3d_exact(a, b, c, d)
 }
 
+/// A triangle's plane, prepared for many orientation queries: [`Plane::side`]`(d)` is the
+/// exact sign of `orient3d(d, t0, t1, t2)`.
+///
+/// PERF: the normal `N = (t0 - t2) x (t1 - t2)` and the magnitudes `M` of its products are
+/// computed once; each query is then `e = d - t2`, `s = e . N` and the permanent
+/// `P = |e| . M`, Shewchuk's orient3d arithmetic in another association (a Laplace expansion
+/// of the same determinant along `e`), so its first-stage error bound `(7 + 56 eps) eps P`
+/// holds; a sign is certified when `|s| > 8 eps P` (`f32` inputs cannot underflow or
+/// overflow in `f64`), else the adaptive exact predicate decides.
+pub(crate) struct Plane<'a> {
+    t: &'a Tri,
+    origin: [f64; 3],
+    normal: [f64; 3],
+    magnitude: [f64; 3],
+}
+
+impl<'a> Plane<'a> {
+    #[inline(always)]
+    pub(crate) fn new(t: &'a Tri) -> Self {
+        let f = |p: &P3| p.map(f64::from);
+        let (a, b, o) = (f(&t[0]), f(&t[1]), f(&t[2]));
+        let u = [a[0] - o[0], a[1] - o[1], a[2] - o[2]];
+        let v = [b[0] - o[0], b[1] - o[1], b[2] - o[2]];
+        let (yz, zy) = (u[1] * v[2], u[2] * v[1]);
+        let (zx, xz) = (u[2] * v[0], u[0] * v[2]);
+        let (xy, yx) = (u[0] * v[1], u[1] * v[0]);
+        Self {
+            t,
+            origin: o,
+            normal: [yz - zy, zx - xz, xy - yx],
+            magnitude: [
+                yz.abs() + zy.abs(),
+                zx.abs() + xz.abs(),
+                xy.abs() + yx.abs(),
+            ],
+        }
+    }
+
+    /// The exact sign of `orient3d(d, t0, t1, t2)`.
+    #[inline(always)]
+    pub(crate) fn side(&self, d: &P3) -> i32 {
+        let (o, n, m) = (&self.origin, &self.normal, &self.magnitude);
+        let e = [
+            f64::from(d[0]) - o[0],
+            f64::from(d[1]) - o[1],
+            f64::from(d[2]) - o[2],
+        ];
+        let s = e[0] * n[0] + e[1] * n[1] + e[2] * n[2];
+        let p = e[0].abs() * m[0] + e[1].abs() * m[1] + e[2].abs() * m[2];
+        let bound = PLANE_ERRBOUND * p;
+        if s > bound {
+            1
+        } else if s < -bound {
+            -1
+        } else {
+            sign(orient3d_exact(d, &self.t[0], &self.t[1], &self.t[2]))
+        }
+    }
+}
+
+/// The certification factor of [`Plane::side`]: `8 eps`, above Shewchuk's
+/// `(7 + 56 eps) eps`.
+const PLANE_ERRBOUND: f64 = 8.0 * EPS;
+
 #[cold]
 #[inline(never)]
 fn orient3d_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
@@ -166,6 +230,12 @@ mod tests {
             }
             prop_assert_eq!(sign(orient3d(&a, &b, &c, &d)), robust_sign(&a, &b, &c, &d));
             prop_assert_eq!(sign(orient3d(&a, &b, &c, &c)), 0);
+            // The prepared plane gives the same exact signs.
+            let t = [a, b, c];
+            let plane = Plane::new(&t);
+            prop_assert_eq!(plane.side(&d), robust_sign(&d, &a, &b, &c));
+            prop_assert_eq!(plane.side(&c), 0);
+            prop_assert_eq!(plane.side(&a), 0);
             prop_assert_eq!(sign(orient3d(&d, &a, &b, &c)), -robust_sign(&a, &b, &c, &d));
         }
     }

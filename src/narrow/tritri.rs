@@ -6,7 +6,9 @@
 //! *is* the segment between its lexicographically smallest and largest corners, and is
 //! tested as that segment (or point).
 
-use super::predicates::{keep, lerp, lex_le, orient2d, orient3d, projection_axis, sign, Tri, P3};
+use super::predicates::{
+    keep, lerp, lex_le, orient2d, orient3d, projection_axis, sign, Plane, Tri, P3,
+};
 
 /// Receives the candidate points of the intersection region. With `COLLECT = false` the
 /// test stops at the first hit and computes no points.
@@ -104,6 +106,70 @@ fn extreme_corners(t: &Tri) -> (usize, usize) {
         }
     }
     (lo, hi)
+}
+
+/// Whether the closed triangles intersect (decision only, the narrow phase's test).
+///
+/// The generic case (no vertex of either triangle on the other's plane) is Guigue and
+/// Devillers' canonical-form test ("Fast and robust triangle-triangle overlap test using
+/// orientation predicates", JGT 8(1), 2003): after the six vertex-plane orientations, each
+/// triangle is rotated so that its lone vertex (alone on its side of the other's plane) comes
+/// first and lies on the positive side (swapping the other triangle's last two vertices when
+/// it does not), and two more orientations decide. With exact orientation signs that is exact.
+/// Every other case (a vertex on the other plane, coplanar or degenerate triangles) goes to
+/// [`tri_tri`], the general test, which is also the oracle the fast path is tested against.
+#[inline]
+pub(crate) fn intersects(a: &Tri, b: &Tri) -> bool {
+    if !aabb_overlap(a, b) {
+        return false;
+    }
+    // Vertices of `a` against the plane of `b`: (x - b2) . ((b0 - b2) x (b1 - b2)).
+    let pb = Plane::new(b);
+    let sa = [pb.side(&a[0]), pb.side(&a[1]), pb.side(&a[2])];
+    if sa[0] * sa[1] > 0 && sa[0] * sa[2] > 0 {
+        return false;
+    }
+    let pa = Plane::new(a);
+    let sb = [pa.side(&b[0]), pa.side(&b[1]), pa.side(&b[2])];
+    if sb[0] * sb[1] > 0 && sb[0] * sb[2] > 0 {
+        return false;
+    }
+    if sa.contains(&0) || sb.contains(&0) {
+        return tri_tri(a, b, &mut Decide);
+    }
+    // Rotate `a` so that its lone vertex comes first; if it is on the negative side, swap
+    // `b`'s last two vertices (which flips the sign of `b`'s plane).
+    let i = lone(sa);
+    let (p1, q1, r1) = (&a[i], &a[(i + 1) % 3], &a[(i + 2) % 3]);
+    let (mut b1, mut b2, mut sb1, mut sb2) = (&b[1], &b[2], sb[1], sb[2]);
+    let (mut q1, mut r1) = (q1, r1);
+    if sa[i] < 0 {
+        (b1, b2, sb1, sb2) = (b2, b1, sb2, sb1);
+    }
+    // The same for `b` against `a`'s plane (now possibly with `a`'s last two swapped).
+    let tb = [&b[0], b1, b2];
+    let sbv = [sb[0], sb1, sb2];
+    let j = lone(sbv);
+    let (p2, q2, r2) = (tb[j], tb[(j + 1) % 3], tb[(j + 2) % 3]);
+    if sbv[j] < 0 {
+        (q1, r1) = (r1, q1);
+    }
+    // Canonical form: p1 above b's plane, p2 above a's plane. They intersect iff the two
+    // triangles' intervals on the planes' common line overlap:
+    // (q2 - q1) . ((p2 - q1) x (p1 - q1)) <= 0 and (r2 - p1) . ((p2 - p1) x (r1 - p1)) <= 0.
+    sign(orient3d(q2, p2, p1, q1)) <= 0 && sign(orient3d(r2, p2, r1, p1)) <= 0
+}
+
+/// The index of the one sign that differs from the other two (all nonzero, not all equal).
+#[inline(always)]
+fn lone(s: [i32; 3]) -> usize {
+    if s[1] == s[2] {
+        0
+    } else if s[0] == s[2] {
+        1
+    } else {
+        2
+    }
 }
 
 /// The core test. Returns whether the closed triangles intersect; with a collecting sink,

@@ -136,11 +136,6 @@ impl RegionTree {
 
         // Padded layouts: every sibling group and every leaf's triangle run takes a multiple
         // of BLOCK slots, so the wide tests and row filters load whole vectors.
-        let mut group_slot = vec![0u32];
-        for g in 0..group_start.len() - 1 {
-            let len = (group_start[g + 1] - group_start[g]) as usize;
-            group_slot.push(group_slot[g] + len.next_multiple_of(BLOCK) as u32);
-        }
         let mut leaf_slot = vec![0u32];
         let mut leaf_vertex = Vec::with_capacity(3 * tri_count);
         for n in 0..node_count {
@@ -172,7 +167,6 @@ impl RegionTree {
             group_start,
             node_group,
             leaf_rank,
-            group_slot,
             leaf_slot,
             leaf_vertex,
             tris,

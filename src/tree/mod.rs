@@ -37,6 +37,7 @@ pub const MAX_LEAF_SIZE: usize = 4096;
 /// vectors of x86-v3 (partial loads are out-of-line calls there), and a node's children are
 /// one block whatever the backend.
 pub const BLOCK: usize = 8;
+const _: () = assert!(MAX_CHILDREN <= BLOCK, "a sibling group fits one block");
 
 /// How far the region tree is subdivided.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -94,9 +95,10 @@ pub struct RegionTree {
     node_group: Vec<u32>,
     /// Index of each leaf among the leaves (`u32::MAX` for internal nodes).
     leaf_rank: Vec<u32>,
-    /// Padded layouts: group `g` owns slots `group_slot[g]..group_slot[g + 1]`, leaf rank
-    /// `r` owns triangle slots `leaf_slot[r]..leaf_slot[r + 1]` (multiples of [`BLOCK`]).
-    group_slot: Vec<u32>,
+    /// Padded layout of the leaves: leaf rank `r` owns triangle slots
+    /// `leaf_slot[r]..leaf_slot[r + 1]` (a multiple of [`BLOCK`]). (Sibling group `g` owns
+    /// node slots `g * BLOCK..(g + 1) * BLOCK`: a group has at most `MAX_CHILDREN <= BLOCK`
+    /// nodes.)
     leaf_slot: Vec<u32>,
     /// Per leaf, a tile of its triangles' corner indices: corner `k` of slot `i` at
     /// `3 * leaf_slot[r] + k * stride + i` (`u32::MAX` in padding).
@@ -161,14 +163,14 @@ impl RegionTree {
 
     /// Number of slots of the padded node layout.
     pub fn slot_count(&self) -> usize {
-        *self.group_slot.last().unwrap_or(&0) as usize
+        self.group_count() * BLOCK
     }
 
     /// The slots of sibling group `g` (its nodes first, in order, then padding; a multiple
     /// of [`BLOCK`]).
     #[inline]
     pub fn group_slots(&self, g: usize) -> Range<usize> {
-        self.group_slot[g] as usize..self.group_slot[g + 1] as usize
+        g * BLOCK..(g + 1) * BLOCK
     }
 
     /// Number of slots of the padded triangle layout.
@@ -317,7 +319,6 @@ impl RegionTree {
             + size_of_val(&self.group_start[..])
             + size_of_val(&self.node_group[..])
             + size_of_val(&self.leaf_rank[..])
-            + size_of_val(&self.group_slot[..])
             + size_of_val(&self.leaf_slot[..])
             + size_of_val(&self.leaf_vertex[..])
             + size_of_val(&self.depth[..])
