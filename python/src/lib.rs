@@ -34,12 +34,29 @@ fn value_error(message: String) -> PyErr {
     PyValueError::new_err(message)
 }
 
+/// An integer argument; one beyond 64 bits is a `ValueError` like any other bad value
+/// (Python would raise `OverflowError`).
+fn int_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<i64> {
+    obj.extract::<i64>().map_err(|e| {
+        if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()) {
+            value_error(format!("{what} {obj} is out of range"))
+        } else {
+            e
+        }
+    })
+}
+
 /// The largest thread count accepted (larger counts are mistakes, not machines).
 // TODO(issue 9): use the library's one thread-count check (`Par::threads`) once it lands.
 const MAX_THREADS: i64 = 1024;
 
-/// The thread count of a query: `1` the calling thread, `0` all cores, `n` a pool of `n`.
-fn par(threads: i64) -> PyResult<Par> {
+/// The thread count of a query: `1` (the default, `None` here) the calling thread, `0` all
+/// cores, `n` a pool of `n`.
+fn par(threads: Option<&Bound<'_, PyAny>>) -> PyResult<Par> {
+    let threads = match threads {
+        None => 1,
+        Some(t) => int_arg(t, "threads")?,
+    };
     match threads {
         1 => Ok(Par::Seq),
         n @ 0..=MAX_THREADS => Ok(Par::Rayon(n as usize)),
@@ -49,8 +66,8 @@ fn par(threads: i64) -> PyResult<Par> {
     }
 }
 
-fn options(levels: Option<i64>) -> PyResult<Options> {
-    let levels = match levels {
+fn options(levels: Option<&Bound<'_, PyAny>>) -> PyResult<Options> {
+    let levels = match levels.map(|l| int_arg(l, "levels")).transpose()? {
         None => None,
         Some(n) if n > 0 => Some(n as usize),
         Some(n) => return Err(value_error(format!("levels must be positive, got {n}"))),
@@ -283,7 +300,7 @@ impl Hierarchy {
         vertices: &Bound<'_, PyAny>,
         faces: &Bound<'_, PyAny>,
         method: &str,
-        levels: Option<i64>,
+        levels: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let m = self::method(method)?;
         let options = self::options(levels)?;
@@ -311,8 +328,12 @@ impl Hierarchy {
     }
 
     /// Intersecting face pairs `[i, j]`, `i < j`, of this mesh, sharing no vertex.
-    #[pyo3(signature = (threads = 1))]
-    fn self_collide(&mut self, py: Python<'_>, threads: i64) -> PyResult<Contacts> {
+    #[pyo3(signature = (threads = None), text_signature = "(self, threads=1)")]
+    fn self_collide(
+        &mut self,
+        py: Python<'_>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Contacts> {
         let par = par(threads)?;
         let (h, ws) = (&mut self.h, &mut self.ws);
         let c = py.detach(|| h.self_collide(ws, par));
@@ -356,12 +377,12 @@ fn widen(pairs: Vec<[u32; 2]>) -> Vec<[u64; 2]> {
 
 /// Intersecting face pairs `[face of a, face of b]` between two hierarchies of one kind.
 #[pyfunction]
-#[pyo3(signature = (a, b, threads = 1))]
+#[pyo3(signature = (a, b, threads = None), text_signature = "(a, b, threads=1)")]
 fn collide(
     py: Python<'_>,
     a: &Bound<'_, Hierarchy>,
     b: &Bound<'_, Hierarchy>,
-    threads: i64,
+    threads: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Contacts> {
     let par = par(threads)?;
     if a.is(b) {
@@ -440,7 +461,7 @@ impl Scene {
                 .map(|&i| ObjectId(i))
                 .ok_or_else(|| value_error(format!("no object named {name:?} in the scene")));
         }
-        let i: i64 = id.extract()?;
+        let i = int_arg(id, "object id")?;
         match u64::try_from(i).map(ObjectId) {
             Ok(o) if self.scene.contains(o) => Ok(o),
             _ => Err(value_error(format!("no object with id {i} in the scene"))),
@@ -452,7 +473,7 @@ impl Scene {
 impl Scene {
     #[new]
     #[pyo3(signature = (method = "dh", levels = None))]
-    fn new(method: &str, levels: Option<i64>) -> PyResult<Self> {
+    fn new(method: &str, levels: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         Ok(Self {
             scene: dhcd::Scene::new(self::method(method)?, options(levels)?),
             ids: HashMap::new(),
@@ -520,8 +541,12 @@ impl Scene {
     }
 
     /// Every contact: rows `[object_a, face_a, object_b, face_b]`, sorted.
-    #[pyo3(signature = (threads = 1))]
-    fn contacts(&mut self, py: Python<'_>, threads: i64) -> PyResult<Contacts> {
+    #[pyo3(signature = (threads = None), text_signature = "(self, threads=1)")]
+    fn contacts(
+        &mut self,
+        py: Python<'_>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Contacts> {
         let par = par(threads)?;
         let scene = &mut self.scene;
         let c = py.detach(|| scene.contacts(par));
