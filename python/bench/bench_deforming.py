@@ -34,6 +34,7 @@ Prints the median time per frame (milliseconds) and the ratio to dhcd, and write
 
 import argparse
 import json
+import os
 import statistics
 import sys
 import time
@@ -42,51 +43,9 @@ import numpy as np
 
 import dhcd
 
-
-def icosphere(subdivisions, radius=1.0):
-    t = (1.0 + 5.0**0.5) / 2.0
-    v = [
-        (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0),
-        (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
-        (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1),
-    ]
-    f = [
-        (0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11),
-        (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6), (7, 1, 8),
-        (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9),
-        (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1),
-    ]
-    verts = [np.array(p, dtype=np.float64) / np.linalg.norm(p) for p in v]
-    for _ in range(subdivisions):
-        mid = {}
-
-        def midpoint(a, b):
-            key = (min(a, b), max(a, b))
-            if key not in mid:
-                m = verts[a] + verts[b]
-                verts.append(m / np.linalg.norm(m))
-                mid[key] = len(verts) - 1
-            return mid[key]
-
-        f = [
-            face
-            for a, b, c in f
-            for face in (
-                (a, midpoint(a, b), midpoint(c, a)),
-                (b, midpoint(b, c), midpoint(a, b)),
-                (c, midpoint(c, a), midpoint(b, c)),
-                (midpoint(a, b), midpoint(b, c), midpoint(c, a)),
-            )
-        ]
-    return np.array(verts) * radius, np.array(f, dtype=np.int64)
-
-
-def wave(v, t, amplitude, offset):
-    d = amplitude * np.stack(
-        [np.sin(3.0 * v[:, 1] + t), np.sin(2.0 * v[:, 2] + 1.3 * t), np.sin(2.5 * v[:, 0] - 0.7 * t)],
-        axis=1,
-    )
-    return (v + d + np.asarray(offset)).astype(np.float32)
+# The test suite's meshes: one definition of the icosphere, the grid and the wave.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+from meshes import grid, icosphere, wave  # noqa: E402
 
 
 def pair_case(frames, subdivisions):
@@ -104,15 +63,8 @@ def pair_case(frames, subdivisions):
 
 def sheet_case(frames, n):
     """A 2n x n sheet folded over itself at x = 1 and rippled, deforming every frame."""
-    xs, ys = np.meshgrid(np.arange(2 * n + 1), np.arange(n + 1), indexing="ij")
-    rest = np.stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)], axis=1) / n
-    idx = lambda i, j: i * (n + 1) + j  # noqa: E731
-    faces = []
-    for i in range(2 * n):
-        for j in range(n):
-            faces.append((idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)))
-            faces.append((idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)))
-    faces = np.array(faces, dtype=np.int64)
+    rest, faces = grid(2 * n, n, 1.0 / n)
+    rest = rest.astype(np.float64)
     x, y = rest[:, 0], rest[:, 1]
     right = x > 1.0
     poses = []

@@ -152,41 +152,7 @@ impl<'py> Vertices<'py> {
 /// Faces as `u32` triangles (negative or too large indices are errors here; indices beyond
 /// the vertex count are the library's `IndexOutOfRange`).
 fn faces(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
-    let arr = numeric_n3(obj, "faces", "iu")?;
-    let np = obj.py().import("numpy")?;
-    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
-    let to_u32 = |t: usize, v: i128| {
-        u32::try_from(v).map_err(|_| {
-            value_error(format!(
-                "face {t} has vertex index {v}, which is out of range"
-            ))
-        })
-    };
-    let mut out = Vec::new();
-    if kind == "u" {
-        let a: PyReadonlyArray2<'_, u64> = np
-            .call_method1("ascontiguousarray", (arr, "uint64"))?
-            .extract()?;
-        for (t, f) in a.as_array().rows().into_iter().enumerate() {
-            out.push([
-                to_u32(t, f[0].into())?,
-                to_u32(t, f[1].into())?,
-                to_u32(t, f[2].into())?,
-            ]);
-        }
-    } else {
-        let a: PyReadonlyArray2<'_, i64> = np
-            .call_method1("ascontiguousarray", (arr, "int64"))?
-            .extract()?;
-        for (t, f) in a.as_array().rows().into_iter().enumerate() {
-            out.push([
-                to_u32(t, f[0].into())?,
-                to_u32(t, f[1].into())?,
-                to_u32(t, f[2].into())?,
-            ]);
-        }
-    }
-    Ok(out)
+    index_rows(&numeric_n3(obj, "faces", "iu")?, "face")
 }
 
 /// Contact pairs `(K, 2)` from Python: non-negative integers below 2^32.
@@ -214,33 +180,36 @@ fn pairs(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 2]>> {
             "pairs must be integers, got dtype kind {kind:?}"
         )));
     }
-    let a: PyReadonlyArray2<'_, i64> = if kind == "u" {
-        // uint64 above i64::MAX would wrap in int64: refuse them first.
-        let too_big: bool = arr.call_method0("max")?.gt(u32::MAX)?;
-        if too_big {
-            return Err(value_error(
-                "pairs hold a triangle index above 2^32 - 1".into(),
-            ));
-        }
-        np.call_method1("ascontiguousarray", (arr, "int64"))?
-            .extract()?
-    } else {
-        np.call_method1("ascontiguousarray", (arr, "int64"))?
-            .extract()?
-    };
+    index_rows(&arr, "pair")
+}
+
+/// The rows of a 2-D integer array of `N` columns as `u32` indices; a value outside
+/// `0..2^32` is an error naming the `item` (row) it is in.
+fn index_rows<const N: usize>(arr: &Bound<'_, PyAny>, item: &str) -> PyResult<Vec<[u32; N]>> {
+    let np = arr.py().import("numpy")?;
+    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+    // int64 holds every valid index; uint64 values beyond it would wrap, so refuse them here.
+    let size: usize = arr.getattr("size")?.extract()?;
+    if kind == "u" && size > 0 && arr.call_method0("max")?.gt(u32::MAX)? {
+        return Err(value_error(format!(
+            "a {item} has an index above 2^32 - 1, which is out of range"
+        )));
+    }
+    let a: PyReadonlyArray2<'_, i64> = np
+        .call_method1("ascontiguousarray", (arr, "int64"))?
+        .extract()?;
     a.as_array()
         .rows()
         .into_iter()
         .enumerate()
-        .map(|(k, r)| {
-            let t = |v: i64| {
-                u32::try_from(v).map_err(|_| {
-                    value_error(format!(
-                        "pair {k} has triangle index {v}, which is out of range"
-                    ))
-                })
-            };
-            Ok([t(r[0])?, t(r[1])?])
+        .map(|(k, row)| {
+            let mut out = [0u32; N];
+            for (o, &v) in out.iter_mut().zip(row.iter()) {
+                *o = u32::try_from(v).map_err(|_| {
+                    value_error(format!("{item} {k} has index {v}, which is out of range"))
+                })?;
+            }
+            Ok(out)
         })
         .collect()
 }
