@@ -1,21 +1,32 @@
-//! Kernel microbenchmarks: each `dhcd-kernels` kernel, scalar reference against the
-//! runtime-dispatched SIMD entry, at 1,024 and 16,384 elements (pairs, points or triangles).
-//! Ids: `kernels/<kernel>/{scalar,dispatched}/<n>`, throughput in elements per second.
-//! Inputs come from a seeded RNG and are generated once per size.
+//! Kernel microbenchmarks: each `dhcd-kernels` kernel against its scalar reference.
+//!
+//! - `kernels/{sphere,aabb}_block/{scalar,simd}`: 4,096 wide node tests (one volume against
+//!   a block of 8, the children of an octree node), as the traversal calls them: the SIMD
+//!   body inside one dispatch (`*_with`), never dispatched per test. Throughput in BV pairs.
+//! - `kernels/leaf_candidates{,_self}/{scalar,simd}`: the narrow phase's filter (boxes,
+//!   shared vertices, separating planes) on 1,024 pairs of leaves of 8 nearby triangles,
+//!   throughput in triangle pairs.
+//! - `kernels/<refit reduction>/{scalar,dispatched}/<n>`: refit reductions over `n` points.
+//!
+//! Inputs come from a seeded RNG and are generated once.
 //!
 //!     cargo bench --bench kernels -- --warm-up-time 1 --measurement-time 3
+#![allow(clippy::needless_range_loop)]
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use dhcd_kernels::narrow::{self, AabbSoaMut};
-use dhcd_kernels::overlap::{self, AabbSoa, DhSoa, SphereSoa};
+use dhcd_kernels::narrow::{self, Pairing, TriSoa};
+use dhcd_kernels::overlap::{self, AabbSoa, SphereSoa};
+use dhcd_kernels::pulp::{Simd, WithSimd};
 use dhcd_kernels::refit;
 use dhcd_kernels::Soa3;
 use std::hint::black_box;
 
 const SIZES: [usize; 2] = [1024, 16384];
-/// Nodes per hierarchy in the overlap benches (a 5-level octree has at most 4,681 nodes).
-const NODES: usize = 4096;
-/// Vertices per mesh (the paper's pawn has 3,490).
-const VERTICES: usize = 3490;
+/// Blocks per node-test bench, and the block size (an octree's children).
+const BLOCKS: usize = 4096;
+const BLOCK: usize = 8;
+/// Leaf pairs per narrow-filter bench, and triangles per leaf.
+const LEAF_PAIRS: usize = 1024;
+const LEAF: usize = 8;
 
 /// xorshift64*.
 struct Rng(u64);
@@ -44,151 +55,217 @@ impl Rng {
     }
 }
 
-struct Side {
-    c: [Vec<f32>; 3],
-    r: Vec<f32>,
-    vertex: Vec<u32>,
-    p: [Vec<f32>; 3],
-    bmin: [Vec<f32>; 3],
-    bmax: [Vec<f32>; 3],
+/// `BLOCKS` blocks of `BLOCK` spheres and boxes (one array per field, block `k` at
+/// `k * BLOCK..`), and `BLOCKS` probes; about a third of the pairs overlap.
+struct Blocks {
+    sphere: [Vec<f32>; 4],
+    boxes: [Vec<f32>; 6],
+    probes: Vec<([f32; 3], f32)>,
 }
 
-impl Side {
+impl Blocks {
     fn new(rng: &mut Rng) -> Self {
-        let c = [0; 3].map(|_| rng.vec(NODES, -1.0, 1.0));
-        // Radii so that roughly a third of random pairs overlap.
-        let r = rng.vec(NODES, 0.0, 0.5);
-        let vertex = rng.idx(NODES, VERTICES);
-        let p = [0; 3].map(|_| rng.vec(VERTICES, -1.0, 1.0));
-        let h = [0; 3].map(|_| rng.vec(NODES, 0.0, 0.6));
-        let bmin = core::array::from_fn(|a| (0..NODES).map(|i| c[a][i] - h[a][i]).collect());
-        let bmax = core::array::from_fn(|a| (0..NODES).map(|i| c[a][i] + h[a][i]).collect());
-        Side {
-            c,
-            r,
-            vertex,
-            p,
-            bmin,
-            bmax,
-        }
-    }
-    fn sphere(&self) -> SphereSoa<'_> {
-        SphereSoa {
-            cx: &self.c[0],
-            cy: &self.c[1],
-            cz: &self.c[2],
-            r: &self.r,
-        }
-    }
-    fn dh(&self) -> DhSoa<'_> {
-        DhSoa {
-            vertex: &self.vertex,
-            r: &self.r,
-            points: Soa3::new(&self.p[0], &self.p[1], &self.p[2]),
-        }
-    }
-    fn aabb(&self) -> AabbSoa<'_> {
-        AabbSoa {
-            min_x: &self.bmin[0],
-            min_y: &self.bmin[1],
-            min_z: &self.bmin[2],
-            max_x: &self.bmax[0],
-            max_y: &self.bmax[1],
-            max_z: &self.bmax[2],
-        }
-    }
-}
-
-type PairFn<'a> = dyn Fn(&[u32], &[u32], &mut [u32]) -> usize + 'a;
-
-fn bench_pairs(c: &mut Criterion, name: &str, scalar: &PairFn, dispatched: &PairFn) {
-    let mut g = c.benchmark_group(format!("kernels/{name}"));
-    for n in SIZES {
-        let mut rng = Rng::new(n as u64);
-        let (ia, ib) = (rng.idx(n, NODES), rng.idx(n, NODES));
-        let mut out = vec![0u32; n];
-        assert_eq!(scalar(&ia, &ib, &mut out), dispatched(&ia, &ib, &mut out));
-        g.throughput(Throughput::Elements(n as u64));
-        g.bench_function(BenchmarkId::new("scalar", n), |b| {
-            b.iter(|| scalar(black_box(&ia), black_box(&ib), black_box(&mut out)))
-        });
-        g.bench_function(BenchmarkId::new("dispatched", n), |b| {
-            b.iter(|| dispatched(black_box(&ia), black_box(&ib), black_box(&mut out)))
-        });
-    }
-    g.finish();
-}
-
-fn overlap_benches(c: &mut Criterion) {
-    let mut rng = Rng::new(42);
-    let (a, b) = (Side::new(&mut rng), Side::new(&mut rng));
-    bench_pairs(
-        c,
-        "sphere_pairs",
-        &|ia, ib, out| overlap::sphere_pairs_scalar(a.sphere(), b.sphere(), ia, ib, out),
-        &|ia, ib, out| overlap::sphere_pairs(a.sphere(), b.sphere(), ia, ib, out),
-    );
-    bench_pairs(
-        c,
-        "dh_pairs",
-        &|ia, ib, out| overlap::dh_pairs_scalar(a.dh(), b.dh(), ia, ib, out),
-        &|ia, ib, out| overlap::dh_pairs(a.dh(), b.dh(), ia, ib, out),
-    );
-    bench_pairs(
-        c,
-        "aabb_pairs",
-        &|ia, ib, out| overlap::aabb_pairs_scalar(a.aabb(), b.aabb(), ia, ib, out),
-        &|ia, ib, out| overlap::aabb_pairs_vectorized(a.aabb(), b.aabb(), ia, ib, out),
-    );
-    bench_pairs(
-        c,
-        "tri_aabb_overlap_pairs",
-        &|ia, ib, out| narrow::tri_aabb_overlap_pairs_scalar(a.aabb(), b.aabb(), ia, ib, out),
-        &|ia, ib, out| narrow::tri_aabb_overlap_pairs(a.aabb(), b.aabb(), ia, ib, out),
-    );
-
-    // One box against a contiguous run of n boxes (no gather).
-    let mut g = c.benchmark_group("kernels/tri_aabb_overlap_row");
-    for n in SIZES {
-        let mut rng = Rng::new(7 + n as u64);
-        let side = BigBoxes::new(&mut rng, n);
-        let bx = ([-0.2f32, -0.1, 0.0], [0.3f32, 0.2, 0.4]);
-        let mut out = vec![0u32; n];
-        g.throughput(Throughput::Elements(n as u64));
-        g.bench_function(BenchmarkId::new("scalar", n), |b| {
-            b.iter(|| {
-                narrow::tri_aabb_overlap_row_scalar(black_box(bx), side.soa(), black_box(&mut out))
-            })
-        });
-        g.bench_function(BenchmarkId::new("dispatched", n), |b| {
-            b.iter(|| narrow::tri_aabb_overlap_row(black_box(bx), side.soa(), black_box(&mut out)))
-        });
-    }
-    g.finish();
-}
-
-struct BigBoxes([Vec<f32>; 6]);
-
-impl BigBoxes {
-    fn new(rng: &mut Rng, n: usize) -> Self {
+        let n = BLOCKS * BLOCK;
         let c = [0; 3].map(|_| rng.vec(n, -1.0, 1.0));
-        let h = [0; 3].map(|_| rng.vec(n, 0.0, 0.3));
-        BigBoxes(core::array::from_fn(|f| {
+        let r = rng.vec(n, 0.0, 0.5);
+        let boxes = core::array::from_fn(|f| {
             let a = f % 3;
             let s = if f < 3 { -1.0 } else { 1.0 };
-            (0..n).map(|i| c[a][i] + s * h[a][i]).collect()
-        }))
-    }
-    fn soa(&self) -> AabbSoa<'_> {
-        let f = &self.0;
-        AabbSoa {
-            min_x: &f[0],
-            min_y: &f[1],
-            min_z: &f[2],
-            max_x: &f[3],
-            max_y: &f[4],
-            max_z: &f[5],
+            (0..n).map(|i| c[a][i] + s * r[i] * 0.8).collect()
+        });
+        let probes = (0..BLOCKS)
+            .map(|_| ([0; 3].map(|_| rng.f32_in(-1.0, 1.0)), rng.f32_in(0.0, 0.5)))
+            .collect();
+        let [x, y, z] = c;
+        Blocks {
+            sphere: [x, y, z, r],
+            boxes,
+            probes,
         }
+    }
+    fn sphere(&self, k: usize) -> SphereSoa<'_> {
+        let r = k * BLOCK..(k + 1) * BLOCK;
+        let s = &self.sphere;
+        SphereSoa {
+            cx: &s[0][r.clone()],
+            cy: &s[1][r.clone()],
+            cz: &s[2][r.clone()],
+            r: &s[3][r],
+        }
+    }
+    fn aabb(&self, k: usize) -> AabbSoa<'_> {
+        let r = k * BLOCK..(k + 1) * BLOCK;
+        let b = &self.boxes;
+        AabbSoa {
+            min_x: &b[0][r.clone()],
+            min_y: &b[1][r.clone()],
+            min_z: &b[2][r.clone()],
+            max_x: &b[3][r.clone()],
+            max_y: &b[4][r.clone()],
+            max_z: &b[5][r],
+        }
+    }
+}
+
+/// Every block against its probe, scalar or SIMD, summing the bits (so nothing is elided).
+struct AllBlocks<'a> {
+    blocks: &'a Blocks,
+    aabb: bool,
+}
+
+impl WithSimd for AllBlocks<'_> {
+    type Output = u32;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> u32 {
+        let b = self.blocks;
+        let mut hits = 0;
+        for (k, &(c, r)) in b.probes.iter().enumerate() {
+            hits += if self.aabb {
+                let lo = [c[0] - r, c[1] - r, c[2] - r];
+                let hi = [c[0] + r, c[1] + r, c[2] + r];
+                overlap::aabb_block_with(simd, lo, hi, b.aabb(k), BLOCK)
+            } else {
+                overlap::sphere_block_with(simd, c, r, b.sphere(k), BLOCK)
+            }
+            .count_ones();
+        }
+        hits
+    }
+}
+
+fn block_benches(c: &mut Criterion) {
+    let blocks = Blocks::new(&mut Rng::new(1));
+    for (name, aabb) in [("sphere_block", false), ("aabb_block", true)] {
+        let mut g = c.benchmark_group(format!("kernels/{name}"));
+        g.throughput(Throughput::Elements((BLOCKS * BLOCK) as u64));
+        g.bench_function("scalar", |bench| {
+            bench.iter(|| {
+                let mut hits = 0;
+                for (k, &(c, r)) in blocks.probes.iter().enumerate() {
+                    hits += if aabb {
+                        let lo = [c[0] - r, c[1] - r, c[2] - r];
+                        let hi = [c[0] + r, c[1] + r, c[2] + r];
+                        overlap::aabb_block_scalar(lo, hi, blocks.aabb(k), BLOCK)
+                    } else {
+                        overlap::sphere_block_scalar(c, r, blocks.sphere(k), BLOCK)
+                    }
+                    .count_ones();
+                }
+                black_box(hits)
+            })
+        });
+        g.bench_function("simd", |bench| {
+            bench.iter(|| {
+                black_box(dhcd_kernels::arch().dispatch(AllBlocks {
+                    blocks: black_box(&blocks),
+                    aabb,
+                }))
+            })
+        });
+        g.finish();
+    }
+}
+
+/// `LEAF_PAIRS` pairs of leaves of 8 nearby triangles (SoA, with corner indices), as
+/// the narrow phase meets them.
+struct LeafPairs {
+    corner: [[Vec<f32>; 3]; 3],
+    lo: [Vec<f32>; 3],
+    hi: [Vec<f32>; 3],
+    vertex: [Vec<u32>; 3],
+}
+
+impl LeafPairs {
+    fn new(rng: &mut Rng) -> Self {
+        let n = 2 * LEAF_PAIRS * LEAF;
+        let mut tris = Vec::with_capacity(n);
+        for _ in 0..LEAF_PAIRS {
+            let c = [0; 3].map(|_| rng.f32_in(-1.0, 1.0));
+            for _ in 0..2 * LEAF {
+                let t: [[f32; 3]; 3] =
+                    [0; 3].map(|_| [0, 1, 2].map(|k| c[k] + rng.f32_in(-0.3, 0.3)));
+                tris.push(t);
+            }
+        }
+        LeafPairs {
+            corner: core::array::from_fn(|c| {
+                core::array::from_fn(|k| tris.iter().map(|t| t[c][k]).collect())
+            }),
+            lo: core::array::from_fn(|k| {
+                tris.iter()
+                    .map(|t| t[0][k].min(t[1][k]).min(t[2][k]))
+                    .collect()
+            }),
+            hi: core::array::from_fn(|k| {
+                tris.iter()
+                    .map(|t| t[0][k].max(t[1][k]).max(t[2][k]))
+                    .collect()
+            }),
+            vertex: core::array::from_fn(|_| (0..n).map(|_| rng.below(4000)).collect()),
+        }
+    }
+    /// Leaf `l` (of `2 * LEAF_PAIRS`).
+    fn leaf(&self, l: usize) -> TriSoa<'_> {
+        let r = l * LEAF..(l + 1) * LEAF;
+        let c = &self.corner;
+        TriSoa {
+            corner: core::array::from_fn(|i| core::array::from_fn(|k| &c[i][k][r.clone()])),
+            lo: core::array::from_fn(|k| &self.lo[k][r.clone()]),
+            hi: core::array::from_fn(|k| &self.hi[k][r.clone()]),
+            vertex: core::array::from_fn(|k| &self.vertex[k][r.clone()]),
+        }
+    }
+}
+
+struct AllLeafPairs<'a> {
+    leaves: &'a LeafPairs,
+    pairing: Pairing,
+}
+
+impl WithSimd for AllLeafPairs<'_> {
+    type Output = u64;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> u64 {
+        let mut rows = [0u64; LEAF];
+        let mut n = 0;
+        for p in 0..LEAF_PAIRS {
+            let (a, b) = (self.leaves.leaf(2 * p), self.leaves.leaf(2 * p + 1));
+            n += narrow::leaf_candidates_with(simd, a, LEAF, b, LEAF, self.pairing, &mut rows);
+            n += rows.iter().map(|r| r.count_ones() as u64).sum::<u64>();
+        }
+        n
+    }
+}
+
+fn leaf_benches(c: &mut Criterion) {
+    let leaves = LeafPairs::new(&mut Rng::new(2));
+    for (name, pairing) in [
+        ("leaf_candidates", Pairing::All),
+        ("leaf_candidates_self", Pairing::NoSharedVertex),
+    ] {
+        let mut g = c.benchmark_group(format!("kernels/{name}"));
+        g.throughput(Throughput::Elements((LEAF_PAIRS * LEAF * LEAF) as u64));
+        g.bench_function("scalar", |bench| {
+            bench.iter(|| {
+                let mut rows = [0u64; LEAF];
+                let mut n = 0;
+                for p in 0..LEAF_PAIRS {
+                    let (a, b) = (leaves.leaf(2 * p), leaves.leaf(2 * p + 1));
+                    n += narrow::leaf_candidates_scalar(a, LEAF, b, LEAF, pairing, &mut rows);
+                    n += rows.iter().map(|r| r.count_ones() as u64).sum::<u64>();
+                }
+                black_box(n)
+            })
+        });
+        g.bench_function("simd", |bench| {
+            bench.iter(|| {
+                black_box(dhcd_kernels::arch().dispatch(AllLeafPairs {
+                    leaves: black_box(&leaves),
+                    pairing,
+                }))
+            })
+        });
+        g.finish();
     }
 }
 
@@ -258,38 +335,5 @@ fn refit_benches(c: &mut Criterion) {
     );
 }
 
-fn out(o: &mut [Vec<f32>; 6]) -> AabbSoaMut<'_> {
-    let [a, b, c, d, e, f] = o;
-    AabbSoaMut {
-        min_x: a,
-        min_y: b,
-        min_z: c,
-        max_x: d,
-        max_y: e,
-        max_z: f,
-    }
-}
-
-fn narrow_benches(c: &mut Criterion) {
-    let mut g = c.benchmark_group("kernels/triangle_bounds");
-    let mut rng = Rng::new(9);
-    let p = [0; 3].map(|_| rng.vec(VERTICES, -1.0, 1.0));
-    let pts = Soa3::new(&p[0], &p[1], &p[2]);
-    for n in SIZES {
-        let tris: Vec<[u32; 3]> = (0..n)
-            .map(|_| [0; 3].map(|_| rng.below(VERTICES)))
-            .collect();
-        let mut o: [Vec<f32>; 6] = core::array::from_fn(|_| vec![0.0; n]);
-        g.throughput(Throughput::Elements(n as u64));
-        g.bench_function(BenchmarkId::new("scalar", n), |b| {
-            b.iter(|| narrow::triangle_bounds_scalar(black_box(pts), black_box(&tris), out(&mut o)))
-        });
-        g.bench_function(BenchmarkId::new("dispatched", n), |b| {
-            b.iter(|| narrow::triangle_bounds(black_box(pts), black_box(&tris), out(&mut o)))
-        });
-    }
-    g.finish();
-}
-
-criterion_group!(benches, overlap_benches, refit_benches, narrow_benches);
+criterion_group!(benches, block_benches, leaf_benches, refit_benches);
 criterion_main!(benches);

@@ -10,8 +10,9 @@ use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
 use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
 use crate::mesh::Mesh;
 use crate::par::Par;
-use crate::self_collide::self_collide_with;
-use crate::traverse::{broad_phase, collide_with, narrow_phase, Contacts, Workspace};
+use crate::traverse::{
+    broad_phase, collide_with, narrow_phase, self_collide_with, Contacts, Workspace,
+};
 use crate::tree::RegionTree;
 
 kinds!(crate::kinds::kind_enum {

@@ -6,7 +6,6 @@ use crate::bv::BvKind;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::narrow::intersection_segment;
-use crate::traverse::corners;
 
 /// An intersection segment `[p, q]` (`p == q` for a single point); see
 /// [`intersection_segment`].
@@ -33,10 +32,8 @@ impl<'h, K: BvKind> OriginalCorners<'h, K> {
             triangle: t.into(),
             triangle_count: self.slot.len(),
         })?;
-        Ok(corners(
-            self.h.points(),
-            self.h.tree().triangles()[i as usize],
-        ))
+        let p = self.h.points();
+        Ok(self.h.tree().triangles()[i as usize].map(|v| p.get(v as usize)))
     }
 }
 

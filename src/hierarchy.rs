@@ -8,6 +8,8 @@ use crate::error::{Error, Result};
 use crate::mesh::{check_positions, Mesh};
 use crate::points::Points;
 use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
+use dhcd_kernels::lazy::LazySoa;
+use dhcd_kernels::narrow::TriSoa;
 
 /// When bounding volumes follow a deformation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -94,52 +96,79 @@ pub struct Hierarchy<K: BvKind> {
     tree: Arc<RegionTree>,
     points: Points,
     nodes: K::Nodes,
-    /// `stamp[n] == epoch` iff node `n` is fitted to the current positions.
-    stamp: Vec<u32>,
-    epoch: u32,
     refit: Refit,
-    /// BV updates done since the last query took them (see [`Hierarchy::take_updates`]).
+    /// BV updates done outside queries (eager refits) since the last query took them.
     updates: u64,
     /// Triangle corners and boxes in the current pose, refreshed lazily per leaf.
     tris: TriCache,
 }
 
-/// Every triangle's corners and closed box in the current pose (internal triangle order),
-/// refreshed lazily, one leaf at a time, by the narrow phase: a leaf meets many leaves of
-/// the other object, so its triangles are gathered once per step instead of once per leaf
-/// pair. Boxes are SoA so the box filter over a leaf's run is one vectorizable loop.
-#[derive(Clone, Debug, Default)]
+/// Every triangle's corners and closed box in the current pose (internal triangle order,
+/// structure-of-arrays), refreshed lazily one leaf at a time by the narrow phase: a leaf
+/// meets several leaves, so its triangles are gathered once per step instead of once per
+/// leaf pair, and the narrow phase's row filters read contiguous arrays.
+#[derive(Clone, Debug)]
 pub(crate) struct TriCache {
-    pub(crate) corners: Vec<[[f32; 3]; 3]>,
-    pub(crate) lo: [Vec<f32>; 3],
-    pub(crate) hi: [Vec<f32>; 3],
-    /// `stamp[leaf] == epoch` iff the leaf's triangles are current.
-    stamp: Vec<u32>,
+    /// `corner[c][k]` = coordinate `k` of corner `c` (9 arrays), then box min xyz and max
+    /// xyz (6 arrays); one group per leaf (its triangle run).
+    data: LazySoa<15>,
+}
+
+/// The cached triangles of one leaf: slices of its padded slot range (its `len`
+/// triangles first, then padding up to a multiple of [`crate::tree::BLOCK`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LeafTris<'a> {
+    /// Number of triangles (the slices are longer: padding).
+    pub(crate) len: usize,
+    pub(crate) soa: TriSoa<'a>,
 }
 
 impl TriCache {
-    fn new(tree: &RegionTree, points: &Points) -> Self {
-        let t = tree.triangle_total();
-        let mut c = Self {
-            corners: vec![[[0.0; 3]; 3]; t],
-            lo: std::array::from_fn(|_| vec![0.0; t]),
-            hi: std::array::from_fn(|_| vec![0.0; t]),
-            stamp: vec![0; tree.node_count()],
-        };
-        c.fill(tree, points, 0..t);
-        c
+    fn new(tree: &RegionTree) -> Self {
+        let groups = (0..tree.leaf_count()).map(|r| tree.leaf_slots(r)).collect();
+        Self {
+            data: LazySoa::new(tree.tri_slot_count(), [0.0; 15], groups),
+        }
     }
 
-    fn fill(&mut self, tree: &RegionTree, p: &Points, range: std::ops::Range<usize>) {
-        for i in range {
-            let c = tree.triangles()[i].map(|v| p.get(v as usize));
-            self.corners[i] = c;
-            let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
-            let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
-            for (k, (l, h)) in lo.into_iter().zip(hi).enumerate() {
-                self.lo[k][i] = l;
-                self.hi[k][i] = h;
+    /// Leaf `leaf`'s triangles in the current pose, gathered first if stale.
+    #[inline]
+    pub(crate) fn leaf<'a>(
+        &'a self,
+        tree: &'a RegionTree,
+        p: &Points,
+        leaf: usize,
+    ) -> LeafTris<'a> {
+        let g = tree.leaf_rank(leaf).expect("a leaf");
+        let tris = tree.tri_range(leaf);
+        let (f, _) = self.data.get_or_fill(g, |_, fields| {
+            for (i, t) in tris.clone().enumerate() {
+                let c = tree.triangles()[t].map(|v| p.get(v as usize));
+                for corner in 0..3 {
+                    for k in 0..3 {
+                        fields[3 * corner + k][i] = c[corner][k];
+                    }
+                }
+                for k in 0..3 {
+                    fields[9 + k][i] = c[0][k].min(c[1][k]).min(c[2][k]);
+                    fields[12 + k][i] = c[0][k].max(c[1][k]).max(c[2][k]);
+                }
             }
+        });
+        let [c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z, lx, ly, lz, hx, hy, hz] = f;
+        let slots = tree.leaf_slots(g);
+        LeafTris {
+            len: tris.len(),
+            soa: TriSoa {
+                corner: [[c0x, c0y, c0z], [c1x, c1y, c1z], [c2x, c2y, c2z]],
+                lo: [lx, ly, lz],
+                hi: [hx, hy, hz],
+                vertex: [
+                    &tree.slot_vertex(0)[slots.clone()],
+                    &tree.slot_vertex(1)[slots.clone()],
+                    &tree.slot_vertex(2)[slots],
+                ],
+            },
         }
     }
 }
@@ -167,15 +196,11 @@ impl<K: BvKind> Hierarchy<K> {
         }
         let points = Points::gather(mesh.positions(), tree.vert_order());
         let nodes = K::build(&tree, &points);
-        let stamp = vec![0; tree.node_count()];
-        let tris = TriCache::new(&tree, &points);
         Ok(Self {
-            tris,
+            tris: TriCache::new(&tree),
             tree,
             points,
             nodes,
-            stamp,
-            epoch: 0,
             refit,
             updates: 0,
         })
@@ -199,18 +224,13 @@ impl<K: BvKind> Hierarchy<K> {
     /// Marks every bounding volume stale without moving anything (the next query refits
     /// what it tests). Used by calibration and benchmarks to repeat a step's refit work.
     pub fn invalidate(&mut self) {
-        if self.epoch == u32::MAX {
-            self.stamp.fill(0);
-            self.tris.stamp.fill(0);
-            self.epoch = 1;
-        } else {
-            self.epoch += 1;
-        }
+        K::invalidate(&mut self.nodes);
+        self.tris.data.invalidate();
     }
 
-    /// Refits exactly the stale nodes among `ids` (each once), as the lazy traversal does,
-    /// counting them as updates. A node id out of range is an [`Error::NodeOutOfRange`] and
-    /// nothing is refitted.
+    /// Refits the stale sibling groups of the nodes `ids` (each group once), as the lazy
+    /// traversal does, counting the nodes fitted as updates. A node id out of range is an
+    /// [`Error::NodeOutOfRange`] and nothing is refitted.
     pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) -> Result<()> {
         if let Some(&n) = ids.iter().find(|&&n| n as usize >= self.node_count()) {
             return Err(Error::NodeOutOfRange {
@@ -218,111 +238,62 @@ impl<K: BvKind> Hierarchy<K> {
                 node_count: self.node_count(),
             });
         }
-        let mut stale = Vec::new();
-        par.install(|| self.ensure_fitted(ids, par.is_parallel(), &mut stale));
+        let mut groups: Vec<usize> = ids
+            .iter()
+            .map(|&n| self.tree.group_of(n as usize))
+            .collect();
+        groups.sort_unstable();
+        groups.dedup();
+        let (nodes, tree, points) = (&self.nodes, &*self.tree, &self.points);
+        let fit = |g: &usize| {
+            if K::group(nodes, tree, points, *g).1 {
+                tree.group_nodes(*g).len() as u64
+            } else {
+                0
+            }
+        };
+        let fitted: u64 = if par.is_parallel() {
+            use rayon::prelude::*;
+            par.install(|| groups.par_iter().map(fit).sum())
+        } else {
+            groups.iter().map(fit).sum()
+        };
+        self.updates += fitted;
         Ok(())
     }
 
-    /// The nodes fitted to the current positions (after a lazy query: the nodes it refitted
-    /// or found fresh), in increasing order.
+    /// The nodes fitted to the current positions (after a lazy query: the sibling groups it
+    /// refitted or found fresh), in increasing order.
     pub fn fitted_nodes(&self) -> Vec<u32> {
         (0..self.node_count() as u32)
-            .filter(|&n| self.stamp[n as usize] == self.epoch)
+            .filter(|&n| self.is_fitted(n as usize))
             .collect()
     }
 
     /// Refits every stale node exactly.
     pub fn refit_all(&mut self) {
-        let all: Vec<u32> = (0..self.node_count() as u32).collect();
-        self.ensure_fitted(&all, false, &mut Vec::new());
+        self.updates += K::refit_all(&mut self.nodes, &self.tree, &self.points, false);
     }
 
-    /// Refits every node bottom-up: stale leaves exactly, internal nodes from their children.
+    /// Refits every stale node bottom-up: leaves exactly, internal nodes from their children.
     pub fn refit_bottom_up(&mut self) {
-        let tree = Arc::clone(&self.tree);
-        for d in (0..tree.depth_count()).rev() {
-            for n in tree.level_nodes(d) {
-                if self.stamp[n] == self.epoch {
-                    continue;
-                }
-                let r = if tree.is_leaf(n) {
-                    K::fit(&self.nodes, &tree, &self.points, n)
-                } else {
-                    K::merge(&self.nodes, &tree, &self.points, n)
-                };
-                K::set(&mut self.nodes, n, r);
-                K::stage(&mut self.nodes, &self.points, n);
-                self.stamp[n] = self.epoch;
-                self.updates += 1;
-            }
-        }
+        self.updates += K::refit_all(&mut self.nodes, &self.tree, &self.points, true);
     }
 
-    /// Lazy refit: fits every node of `ids` that is stale (each once), counting the updates.
-    /// `stale` is scratch. In parallel, the fits are computed on the current rayon pool and
-    /// stored in order; a fit reads only positions and its own node, so the result is the
-    /// same either way.
-    pub(crate) fn ensure_fitted(&mut self, ids: &[u32], parallel: bool, stale: &mut Vec<u32>) {
-        stale.clear();
-        // PERF: frontiers repeat a node in runs (a parent's child against all of the other
-        // parent's children); a repeat of the previous id is already fitted.
-        let mut last = u32::MAX;
-        for &n in ids {
-            if n == last {
-                continue;
-            }
-            last = n;
-            let slot = &mut self.stamp[n as usize];
-            if *slot != self.epoch {
-                *slot = self.epoch;
-                stale.push(n);
-            }
-        }
-        self.updates += stale.len() as u64;
-        if parallel && stale.len() > 1 {
-            use rayon::prelude::*;
-            let (nodes, tree, points) = (&self.nodes, &*self.tree, &self.points);
-            let fitted: Vec<K::Record> = stale
-                .par_iter()
-                .with_min_len(4)
-                .map(|&n| K::fit(nodes, tree, points, n as usize))
-                .collect();
-            for (&n, r) in stale.iter().zip(fitted) {
-                K::set(&mut self.nodes, n as usize, r);
-                K::stage(&mut self.nodes, &self.points, n as usize);
-            }
-        } else {
-            for &n in stale.iter() {
-                let r = K::fit(&self.nodes, &self.tree, &self.points, n as usize);
-                K::set(&mut self.nodes, n as usize, r);
-                K::stage(&mut self.nodes, &self.points, n as usize);
-            }
-        }
-    }
-
-    /// Brings leaf `leaf`'s entries of the triangle cache to the current pose (once per step).
+    /// Sibling group `g`'s volumes, fitted first if stale; whether this call fitted them.
     #[inline]
-    pub(crate) fn ensure_leaf_tris(&mut self, leaf: usize) {
-        if self.tris.stamp[leaf] != self.epoch {
-            self.tris.stamp[leaf] = self.epoch;
-            self.tris
-                .fill(&self.tree, &self.points, self.tree.tri_range(leaf));
-        }
+    pub(crate) fn group(&self, g: usize) -> (K::Block<'_>, bool) {
+        K::group(&self.nodes, &self.tree, &self.points, g)
     }
 
-    /// Whether leaf `leaf`'s entries of the triangle cache are current.
+    /// Leaf `leaf`'s triangles in the current pose, gathered first if stale.
     #[inline]
-    pub(crate) fn leaf_tris_current(&self, leaf: usize) -> bool {
-        self.tris.stamp[leaf] == self.epoch
+    pub(crate) fn leaf_tris(&self, leaf: usize) -> LeafTris<'_> {
+        self.tris.leaf(&self.tree, &self.points, leaf)
     }
 
-    /// The triangle cache (current only for leaves passed to `ensure_leaf_tris` this step).
-    #[inline]
-    pub(crate) fn tri_cache(&self) -> &TriCache {
-        &self.tris
-    }
-
-    /// The BV updates done since the last call (queries add them to their `bv_updates`).
+    /// The BV updates done outside queries (eager refits, [`Hierarchy::refit_nodes`]) since
+    /// the last call; queries add them to their `bv_updates`.
     pub fn take_updates(&mut self) -> u64 {
         std::mem::take(&mut self.updates)
     }
@@ -334,10 +305,9 @@ impl<K: BvKind> Hierarchy<K> {
     pub fn validate(&self) -> std::result::Result<usize, InvariantError> {
         let mut checked = 0;
         for n in 0..self.node_count() {
-            if self.stamp[n] != self.epoch {
+            let Some(rec) = self.record(n) else {
                 continue;
-            }
-            let rec = K::get(&self.nodes, n);
+            };
             if let Some(v) = self
                 .tree
                 .region_vertices(n)
@@ -355,14 +325,14 @@ impl<K: BvKind> Hierarchy<K> {
         Ok(checked)
     }
 
-    /// Whether node `n` is fitted to the current positions.
+    /// Whether node `n` is fitted to the current positions (its sibling group is).
     pub fn is_fitted(&self, n: usize) -> bool {
-        self.stamp[n] == self.epoch
+        K::group_current(&self.nodes, self.tree.group_of(n))
     }
 
-    /// Node `n`'s record (possibly stale: see [`Hierarchy::is_fitted`]).
-    pub fn record(&self, n: usize) -> K::Record {
-        K::get(&self.nodes, n)
+    /// Node `n`'s record, if it is fitted to the current positions.
+    pub fn record(&self, n: usize) -> Option<K::Record> {
+        K::record(&self.nodes, &self.tree, n)
     }
 
     pub fn tree(&self) -> &Arc<RegionTree> {
@@ -396,7 +366,7 @@ impl<K: BvKind> Hierarchy<K> {
     }
 
     /// Bytes of all node records of this hierarchy (`node_count * bytes_per_node`; the
-    /// shared topology is [`RegionTree::topology_bytes`], the SIMD padding is not counted).
+    /// shared topology is [`RegionTree::topology_bytes`]).
     pub fn bv_bytes(&self) -> usize {
         self.node_count() * self.bytes_per_node()
     }

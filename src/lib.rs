@@ -39,7 +39,6 @@ pub mod narrow;
 pub mod par;
 pub mod points;
 pub mod scene;
-pub mod self_collide;
 pub mod shapes;
 pub mod traverse;
 pub mod tree;
@@ -52,6 +51,9 @@ pub use hierarchy::{Hierarchy, InvariantError, Options, Refit};
 pub use mesh::Mesh;
 pub use par::Par;
 pub use scene::{ObjectId, Scene, SceneContacts};
-pub use self_collide::{self_collide, self_collide_with};
-pub use traverse::{broad_phase, collide, collide_with, narrow_phase, Contacts, Workspace};
+
+pub use traverse::{
+    broad_phase, collide, collide_with, narrow_phase, self_collide, self_collide_with, Contacts,
+    Workspace,
+};
 pub use tree::RegionTree;

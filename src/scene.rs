@@ -30,8 +30,7 @@ use crate::hierarchy::{Hierarchy, Options};
 use crate::kinds::{kinds, match_kind, with_kind};
 use crate::mesh::Mesh;
 use crate::par::Par;
-use crate::self_collide::self_collide_with;
-use crate::traverse::{collide_with, Contacts, Workspace};
+use crate::traverse::{collide_with, self_collide_with, Contacts, Workspace};
 
 /// Identifies an object of a [`Scene`]. Ids are handed out in increasing order from 0 and
 /// are **never reused**, even after [`Scene::remove`]: a stale id is always an

@@ -1,26 +1,37 @@
-//! The query: a stackless, level-synchronous traversal of two hierarchies, then the exact
-//! narrow phase on the triangle pairs of overlapping leaves.
+//! The query: a depth-first traversal of two hierarchies (or one against itself) with wide
+//! node tests, and the exact narrow phase on the triangle pairs of overlapping leaves.
 //!
-//! The frontier is an array of node pairs. Each round refits the stale nodes it names (lazy
-//! refit), batch-tests all its pairs with one kernel call per chunk, and expands the
-//! overlapping pairs: two leaves become a leaf pair; a leaf against an internal node pairs
-//! the leaf with the node's children; two internal nodes pair all their children. Every node
-//! pair is produced at most once, so no contact is reported twice.
+//! A stack holds node pairs known to overlap. Popping `(x, y)`:
+//! - two leaves: the narrow phase runs on their triangles at once (no list of leaf pairs
+//!   is kept);
+//! - otherwise the larger volume (or the internal one) is descended: the other node is
+//!   tested against the whole sibling group of its children in one SIMD operation
+//!   (Embree's collider pattern), and only the overlapping children are pushed.
 //!
-//! In parallel, each round is cut into chunks of `grain` pairs (leaf pairs: `grain / 64`)
-//! whose outputs are concatenated in chunk order, so contacts and counters are identical for
-//! every thread count.
+//! Self-collision starts from the *self pair* `(root, root)`. A self pair `(x, x)` is never
+//! tested (a node overlaps itself): an internal `x` pushes the self pairs of its children
+//! and, for each child `c_i`, the overlapping `(c_i, c_j)`, `j > i` (one wide test of `c_i`
+//! against the rest of the group); a leaf `x` is narrow-tested against itself.
+//!
+//! Memory does not grow with the work: the stack holds at most
+//! `depth * (MAX_CHILDREN + MAX_CHILDREN^2 / 2)` pairs, and the only output is the contact
+//! list. Lazy refit happens in the same walk: a sibling group is fitted right before its
+//! first test in a step (see [`LazySoa`](crate::lazy)), whichever thread gets there first.
+//!
+//! Parallelism: the walk is expanded breadth-first on the calling thread until there are
+//! enough pairs to share, then each pair is walked depth-first as a rayon task. Every pair
+//! of nodes is visited at most once whatever the split, so the counters are identical for
+//! every thread count, and the contacts are sorted.
 
+use pulp::{Simd, WithSimd};
 use rayon::prelude::*;
 
 use crate::bv::BvKind;
 use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
-use crate::narrow;
+use crate::narrow::leaves::{leaf_pair, LeafSide, Leaves};
 use crate::par::Par;
-use crate::points::Points;
-use crate::tree::RegionTree;
 
 /// Result of a query: contacts as `[triangle of A, triangle of B]` in the caller's original
 /// triangle indices, sorted ascending, and the counted work.
@@ -30,22 +41,20 @@ pub struct Contacts {
     pub counters: Counters,
 }
 
-/// Default number of node pairs per parallel task.
-pub const DEFAULT_GRAIN: usize = 1024;
+/// Default smallest number of starting pairs per parallel task.
+pub const DEFAULT_GRAIN: usize = 1;
 
-/// Reusable scratch of a query (frontier arrays, masks, leaf pairs): keep one per thread to
-/// avoid allocating every step. Also holds the parallel grain.
+/// Pairs the breadth-first start aims for, per thread, before the parallel walk.
+const SEEDS_PER_THREAD: usize = 64;
+
+/// Reusable scratch of a query (the walk's stack, the leaf pairs of [`broad_phase`]): keep
+/// one per thread to avoid allocating every step. Also holds the parallel grain.
 #[derive(Clone, Debug)]
 pub struct Workspace {
     pub(crate) grain: usize,
-    pub(crate) ia: Vec<u32>,
-    pub(crate) ib: Vec<u32>,
-    pub(crate) next_a: Vec<u32>,
-    pub(crate) next_b: Vec<u32>,
-    pub(crate) mask: Vec<u32>,
-    pub(crate) leaves: Vec<[u32; 2]>,
-    pub(crate) stale: Vec<u32>,
-    pub(crate) sel: Vec<u32>,
+    stack: Vec<[u32; 2]>,
+    seeds: Vec<[u32; 2]>,
+    leaves: Vec<[u32; 2]>,
 }
 
 impl Default for Workspace {
@@ -55,20 +64,20 @@ impl Default for Workspace {
 }
 
 impl Workspace {
-    /// A workspace whose parallel tasks take `grain` node pairs each (at least 1). Small
-    /// grains force splits everywhere (tests); large ones cut scheduling overhead.
+    /// A workspace whose parallel tasks take at least `grain` starting pairs each (at least
+    /// 1). Larger grains cut scheduling overhead; the result never depends on it.
     pub fn with_grain(grain: usize) -> Self {
         Self {
             grain: grain.max(1),
-            ia: Vec::new(),
-            ib: Vec::new(),
-            next_a: Vec::new(),
-            next_b: Vec::new(),
-            mask: Vec::new(),
+            stack: Vec::new(),
+            seeds: Vec::new(),
             leaves: Vec::new(),
-            stale: Vec::new(),
-            sel: Vec::new(),
         }
+    }
+
+    /// The overlapping leaf pairs (node ids) found by the last [`broad_phase`].
+    pub fn leaf_pairs(&self) -> &[[u32; 2]] {
+        &self.leaves
     }
 }
 
@@ -86,29 +95,68 @@ pub fn collide_with<K: BvKind>(
     ws: &mut Workspace,
     par: Par,
 ) -> Contacts {
-    par.install(|| run(a, b, ws, par.is_parallel()))
+    let updates = a.take_updates() + b.take_updates();
+    let walk = Walk {
+        a,
+        b,
+        self_query: false,
+        narrow: true,
+    };
+    let mut c = par.install(|| walk.run(ws, par.is_parallel()));
+    c.counters.bv_updates += updates;
+    c
 }
 
-fn run<K: BvKind>(
-    a: &mut Hierarchy<K>,
-    b: &mut Hierarchy<K>,
+/// Every pair of intersecting triangles of one object, `[ti, tj]` with `ti < tj` (the
+/// caller's original indices), sorted, excluding pairs that share a vertex index; on the
+/// calling thread. Refits (lazily) the nodes it tests.
+///
+/// ```
+/// use dhcd::{bv::Dh, self_collide, Hierarchy, Mesh, Options};
+/// // Two triangles of one mesh crossing each other (no shared vertex), and a third one
+/// // sharing an edge with the first (neighbours are never reported).
+/// let mesh = Mesh::new(
+///     vec![
+///         [0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0],
+///         [0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [0.2, 0.8, 0.0],
+///         [2.0, 2.0, 0.0],
+///     ],
+///     vec![[0, 1, 2], [3, 4, 5], [1, 6, 2]],
+/// )?;
+/// let mut h = Hierarchy::<Dh>::new(&mesh, Options::default())?;
+/// let c = self_collide(&mut h);
+/// assert_eq!(c.pairs, vec![[0, 1]]);
+/// assert_eq!(c.pairs, dhcd::narrow::brute_force_self_pairs(&mesh));
+/// # Ok::<(), dhcd::Error>(())
+/// ```
+pub fn self_collide<K: BvKind>(h: &mut Hierarchy<K>) -> Contacts {
+    self_collide_with(h, &mut Workspace::default(), Par::Seq)
+}
+
+/// [`self_collide`] with caller-owned scratch and a choice of parallelism. The result does
+/// not depend on `par`.
+pub fn self_collide_with<K: BvKind>(
+    h: &mut Hierarchy<K>,
     ws: &mut Workspace,
-    parallel: bool,
+    par: Par,
 ) -> Contacts {
-    let mut counters = broad(a, b, ws, parallel);
-    let narrow = narrow(a, b, &ws.leaves, ws.grain, parallel);
-    debug_assert_eq!(narrow.counters.prim_tests, counters.prim_tests);
-    counters.contacts = narrow.counters.contacts;
-    Contacts {
-        pairs: narrow.pairs,
-        counters,
-    }
+    let updates = h.take_updates();
+    let walk = Walk {
+        a: h,
+        b: h,
+        self_query: true,
+        narrow: true,
+    };
+    let mut c = par.install(|| walk.run(ws, par.is_parallel()));
+    c.counters.bv_updates += updates;
+    c
 }
 
 /// The broad phase alone: lazy refit and traversal down to the overlapping leaf pairs, which
-/// stay in `ws` ([`Workspace::leaf_pairs`]). Its counters have `bv_tests`, `bv_updates` and
-/// `prim_tests` (the triangle pairs the narrow phase will test) as [`collide_with`] counts
-/// them; `contacts` is 0. With [`narrow_phase`] it is [`collide_with`] split in two, for
+/// stay in `ws` ([`Workspace::leaf_pairs`], in a deterministic order; this list, unlike a
+/// query, grows with the work). Its counters have `bv_tests`, `bv_updates` and `prim_tests`
+/// (the triangle pairs the narrow phase will test) as [`collide_with`] counts them;
+/// `contacts` is 0. With [`narrow_phase`] it is [`collide_with`] split in two, for
 /// benchmarks and cost-model calibration.
 pub fn broad_phase<K: BvKind>(
     a: &mut Hierarchy<K>,
@@ -116,7 +164,25 @@ pub fn broad_phase<K: BvKind>(
     ws: &mut Workspace,
     par: Par,
 ) -> Counters {
-    par.install(|| broad(a, b, ws, par.is_parallel()))
+    let updates = a.take_updates() + b.take_updates();
+    let walk = Walk {
+        a,
+        b,
+        self_query: false,
+        narrow: false,
+    };
+    let c = par.install(|| walk.run(ws, par.is_parallel()));
+    let (ta, tb) = (a.tree(), b.tree());
+    let prim_tests = ws
+        .leaves
+        .iter()
+        .map(|&[x, y]| (ta.tri_range(x as usize).len() * tb.tri_range(y as usize).len()) as u64)
+        .sum();
+    Counters {
+        bv_updates: c.counters.bv_updates + updates,
+        prim_tests,
+        ..c.counters
+    }
 }
 
 /// The narrow phase alone: exact tests of every triangle pair of the given leaf pairs (node
@@ -142,299 +208,310 @@ pub fn narrow_phase<K: BvKind>(
             }
         }
     }
-    Ok(par.install(|| narrow(a, b, leaves, DEFAULT_GRAIN, par.is_parallel())))
-}
-
-impl Workspace {
-    /// The overlapping leaf pairs (node ids) found by the last query or [`broad_phase`].
-    pub fn leaf_pairs(&self) -> &[[u32; 2]] {
-        &self.leaves
-    }
-}
-
-/// One round of the frontier: batch-tests the pairs `ws.ia[k], ws.ib[k]` (already fitted)
-/// and appends the expansion of the overlapping ones to `ws.next_a`/`ws.next_b` (children
-/// pairs) and `ws.leaves` (leaf pairs), in chunk order. Returns the number of pairs tested.
-/// Shared by the two-object query and self-collision (`a` and `b` the same hierarchy).
-pub(crate) fn test_and_expand<K: BvKind>(
-    a: &Hierarchy<K>,
-    b: &Hierarchy<K>,
-    ws: &mut Workspace,
-    parallel: bool,
-) -> u64 {
-    let grain = ws.grain;
-    ws.mask.resize(ws.ia.len(), 0);
-    let test = |ia: &[u32], ib: &[u32], out: &mut [u32]| {
-        K::overlap(a.nodes(), a.points(), b.nodes(), b.points(), ia, ib, out);
+    let walk = Walk {
+        a,
+        b,
+        self_query: false,
+        narrow: true,
     };
-    let (ta, tb) = (&**a.tree(), &**b.tree());
-    if parallel && ws.ia.len() > grain {
-        ws.mask
-            .par_chunks_mut(grain)
-            .zip(ws.ia.par_chunks(grain).zip(ws.ib.par_chunks(grain)))
-            .for_each(|(out, (ia, ib))| test(ia, ib, out));
-        let parts: Vec<Expansion> = ws
-            .ia
-            .par_chunks(grain)
-            .zip(ws.ib.par_chunks(grain).zip(ws.mask.par_chunks(grain)))
-            .map(|(ia, (ib, mask))| {
-                let mut e = Expansion::default();
-                e.expand(ta, tb, ia, ib, mask);
-                e
-            })
-            .collect();
-        for e in parts {
-            ws.next_a.extend_from_slice(&e.next_a);
-            ws.next_b.extend_from_slice(&e.next_b);
-            ws.leaves.extend_from_slice(&e.leaves);
-        }
+    let run = |chunk: &[[u32; 2]]| {
+        let mut out = Output::default();
+        dhcd_kernels::arch().dispatch(NarrowOp {
+            walk: &walk,
+            leaves: chunk,
+            out: &mut out,
+        });
+        out
+    };
+    let out = if par.is_parallel() {
+        par.install(|| {
+            leaves
+                .par_chunks(64)
+                .map(run)
+                .reduce(Output::default, Output::merge)
+        })
     } else {
-        test(&ws.ia, &ws.ib, &mut ws.mask);
-        let mut e = Expansion {
-            next_a: std::mem::take(&mut ws.next_a),
-            next_b: std::mem::take(&mut ws.next_b),
-            leaves: std::mem::take(&mut ws.leaves),
-            sel: std::mem::take(&mut ws.sel),
-        };
-        e.expand(ta, tb, &ws.ia, &ws.ib, &ws.mask);
-        (ws.next_a, ws.next_b, ws.leaves, ws.sel) = (e.next_a, e.next_b, e.leaves, e.sel);
-    }
-    ws.ia.len() as u64
+        run(leaves)
+    };
+    Ok(out.finish())
 }
 
-fn broad<K: BvKind>(
-    a: &mut Hierarchy<K>,
-    b: &mut Hierarchy<K>,
-    ws: &mut Workspace,
-    parallel: bool,
-) -> Counters {
-    let mut counters = Counters::default();
-    ws.leaves.clear();
-    ws.ia.clear();
-    ws.ib.clear();
-    ws.ia.push(0);
-    ws.ib.push(0);
-    while !ws.ia.is_empty() {
-        a.ensure_fitted(&ws.ia, parallel, &mut ws.stale);
-        b.ensure_fitted(&ws.ib, parallel, &mut ws.stale);
-        ws.next_a.clear();
-        ws.next_b.clear();
-        counters.bv_tests += test_and_expand(a, b, ws, parallel);
-        std::mem::swap(&mut ws.ia, &mut ws.next_a);
-        std::mem::swap(&mut ws.ib, &mut ws.next_b);
-    }
-    counters.bv_updates = a.take_updates() + b.take_updates();
-    // The narrow phase's triangle cache: each leaf met by a leaf pair, once per step.
-    for &[la, lb] in &ws.leaves {
-        a.ensure_leaf_tris(la as usize);
-        b.ensure_leaf_tris(lb as usize);
-    }
-    let (ta, tb) = (a.tree(), b.tree());
-    counters.prim_tests = ws
-        .leaves
-        .iter()
-        .map(|&[x, y]| (ta.tri_range(x as usize).len() * tb.tri_range(y as usize).len()) as u64)
-        .sum();
-    counters
+/// One query's hierarchies: `a` against `b`, or one hierarchy against itself.
+struct Walk<'h, K: BvKind> {
+    a: &'h Hierarchy<K>,
+    b: &'h Hierarchy<K>,
+    /// `a` and `b` are the same hierarchy: self pairs, shared vertices skipped.
+    self_query: bool,
+    /// Run the narrow phase on overlapping leaf pairs (else collect them).
+    narrow: bool,
 }
 
-fn narrow<K: BvKind>(
-    a: &Hierarchy<K>,
-    b: &Hierarchy<K>,
-    leaves: &[[u32; 2]],
-    grain: usize,
-    parallel: bool,
-) -> Contacts {
-    exact_tests(leaves, grain, parallel, |la, lb, out| {
-        narrow_leaf_pair(a, b, la, lb, out)
-    })
-}
-
-/// Runs `test_pair(x, y, out)` (which pushes contacts and returns the triangle pairs it
-/// tested) on every leaf pair, in chunks of `grain / 64` leaf pairs when parallel, with
-/// outputs concatenated in chunk order; returns the sorted contacts and `prim_tests` /
-/// `contacts`. Shared by the two-object query and self-collision.
-pub(crate) fn exact_tests(
-    leaves: &[[u32; 2]],
-    grain: usize,
-    parallel: bool,
-    test_pair: impl Fn(usize, usize, &mut Vec<[u32; 2]>) -> u64 + Sync,
-) -> Contacts {
-    let mut counters = Counters::default();
-    let leaf_grain = (grain / 64).max(1);
-    let mut pairs = Vec::new();
-    if parallel && leaves.len() > leaf_grain {
-        let parts: Vec<(Vec<[u32; 2]>, u64)> = leaves
-            .par_chunks(leaf_grain)
-            .map(|chunk| {
-                let mut out = Vec::new();
-                let tested = chunk
-                    .iter()
-                    .map(|&[x, y]| test_pair(x as usize, y as usize, &mut out))
-                    .sum::<u64>();
-                (out, tested)
-            })
-            .collect();
-        for (out, tested) in parts {
-            pairs.extend_from_slice(&out);
-            counters.prim_tests += tested;
-        }
-    } else {
-        for &[x, y] in leaves {
-            counters.prim_tests += test_pair(x as usize, y as usize, &mut pairs);
-        }
-    }
-    pairs.sort_unstable();
-    counters.contacts = pairs.len() as u64;
-    Contacts { pairs, counters }
-}
-
-/// The output of expanding one chunk of a frontier.
+/// What a walk produces: contacts, counters, and (broad phase only) leaf pairs.
 #[derive(Default)]
-pub(crate) struct Expansion {
-    pub(crate) next_a: Vec<u32>,
-    pub(crate) next_b: Vec<u32>,
-    pub(crate) leaves: Vec<[u32; 2]>,
-    /// Scratch: positions of the overlapping pairs.
-    pub(crate) sel: Vec<u32>,
+struct Output {
+    pairs: Vec<[u32; 2]>,
+    counters: Counters,
+    leaves: Vec<[u32; 2]>,
 }
 
-impl Expansion {
-    /// Appends the children pairs of the overlapping pairs (`mask[k] != 0`) and the leaf pairs.
-    ///
-    /// PERF: most tested pairs do not overlap and the mask is unpredictable, so the overlapping
-    /// positions are first compacted without branches (`sel`), then expanded; children runs
-    /// are appended with `extend` (one capacity check per run, not per pair).
-    pub(crate) fn expand(
-        &mut self,
-        ta: &RegionTree,
-        tb: &RegionTree,
-        ia: &[u32],
-        ib: &[u32],
-        mask: &[u32],
-    ) {
-        let sel = &mut self.sel;
-        sel.clear();
-        sel.resize(ia.len(), 0);
-        let mut hits = 0;
-        for (k, &m) in mask[..ia.len()].iter().enumerate() {
-            sel[hits] = k as u32;
-            hits += (m != 0) as usize;
+impl Output {
+    fn merge(mut self, other: Self) -> Self {
+        self.pairs.extend_from_slice(&other.pairs);
+        self.leaves.extend_from_slice(&other.leaves);
+        self.counters += other.counters;
+        self
+    }
+
+    fn finish(mut self) -> Contacts {
+        self.pairs.sort_unstable();
+        self.counters.contacts = self.pairs.len() as u64;
+        Contacts {
+            pairs: self.pairs,
+            counters: self.counters,
         }
-        for &k in &sel[..hits] {
-            let (x, y) = (ia[k as usize] as usize, ib[k as usize] as usize);
-            let (cx, cy) = (ta.children(x), tb.children(y));
-            match (cx.is_empty(), cy.is_empty()) {
-                (true, true) => self.leaves.push([x as u32, y as u32]),
-                (true, false) => {
-                    self.next_a.extend(std::iter::repeat_n(x as u32, cy.len()));
-                    self.next_b.extend(cy.map(|c| c as u32));
-                }
-                (false, true) => {
-                    self.next_b.extend(std::iter::repeat_n(y as u32, cx.len()));
-                    self.next_a.extend(cx.map(|c| c as u32));
-                }
-                (false, false) => {
-                    for c in cx {
-                        self.next_a.extend(std::iter::repeat_n(c as u32, cy.len()));
-                        self.next_b.extend(cy.clone().map(|c| c as u32));
+    }
+}
+
+impl<K: BvKind> Walk<'_, K> {
+    fn run(&self, ws: &mut Workspace, parallel: bool) -> Contacts {
+        ws.leaves.clear();
+        let mut out = Output {
+            leaves: std::mem::take(&mut ws.leaves),
+            ..Output::default()
+        };
+        let threads = rayon::current_num_threads();
+        let seed_target = if parallel && threads > 1 {
+            SEEDS_PER_THREAD * threads
+        } else {
+            0
+        };
+        dhcd_kernels::arch().dispatch(StartOp {
+            walk: self,
+            seeds: &mut ws.seeds,
+            stack: &mut ws.stack,
+            seed_target,
+            out: &mut out,
+        });
+        if !ws.seeds.is_empty() {
+            // The breadth-first start left `seeds`: walk them in parallel.
+            let part = ws
+                .seeds
+                .par_chunks(ws.grain)
+                .fold(Output::default, |mut o, chunk| {
+                    let mut stack = Vec::new();
+                    dhcd_kernels::arch().dispatch(WalkOp {
+                        walk: self,
+                        seeds: chunk,
+                        stack: &mut stack,
+                        out: &mut o,
+                    });
+                    o
+                })
+                .reduce(Output::default, Output::merge);
+            out = out.merge(part);
+            // Deterministic order of the collected leaf pairs (the broad-phase API).
+            out.leaves.sort_unstable();
+        }
+        ws.leaves = std::mem::take(&mut out.leaves);
+        out.finish()
+    }
+
+    /// The root entry: the roots' test (two objects) or the root self pair.
+    #[inline(always)]
+    fn root<S: Simd>(&self, simd: S, out: &mut Output) -> Option<[u32; 2]> {
+        if self.self_query {
+            return Some([0, 0]);
+        }
+        let (ba, fa) = self.a.group(0);
+        let (bb, fb) = self.b.group(0);
+        out.counters.bv_updates += fa as u64 + fb as u64;
+        out.counters.bv_tests += 1;
+        (K::test(simd, ba, 0, bb, 1) != 0).then_some([0, 0])
+    }
+
+    /// Expands one overlapping pair: pushes its overlapping children pairs to `next`, or
+    /// runs the narrow phase on a leaf pair.
+    #[inline(always)]
+    fn expand<S: Simd>(
+        &self,
+        simd: S,
+        [x, y]: [u32; 2],
+        next: &mut Vec<[u32; 2]>,
+        out: &mut Output,
+    ) {
+        let (x, y) = (x as usize, y as usize);
+        let (ta, tb) = (self.a.tree(), self.b.tree());
+        if self.self_query && x == y {
+            let Some(g) = ta.child_group(x) else {
+                return self.leaves(simd, x, y, out);
+            };
+            let (block, fitted) = self.a.group(g);
+            let nodes = ta.group_nodes(g);
+            if fitted {
+                out.counters.bv_updates += nodes.len() as u64;
+            }
+            let m = nodes.len();
+            for i in 0..m {
+                let ci = (nodes.start + i) as u32;
+                next.push([ci, ci]);
+                if i + 1 < m {
+                    // The whole group in one test (aligned loads); the pairs j <= i are
+                    // masked off and not counted.
+                    out.counters.bv_tests += (m - i - 1) as u64;
+                    let mut bits = K::test(simd, block, i, block, m) & !((2u32 << i) - 1);
+                    while bits != 0 {
+                        let k = bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        next.push([ci, (nodes.start + k) as u32]);
                     }
                 }
             }
+            return;
         }
-    }
-}
-
-#[inline]
-pub(crate) fn corners(p: &Points, tri: [u32; 3]) -> [[f32; 3]; 3] {
-    tri.map(|v| p.get(v as usize))
-}
-
-/// Exact tests of every triangle pair of leaves `la` x `lb`; pushes the intersecting ones
-/// (original indices) and returns the number of pairs tested (`N_P`: all of them).
-///
-/// PERF: corners and boxes come from the hierarchies' triangle caches (gathered once per
-/// leaf per step); each triangle of `la` is box-checked against `lb`'s run of boxes and
-/// only the pairs whose closed boxes overlap reach the exact test. That box test is the
-/// exact test's own first filter (closed boxes, comparisons only): contacts are unchanged.
-fn narrow_leaf_pair<K: BvKind>(
-    a: &Hierarchy<K>,
-    b: &Hierarchy<K>,
-    la: usize,
-    lb: usize,
-    out: &mut Vec<[u32; 2]>,
-) -> u64 {
-    if !(a.leaf_tris_current(la) && b.leaf_tris_current(lb)) {
-        return narrow_leaf_pair_gather(a, b, la, lb, out);
-    }
-    let (ta, tb) = (a.tree(), b.tree());
-    let (ca, cb) = (a.tri_cache(), b.tri_cache());
-    let ra = ta.tri_range(la);
-    let rb = tb.tri_range(lb);
-    let n = rb.len();
-    let (lx, ly, lz) = (
-        &cb.lo[0][rb.clone()],
-        &cb.lo[1][rb.clone()],
-        &cb.lo[2][rb.clone()],
-    );
-    let (hx, hy, hz) = (
-        &cb.hi[0][rb.clone()],
-        &cb.hi[1][rb.clone()],
-        &cb.hi[2][rb.clone()],
-    );
-    let corners_b = &cb.corners[rb.clone()];
-    let order_b = &tb.tri_order()[rb.clone()];
-    for i in ra.clone() {
-        let tri_a = &ca.corners[i];
-        let lo = [ca.lo[0][i], ca.lo[1][i], ca.lo[2][i]];
-        let hi = [ca.hi[0][i], ca.hi[1][i], ca.hi[2][i]];
-        // Blocks of 64: the box tests become a bit mask without branches (vectorizable),
-        // then only the set bits (overlapping boxes) are visited.
-        for base in (0..n).step_by(64) {
-            let end = (base + 64).min(n);
-            let mut bits = 0u64;
-            for j in base..end {
-                let ov = (hx[j] >= lo[0])
-                    & (lx[j] <= hi[0])
-                    & (hy[j] >= lo[1])
-                    & (ly[j] <= hi[1])
-                    & (hz[j] >= lo[2])
-                    & (lz[j] <= hi[2]);
-                bits |= (ov as u64) << (j - base);
+        let (gx, gy) = (ta.group_of(x), tb.group_of(y));
+        let (bx, by) = (self.a.group(gx).0, self.b.group(gy).0);
+        let (ix, iy) = (x - ta.group_nodes(gx).start, y - tb.group_nodes(gy).start);
+        let descend_x = match (ta.child_group(x), tb.child_group(y)) {
+            (None, None) => return self.leaves(simd, x, y, out),
+            (Some(_), None) => true,
+            (None, Some(_)) => false,
+            (Some(_), Some(_)) => K::extent(bx, ix) >= K::extent(by, iy),
+        };
+        if descend_x {
+            let g = ta.child_group(x).unwrap_or_default();
+            let (children, fitted) = self.a.group(g);
+            let nodes = ta.group_nodes(g);
+            if fitted {
+                out.counters.bv_updates += nodes.len() as u64;
             }
+            out.counters.bv_tests += nodes.len() as u64;
+            let mut bits = K::test(simd, by, iy, children, nodes.len());
             while bits != 0 {
-                let j = base + bits.trailing_zeros() as usize;
+                let k = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
-                if narrow::triangles_intersect(tri_a, &corners_b[j]) {
-                    out.push([ta.tri_order()[i], order_b[j]]);
-                }
+                next.push([(nodes.start + k) as u32, y as u32]);
+            }
+        } else {
+            let g = tb.child_group(y).unwrap_or_default();
+            let (children, fitted) = self.b.group(g);
+            let nodes = tb.group_nodes(g);
+            if fitted {
+                out.counters.bv_updates += nodes.len() as u64;
+            }
+            out.counters.bv_tests += nodes.len() as u64;
+            let mut bits = K::test(simd, bx, ix, children, nodes.len());
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                next.push([x as u32, (nodes.start + k) as u32]);
             }
         }
     }
-    (ra.len() * rb.len()) as u64
+
+    /// An overlapping leaf pair: the narrow phase now, or collected (broad phase).
+    #[inline(always)]
+    fn leaves<S: Simd>(&self, simd: S, x: usize, y: usize, out: &mut Output) {
+        if !self.narrow {
+            out.leaves.push([x as u32, y as u32]);
+            return;
+        }
+        fn side<K: BvKind>(h: &Hierarchy<K>, leaf: usize) -> LeafSide<'_> {
+            LeafSide {
+                tris: h.leaf_tris(leaf),
+                order: &h.tree().tri_order()[h.tree().tri_range(leaf)],
+            }
+        }
+        let leaves = match (self.self_query, x == y) {
+            (false, _) => Leaves::Objects,
+            (true, false) => Leaves::SelfDistinct,
+            (true, true) => Leaves::SelfSame,
+        };
+        let (sa, sb) = (side(self.a, x), side(self.b, y));
+        out.counters.prim_tests += leaf_pair(simd, &sa, &sb, leaves, &mut out.pairs);
+    }
+
+    /// Depth-first from each of `seeds`.
+    #[inline(always)]
+    fn walk<S: Simd>(
+        &self,
+        simd: S,
+        seeds: &[[u32; 2]],
+        stack: &mut Vec<[u32; 2]>,
+        out: &mut Output,
+    ) {
+        for &seed in seeds {
+            stack.clear();
+            stack.push(seed);
+            while let Some(pair) = stack.pop() {
+                self.expand(simd, pair, stack, out);
+            }
+        }
+    }
 }
 
-/// [`narrow_leaf_pair`] for leaves whose cached triangles are stale (a caller's own leaf
-/// pairs, not from [`broad_phase`] this step): gathers the corners directly; pushes the intersecting ones
-/// (original indices) and returns the number of pairs tested.
-fn narrow_leaf_pair_gather<K: BvKind>(
-    a: &Hierarchy<K>,
-    b: &Hierarchy<K>,
-    la: usize,
-    lb: usize,
-    out: &mut Vec<[u32; 2]>,
-) -> u64 {
-    let (ta, tb) = (a.tree(), b.tree());
-    let ra = ta.tri_range(la);
-    let rb = tb.tri_range(lb);
-    for i in ra.clone() {
-        let tri_a = corners(a.points(), ta.triangles()[i]);
-        for j in rb.clone() {
-            let tri_b = corners(b.points(), tb.triangles()[j]);
-            if narrow::triangles_intersect(&tri_a, &tri_b) {
-                out.push([ta.tri_order()[i], tb.tri_order()[j]]);
+/// The calling thread's part: the root, then either the whole walk (sequential) or a
+/// breadth-first expansion until `seed_target` pairs are waiting (left in `seeds`).
+struct StartOp<'w, 'h, K: BvKind> {
+    walk: &'w Walk<'h, K>,
+    seeds: &'w mut Vec<[u32; 2]>,
+    stack: &'w mut Vec<[u32; 2]>,
+    seed_target: usize,
+    out: &'w mut Output,
+}
+
+impl<K: BvKind> WithSimd for StartOp<'_, '_, K> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        self.seeds.clear();
+        let Some(root) = self.walk.root(simd, self.out) else {
+            return;
+        };
+        if self.seed_target == 0 {
+            return self.walk.walk(simd, &[root], self.stack, self.out);
+        }
+        self.seeds.push(root);
+        let mut next = std::mem::take(self.stack);
+        while !self.seeds.is_empty() && self.seeds.len() < self.seed_target {
+            next.clear();
+            for &pair in self.seeds.iter() {
+                self.walk.expand(simd, pair, &mut next, self.out);
             }
+            std::mem::swap(self.seeds, &mut next);
+        }
+        *self.stack = next;
+    }
+}
+
+/// One parallel task: depth-first from each of its seeds.
+struct WalkOp<'w, 'h, K: BvKind> {
+    walk: &'w Walk<'h, K>,
+    seeds: &'w [[u32; 2]],
+    stack: &'w mut Vec<[u32; 2]>,
+    out: &'w mut Output,
+}
+
+impl<K: BvKind> WithSimd for WalkOp<'_, '_, K> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        self.walk.walk(simd, self.seeds, self.stack, self.out);
+    }
+}
+
+/// The narrow phase of given leaf pairs ([`narrow_phase`]).
+struct NarrowOp<'w, 'h, K: BvKind> {
+    walk: &'w Walk<'h, K>,
+    leaves: &'w [[u32; 2]],
+    out: &'w mut Output,
+}
+
+impl<K: BvKind> WithSimd for NarrowOp<'_, '_, K> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        for &[x, y] in self.leaves {
+            self.walk.leaves(simd, x as usize, y as usize, self.out);
         }
     }
-    (ra.len() * rb.len()) as u64
 }

@@ -247,7 +247,7 @@ fn dh_central_vertex_is_closest_to_region_centroid() {
                 .map(|k| (p.get(v as usize)[k] as f64 - mean[k]).powi(2))
                 .sum()
         };
-        let c = h.record(n).vertex;
+        let c = h.record(n).unwrap().vertex;
         assert!(verts.contains(&c));
         assert!(verts.iter().all(|&v| d(c) <= d(v)), "node {n}");
     }
@@ -560,5 +560,6 @@ fn unreferenced_vertices_are_ignored() {
     let mut h = Hierarchy::<Aabb>::new(&a, Options::default()).unwrap();
     h.refit_all();
     // The root box is the sphere's, not stretched to the unreferenced vertices.
-    assert!(h.record(0).max[0] < 2.0 && h.record(0).min[0] > -2.0);
+    let root = h.record(0).unwrap();
+    assert!(root.max[0] < 2.0 && root.min[0] > -2.0);
 }

@@ -1,19 +1,21 @@
-//! Pure batch kernels of `dhcd`: bounding-volume overlap tests and refit reductions over
-//! structure-of-arrays slices. No tree knowledge lives here: slices in, masks and values out.
+//! Pure batch kernels of `dhcd`: wide bounding-volume tests (one volume against a block of
+//! volumes, [`overlap`]), narrow-phase row filters (one triangle against a row of triangles,
+//! [`narrow`]) and refit reductions ([`refit`]) over structure-of-arrays slices. No tree
+//! knowledge lives here: slices in, bit masks and values out.
 //!
 //! Every kernel has a scalar reference beside it (`*_scalar`) with the same operation order.
 //!
-//! Each public entry is a SIMD kernel with runtime dispatch (pulp): a private generic body
-//! `x_simd<S: pulp::Simd>`, a small `pulp::WithSimd` struct, and the entry that dispatches
-//! it on the cached [`arch`]. Every entry also has a `*_with(simd, ..)` twin that runs the
-//! same body on a backend chosen by the caller (tests run `pulp::Scalar`, `Scalar128b`,
-//! `Scalar256b`, `Scalar512b` and the dispatched backend against the references).
+//! Each public entry is a SIMD kernel with runtime dispatch (pulp): a generic body, a small
+//! `pulp::WithSimd` struct, and the entry that dispatches it on the cached [`arch`]. The
+//! bodies are public as `*_with(simd, ..)` and `#[inline(always)]`, so a caller that runs a
+//! whole traversal inside one `WithSimd` (dispatching once, never per node) inlines them
+//! under its target features; tests run them on `pulp::Scalar`, `Scalar128b`, `Scalar256b`,
+//! `Scalar512b` and the native backends against the references.
 //!
 //! Exactness: the SIMD bodies use no fused multiply-add. pulp's `mul_add_e_f32s` is fused on
 //! the vector backends but unfused on `pulp::Scalar`, so fusing would make results depend on
-//! the backend; the kernels are bound by index gathers, not by arithmetic, so the two saved
-//! operations per pair are not worth it. Overlap kernels therefore give bit-identical masks on
-//! every backend; reductions ([`refit`]) are exact against `*_scalar_lanes(.., lanes)` for the
+//! the backend. Overlap and filter kernels therefore give bit-identical masks on every
+//! backend; reductions ([`refit`]) are exact against `*_scalar_lanes(.., lanes)` for the
 //! backend's lane count ([`f32_lanes`]).
 //!
 //! NaN policy: overlap tests use ordered comparisons only, so a NaN anywhere in a pair makes
@@ -25,6 +27,7 @@
 // iterator forms clippy suggests hide that layout.
 #![allow(clippy::needless_range_loop)]
 
+pub mod lazy;
 pub mod narrow;
 pub mod overlap;
 pub mod refit;
@@ -66,22 +69,76 @@ pub fn f32_lanes() -> usize {
 pub(crate) mod lanes {
     use pulp::Simd;
 
+    /// Loads `v` (at most `S::F32_LANES` values; missing lanes are zero): one full load
+    /// when `v` fills a register, else pulp's partial load, which reads nothing past `v`.
+    #[inline(always)]
+    pub fn load_prefix<S: Simd>(simd: S, v: &[f32]) -> S::f32s {
+        if v.len() == S::F32_LANES {
+            S::as_simd_f32s(v).0[0]
+        } else {
+            simd.partial_load_f32s(v)
+        }
+    }
+
+    /// [`load_prefix`] for `u32`.
+    #[inline(always)]
+    pub fn load_prefix_u32<S: Simd>(simd: S, v: &[u32]) -> S::u32s {
+        if v.len() == S::U32_LANES {
+            S::as_simd_u32s(v).0[0]
+        } else {
+            simd.partial_load_u32s(v)
+        }
+    }
+
+    /// The lanes of a comparison mask as bits (lane `k` -> bit `k`). pulp's masks are either
+    /// a vector of all-ones/all-zeros lanes (x86-v3, NEON, the emulated backends), a bit
+    /// mask register (AVX-512), or a `bool` (the one-lane scalar backend).
+    #[inline(always)]
+    pub fn mask_bits<S: Simd>(simd: S, m: S::m32s) -> u32 {
+        use core::mem::size_of;
+        #[cfg(target_arch = "x86_64")]
+        if let Some(v3) = as_v3(simd) {
+            // PERF: one `vmovmskps`; the generic lane loop below is not recognised as one.
+            let v: pulp::f32x8 = bytemuck::cast(m);
+            return v3.avx._mm256_movemask_ps(bytemuck::cast(v)) as u32;
+        }
+        let _ = simd;
+        if size_of::<S::m32s>() == size_of::<S::u32s>() && S::U32_LANES > 1 {
+            let v: S::u32s = bytemuck::cast(m);
+            let mut bits = 0;
+            for (k, &x) in u32_array::<S>(&v).iter().enumerate() {
+                bits |= (x >> 31) << k;
+            }
+            bits
+        } else if size_of::<S::m32s>() == 2 {
+            let v: u16 = bytemuck::cast(m);
+            v as u32
+        } else if size_of::<S::m32s>() == 1 {
+            let v: u8 = bytemuck::cast(m);
+            v as u32
+        } else {
+            let v: S::u32s = bytemuck::cast(m);
+            u32_array::<S>(&v)[0] & 1
+        }
+    }
+
+    /// `simd` as pulp's x86-v3 token when that is its type.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn as_v3<S: Simd>(simd: S) -> Option<pulp::x86::V3> {
+        if core::any::TypeId::of::<S>() == core::any::TypeId::of::<pulp::x86::V3>() {
+            // SAFETY: `S` is `V3`, a zero-sized token that exists only when the CPU has
+            // x86-v3 (the caller holds one: `simd`).
+            Some(unsafe { core::mem::transmute_copy::<S, pulp::x86::V3>(&simd) })
+        } else {
+            None
+        }
+    }
+
     /// Loads the first `S::F32_LANES` values of `v`.
     #[inline(always)]
     pub fn load<S: Simd>(v: &[f32]) -> S::f32s {
         S::as_simd_f32s(&v[..S::F32_LANES]).0[0]
-    }
-
-    /// Stores `v` into the first `S::F32_LANES` values of `out`.
-    #[inline(always)]
-    pub fn store_u32<S: Simd>(out: &mut [u32], v: S::u32s) {
-        S::as_mut_simd_u32s(&mut out[..S::U32_LANES]).0[0] = v;
-    }
-
-    /// Stores `v` into the first `S::F32_LANES` values of `out`.
-    #[inline(always)]
-    pub fn store_f32<S: Simd>(out: &mut [f32], v: S::f32s) {
-        S::as_mut_simd_f32s(&mut out[..S::F32_LANES]).0[0] = v;
     }
 
     /// The lanes of `v`, lane 0 first.

@@ -1,334 +1,466 @@
-//! Front filters of the exact narrow phase: per-triangle bounding boxes, and box-box tests
-//! for batches of triangle pairs, so the exact triangle-triangle test only runs on pairs whose
-//! boxes overlap.
+//! The narrow phase's front filter: the *candidate pairs* of two blocks of triangles (the
+//! triangles of two leaves, in structure-of-arrays form), as one bit row per triangle of
+//! the first block. A pair is a candidate when
 //!
-//! Typical use for a leaf pair: [`triangle_bounds`] for the triangles of each leaf (into
-//! caller-owned scratch), then [`tri_aabb_overlap_row`] for each triangle of one leaf against
-//! all triangles of the other (contiguous, no gather), or [`tri_aabb_overlap_pairs`] for an
-//! arbitrary list of candidate pairs.
+//! 1. the pairing allows it (self-collision excludes pairs sharing a vertex index, and pairs
+//!    `j <= i` inside one leaf),
+//! 2. the closed boxes overlap (comparisons only: exact), and
+//! 3. no separating plane is certified: neither triangle has all three corners strictly on
+//!    one side of the other's plane, by a semi-static floating-point filter (below).
 //!
-//! Boxes are closed (touching counts) and NaN never overlaps, exactly like
-//! [`crate::overlap::aabb_pairs`]; results are bit-identical to the `*_scalar` references on
-//! every backend.
+//! Every dropped pair certainly does not intersect, so running the exact test on the
+//! candidates alone gives exactly the contacts of the exact test on every pair.
+//!
+//! **The plane filter.** In `f32`, `s = det[u, v, e]` with `u = b - a`, `v = c - a` (the
+//! plane triangle's edges from corner `a`) and `e = d - a` (the tested corner), computed as
+//! `(e_x N_x + e_y N_y) + e_z N_z` with `N = u x v`, next to the permanent
+//! `P = (|e_x| M_x + |e_y| M_y) + |e_z| M_z`, `M_x = |u_y v_z| + |u_z v_y|` (cyclically),
+//! from the same rounded products. That is Shewchuk's `orient3d` arithmetic (a Laplace
+//! expansion of the same determinant: rounded differences times rounded 2x2 minors of rounded
+//! differences), whose rounding error is at most `(7 + 56 eps) eps P` (eps = 2^-24) when
+//! nothing underflows. Gradual underflow adds an absolute error of at most `2^-150` per
+//! product, which the products by `e` scale: at most `(2 |e|_1 + 3) 2^-150` in all. A sign is
+//! certified only when `|s| > 8 eps P + 2^-147 (|e|_1 + 2)`, which covers both with margin
+//! (and the rounding of the bound itself). Overflow gives an infinite `P` (so `|s|` can never
+//! exceed the bound: `|s| <= P` holds in floating point by monotonic rounding); NaN compares
+//! false. So a certified sign is the exact sign of the determinant, for every `f32` input.
+//! A degenerate triangle has `N = M = 0` and certifies nothing.
+//!
+//! Results are bit-identical to [`leaf_candidates_scalar`] on every backend (same operation
+//! order, no fused multiply-add).
 
-use crate::lanes::{load, store_f32, store_u32, u32_array};
-use crate::overlap::{aabbs_overlap_simd, AabbPairs, AabbSoa};
-use crate::refit::widen_simd;
-use crate::{Soa3, MAX_LANES};
+use crate::lanes::{load_prefix, load_prefix_u32, mask_bits};
 use pulp::{Simd, WithSimd};
 
-/// Writable axis-aligned boxes in SoA form (the output of [`triangle_bounds`]).
-#[derive(Debug)]
-pub struct AabbSoaMut<'a> {
-    pub min_x: &'a mut [f32],
-    pub min_y: &'a mut [f32],
-    pub min_z: &'a mut [f32],
-    pub max_x: &'a mut [f32],
-    pub max_y: &'a mut [f32],
-    pub max_z: &'a mut [f32],
+/// Largest second block: the bits of one row.
+pub const MAX_ROW: usize = 64;
+
+/// The relative factor of the plane filter's certification bound: `8 eps`, `eps = 2^-24`.
+pub const PLANE_ERR: f32 = 8.0 * (f32::EPSILON / 2.0);
+/// The absolute factor for gradual underflow: `2^-147` (a subnormal).
+pub const PLANE_TINY: f32 = f32::from_bits(4);
+
+/// Triangles in structure-of-arrays form: `corner[c][k][t]` is coordinate `k` of corner `c`
+/// of triangle `t`, `lo`/`hi` its closed box, `vertex[c][t]` its corner indices (used by
+/// the self pairings only). All slices of equal length (padding allowed past the tested
+/// count).
+#[derive(Clone, Copy, Debug)]
+pub struct TriSoa<'a> {
+    pub corner: [[&'a [f32]; 3]; 3],
+    pub lo: [&'a [f32]; 3],
+    pub hi: [&'a [f32]; 3],
+    pub vertex: [&'a [u32]; 3],
 }
 
-impl AabbSoaMut<'_> {
-    /// The shortest of the six arrays.
+impl<'a> TriSoa<'a> {
+    #[inline(always)]
     pub fn len(&self) -> usize {
-        [
-            self.min_x.len(),
-            self.min_y.len(),
-            self.min_z.len(),
-            self.max_x.len(),
-            self.max_y.len(),
-            self.max_z.len(),
-        ]
-        .into_iter()
-        .min()
-        .unwrap_or(0)
+        self.lo[0].len()
     }
 
-    /// True if any array is empty.
+    #[inline(always)]
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
 
-    /// A read-only view.
-    pub fn as_soa(&self) -> AabbSoa<'_> {
-        AabbSoa {
-            min_x: self.min_x,
-            min_y: self.min_y,
-            min_z: self.min_z,
-            max_x: self.max_x,
-            max_y: self.max_y,
-            max_z: self.max_z,
-        }
-    }
-}
-
-// ---------------------------------------------------------------------------------------
-// triangle_bounds
-
-/// Scalar reference of [`triangle_bounds`].
-pub fn triangle_bounds_scalar(points: Soa3, tris: &[[u32; 3]], out: AabbSoaMut) {
-    assert!(
-        out.len() >= tris.len(),
-        "triangle_bounds: out is shorter than tris"
-    );
-    for (t, tri) in tris.iter().enumerate() {
-        let (mut lo, mut hi) = crate::refit::EMPTY_BOUNDS;
-        for &v in tri {
-            let q = points.get(v as usize);
-            for a in 0..3 {
-                if q[a] < lo[a] {
-                    lo[a] = q[a];
-                }
-                if q[a] > hi[a] {
-                    hi[a] = q[a];
-                }
-            }
-        }
-        out.min_x[t] = lo[0];
-        out.min_y[t] = lo[1];
-        out.min_z[t] = lo[2];
-        out.max_x[t] = hi[0];
-        out.max_y[t] = hi[1];
-        out.max_z[t] = hi[2];
-    }
-}
-
-/// Axis-aligned box of each triangle: `out.*[t]` for `t in 0..tris.len()` is the box of the
-/// vertices `points[tris[t][0..3]]`. Entries of `out` past `tris.len()` are untouched.
-///
-/// Same policy as [`crate::refit::bounds`]: starting from the empty box, a coordinate widens
-/// the box only if strictly outside it, so NaN coordinates are skipped (an axis whose three
-/// coordinates are NaN stays empty, `+inf..-inf`, and never overlaps).
-///
-/// Panics if `out` is shorter than `tris` or a vertex index is out of range.
-pub fn triangle_bounds(points: Soa3, tris: &[[u32; 3]], out: AabbSoaMut) {
-    crate::arch().dispatch(TriangleBounds { points, tris, out })
-}
-
-/// [`triangle_bounds`] on the backend `simd`.
-pub fn triangle_bounds_with<S: Simd>(simd: S, points: Soa3, tris: &[[u32; 3]], out: AabbSoaMut) {
-    simd.vectorize(TriangleBounds { points, tris, out })
-}
-
-struct TriangleBounds<'a> {
-    points: Soa3<'a>,
-    tris: &'a [[u32; 3]],
-    out: AabbSoaMut<'a>,
-}
-
-impl WithSimd for TriangleBounds<'_> {
-    type Output = ();
+    /// Triangle `t`'s corners.
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
-        triangle_bounds_simd(simd, self.points, self.tris, self.out)
+    pub fn corners(&self, t: usize) -> [[f32; 3]; 3] {
+        let c = &self.corner;
+        [
+            [c[0][0][t], c[0][1][t], c[0][2][t]],
+            [c[1][0][t], c[1][1][t], c[1][2][t]],
+            [c[2][0][t], c[2][1][t], c[2][2][t]],
+        ]
+    }
+
+    /// Triangles `range`.
+    #[inline(always)]
+    pub fn slice(&self, range: core::ops::Range<usize>) -> TriSoa<'a> {
+        let r = || range.clone();
+        let c = &self.corner;
+        TriSoa {
+            corner: [
+                [&c[0][0][r()], &c[0][1][r()], &c[0][2][r()]],
+                [&c[1][0][r()], &c[1][1][r()], &c[1][2][r()]],
+                [&c[2][0][r()], &c[2][1][r()], &c[2][2][r()]],
+            ],
+            lo: [&self.lo[0][r()], &self.lo[1][r()], &self.lo[2][r()]],
+            hi: [&self.hi[0][r()], &self.hi[1][r()], &self.hi[2][r()]],
+            vertex: [
+                &self.vertex[0][r()],
+                &self.vertex[1][r()],
+                &self.vertex[2][r()],
+            ],
+        }
     }
 }
 
-#[inline(always)]
-fn triangle_bounds_simd<S: Simd>(simd: S, p: Soa3, tris: &[[u32; 3]], out: AabbSoaMut) {
-    assert!(
-        out.len() >= tris.len(),
-        "triangle_bounds: out is shorter than tris"
-    );
-    let lanes = S::F32_LANES;
-    assert!(lanes <= MAX_LANES);
-    let n = tris.len();
-    let outs = [
-        out.min_x, out.min_y, out.min_z, out.max_x, out.max_y, out.max_z,
-    ];
-    let mut k = 0;
-    while k < n {
-        let m = lanes.min(n - k);
-        // buf[3 * corner + axis][lane]; padding lanes are NaN (their box stays empty and is
-        // not stored).
-        let mut buf = [[f32::NAN; MAX_LANES]; 9];
-        for (l, tri) in tris[k..k + m].iter().enumerate() {
-            for (c, &v) in tri.iter().enumerate() {
-                let v = v as usize;
-                buf[3 * c][l] = p.x[v];
-                buf[3 * c + 1][l] = p.y[v];
-                buf[3 * c + 2][l] = p.z[v];
-            }
-        }
-        for a in 0..3 {
-            let mut lo = simd.splat_f32s(f32::INFINITY);
-            let mut hi = simd.splat_f32s(f32::NEG_INFINITY);
-            for c in 0..3 {
-                widen_simd(simd, &mut lo, &mut hi, load::<S>(&buf[3 * c + a]));
-            }
-            if m == lanes {
-                store_f32::<S>(&mut outs[a][k..k + m], lo);
-                store_f32::<S>(&mut outs[3 + a][k..k + m], hi);
-            } else {
-                simd.partial_store_f32s(&mut outs[a][k..k + m], lo);
-                simd.partial_store_f32s(&mut outs[3 + a][k..k + m], hi);
-            }
-        }
-        k += m;
-    }
+/// Which pairs `(i, j)` of two blocks are allowed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pairing {
+    /// Every pair (two objects).
+    All,
+    /// Pairs sharing no vertex index (two parts of one mesh).
+    NoSharedVertex,
+    /// Pairs `i < j` sharing no vertex index (one block with itself).
+    NoSharedVertexUpper,
 }
 
 // ---------------------------------------------------------------------------------------
-// tri_aabb_overlap_pairs
+// scalar
 
-/// Scalar reference of [`tri_aabb_overlap_pairs`].
-pub fn tri_aabb_overlap_pairs_scalar(
-    a: AabbSoa,
-    b: AabbSoa,
-    ta: &[u32],
-    tb: &[u32],
-    out: &mut [u32],
-) -> usize {
-    crate::overlap::aabb_pairs_scalar(a, b, ta, tb, out)
+/// A triangle's plane from corner 0: `N = u x v` and `M` (see the module doc).
+#[inline(always)]
+fn plane(t: &[[f32; 3]; 3]) -> ([f32; 3], [f32; 3]) {
+    let u = [t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]];
+    let v = [t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]];
+    let (yz, zy) = (u[1] * v[2], u[2] * v[1]);
+    let (zx, xz) = (u[2] * v[0], u[0] * v[2]);
+    let (xy, yx) = (u[0] * v[1], u[1] * v[0]);
+    (
+        [yz - zy, zx - xz, xy - yx],
+        [
+            yz.abs() + zy.abs(),
+            zx.abs() + xz.abs(),
+            xy.abs() + yx.abs(),
+        ],
+    )
 }
 
-/// Triangle-box filter for a batch of candidate triangle pairs `(ta[k], tb[k])`: `a` and `b`
-/// hold triangle boxes (e.g. from [`triangle_bounds`]); `out[k] = 1` when the closed boxes
-/// overlap, else `0`; returns the number of overlapping pairs. The same test and kernel as
-/// [`crate::overlap::aabb_pairs`], named for the narrow phase.
-pub fn tri_aabb_overlap_pairs(
-    a: AabbSoa,
-    b: AabbSoa,
-    ta: &[u32],
-    tb: &[u32],
-    out: &mut [u32],
-) -> usize {
-    crate::overlap::aabb_pairs(a, b, ta, tb, out)
+/// Side of `d` against the plane `(a, n, m)`: `1` certainly positive, `-1` certainly
+/// negative, `0` unknown (or on the plane).
+#[inline(always)]
+fn side(a: &[f32; 3], n: &[f32; 3], m: &[f32; 3], d: &[f32; 3]) -> i32 {
+    let e = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+    let s = e[0] * n[0] + e[1] * n[1] + e[2] * n[2];
+    let p = e[0].abs() * m[0] + e[1].abs() * m[1] + e[2].abs() * m[2];
+    let l = e[0].abs() + e[1].abs() + e[2].abs();
+    let bound = PLANE_ERR * p + PLANE_TINY * (l + 2.0);
+    i32::from(s > bound) - i32::from(s < 0.0 - bound)
 }
 
-/// [`tri_aabb_overlap_pairs`] on the backend `simd`.
-pub fn tri_aabb_overlap_pairs_with<S: Simd>(
-    simd: S,
-    a: AabbSoa,
-    b: AabbSoa,
-    ta: &[u32],
-    tb: &[u32],
-    out: &mut [u32],
-) -> usize {
-    simd.vectorize(AabbPairs {
+/// Whether the triangle `d` lies certainly strictly on one side of `t`'s plane.
+#[inline(always)]
+fn separated(t: &[[f32; 3]; 3], d: &[[f32; 3]; 3]) -> bool {
+    let (n, m) = plane(t);
+    let s = d.map(|p| side(&t[0], &n, &m, &p));
+    (s[0] == 1 && s[1] == 1 && s[2] == 1) || (s[0] == -1 && s[1] == -1 && s[2] == -1)
+}
+
+/// Whether a separating plane of `a` or `b` is certified (the plane filter on one pair).
+pub fn plane_separated(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
+    separated(a, b) || separated(b, a)
+}
+
+fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[u64]) {
+    assert!(
+        nb <= MAX_ROW,
+        "the second block holds at most {MAX_ROW} triangles"
+    );
+    assert!(
+        na <= a.len() && nb <= b.len(),
+        "more triangles tested than the blocks hold"
+    );
+    assert!(
+        out.len() >= na,
+        "one output row per triangle of the first block"
+    );
+}
+
+/// Scalar reference of [`leaf_candidates`] (one pair at a time).
+pub fn leaf_candidates_scalar(
+    a: TriSoa,
+    na: usize,
+    b: TriSoa,
+    nb: usize,
+    pairing: Pairing,
+    out: &mut [u64],
+) -> u64 {
+    check(&a, na, &b, nb, out);
+    let mut counted = 0;
+    for i in 0..na {
+        let ta = a.corners(i);
+        let va = [a.vertex[0][i], a.vertex[1][i], a.vertex[2][i]];
+        let mut row = 0;
+        for j in 0..nb {
+            if pairing == Pairing::NoSharedVertexUpper && j <= i {
+                continue;
+            }
+            if pairing != Pairing::All && (0..3).any(|c| va.contains(&b.vertex[c][j])) {
+                continue;
+            }
+            counted += 1;
+            let boxes = (0..3).all(|k| a.lo[k][i] <= b.hi[k][j] && b.lo[k][j] <= a.hi[k][i]);
+            if boxes && !plane_separated(&ta, &b.corners(j)) {
+                row |= 1 << j;
+            }
+        }
+        out[i] = row;
+    }
+    counted
+}
+
+/// The candidate pairs of the first `na` triangles of `a` and the first `nb <= MAX_ROW` of
+/// `b`: `out[i]` gets bit `j` set iff `(i, j)` is allowed by `pairing`, the boxes overlap and
+/// no separating plane is certified. Returns the number of allowed pairs (the narrow phase's
+/// `N_P`). Panics if `nb > MAX_ROW`, a block is shorter than its count, or `out` is shorter
+/// than `na`.
+pub fn leaf_candidates(
+    a: TriSoa,
+    na: usize,
+    b: TriSoa,
+    nb: usize,
+    pairing: Pairing,
+    out: &mut [u64],
+) -> u64 {
+    crate::arch().dispatch(LeafCandidates {
         a,
+        na,
         b,
-        ia: ta,
-        ib: tb,
+        nb,
+        pairing,
         out,
     })
 }
 
-// ---------------------------------------------------------------------------------------
-// tri_aabb_overlap_row
-
-/// Scalar reference of [`tri_aabb_overlap_row`].
-pub fn tri_aabb_overlap_row_scalar(a: ([f32; 3], [f32; 3]), b: AabbSoa, out: &mut [u32]) -> usize {
-    let n = row_len(b, out);
-    let (lo, hi) = a;
-    let mut hits = 0;
-    for j in 0..n {
-        let hit = lo[0] <= b.max_x[j]
-            && b.min_x[j] <= hi[0]
-            && lo[1] <= b.max_y[j]
-            && b.min_y[j] <= hi[1]
-            && lo[2] <= b.max_z[j]
-            && b.min_z[j] <= hi[2];
-        out[j] = hit as u32;
-        hits += hit as usize;
-    }
-    hits
+struct LeafCandidates<'a> {
+    a: TriSoa<'a>,
+    na: usize,
+    b: TriSoa<'a>,
+    nb: usize,
+    pairing: Pairing,
+    out: &'a mut [u64],
 }
 
-fn row_len(b: AabbSoa, out: &[u32]) -> usize {
-    let n = b.min_x.len();
-    assert!(
-        [
-            b.min_y.len(),
-            b.min_z.len(),
-            b.max_x.len(),
-            b.max_y.len(),
-            b.max_z.len()
-        ]
-        .iter()
-        .all(|&l| l == n),
-        "tri_aabb_overlap_row: ragged box arrays"
-    );
-    assert!(
-        out.len() >= n,
-        "tri_aabb_overlap_row: out is shorter than b"
-    );
-    n
-}
-
-/// One box `a = (min, max)` against every box of `b` (all six arrays of equal length `n`):
-/// `out[j] = 1` when `a` and `b[j]` overlap (closed, NaN never overlaps), else `0`, for
-/// `j in 0..n`; returns the number of overlaps. Contiguous loads, no gather: the fast path of
-/// the narrow-phase filter (one triangle of one leaf against the triangle run of another).
-pub fn tri_aabb_overlap_row(a: ([f32; 3], [f32; 3]), b: AabbSoa, out: &mut [u32]) -> usize {
-    crate::arch().dispatch(TriAabbRow { a, b, out })
-}
-
-/// [`tri_aabb_overlap_row`] on the backend `simd`.
-pub fn tri_aabb_overlap_row_with<S: Simd>(
-    simd: S,
-    a: ([f32; 3], [f32; 3]),
-    b: AabbSoa,
-    out: &mut [u32],
-) -> usize {
-    simd.vectorize(TriAabbRow { a, b, out })
-}
-
-struct TriAabbRow<'a> {
-    a: ([f32; 3], [f32; 3]),
-    b: AabbSoa<'a>,
-    out: &'a mut [u32],
-}
-
-impl WithSimd for TriAabbRow<'_> {
-    type Output = usize;
+impl WithSimd for LeafCandidates<'_> {
+    type Output = u64;
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> usize {
-        tri_aabb_overlap_row_simd(simd, self.a, self.b, self.out)
+    fn with_simd<S: Simd>(self, simd: S) -> u64 {
+        leaf_candidates_with(
+            simd,
+            self.a,
+            self.na,
+            self.b,
+            self.nb,
+            self.pairing,
+            self.out,
+        )
+    }
+}
+
+/// The low `n` bits set (`n <= 64`).
+#[inline(always)]
+fn low_bits(n: usize) -> u64 {
+    if n >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << n) - 1
     }
 }
 
 #[inline(always)]
-fn tri_aabb_overlap_row_simd<S: Simd>(
+fn splat3<S: Simd>(simd: S, v: [f32; 3]) -> [S::f32s; 3] {
+    [
+        simd.splat_f32s(v[0]),
+        simd.splat_f32s(v[1]),
+        simd.splat_f32s(v[2]),
+    ]
+}
+
+/// [`leaf_candidates`] on the backend `simd` (inlined into the caller's dispatched body).
+///
+/// PERF: the second block is loaded one vector of lanes at a time, with its planes, and
+/// every triangle of the first block is tested against it from registers; the plane filter
+/// runs only for rows with a pair left after the box and shared-vertex tests. No closures
+/// here: they may be compiled without the dispatched target features.
+#[inline(always)]
+pub fn leaf_candidates_with<S: Simd>(
     simd: S,
-    a: ([f32; 3], [f32; 3]),
-    b: AabbSoa,
-    out: &mut [u32],
-) -> usize {
-    let n = row_len(b, out);
-    let lanes = S::F32_LANES;
-    let mut v = [simd.splat_f32s(0.0); 12];
-    for f in 0..3 {
-        v[f] = simd.splat_f32s(a.0[f]);
-        v[3 + f] = simd.splat_f32s(a.1[f]);
+    a: TriSoa,
+    na: usize,
+    b: TriSoa,
+    nb: usize,
+    pairing: Pairing,
+    out: &mut [u64],
+) -> u64 {
+    check(&a, na, &b, nb, out);
+    for row in out[..na].iter_mut() {
+        *row = 0;
     }
-    let (one, zero) = (simd.splat_u32s(1), simd.splat_u32s(0));
-    let cols = [b.min_x, b.min_y, b.min_z, b.max_x, b.max_y, b.max_z];
-    let mut count = zero;
-    let full = n - n % lanes;
-    let mut k = 0;
-    while k < full {
-        for f in 0..6 {
-            v[6 + f] = load::<S>(&cols[f][k..]);
+    let len = b.len();
+    let (err, tiny, two, zero) = (
+        simd.splat_f32s(PLANE_ERR),
+        simd.splat_f32s(PLANE_TINY),
+        simd.splat_f32s(2.0),
+        simd.splat_f32s(0.0),
+    );
+    let mut counted = 0u64;
+    let mut base = 0;
+    while base < nb {
+        let end = (base + S::F32_LANES).min(len);
+        let lanes_valid = low_bits((nb - base).min(S::F32_LANES));
+        let mut blo = [zero; 3];
+        let mut bhi = [zero; 3];
+        let mut bc = [[zero; 3]; 3];
+        for k in 0..3 {
+            blo[k] = load_prefix(simd, &b.lo[k][base..end]);
+            bhi[k] = load_prefix(simd, &b.hi[k][base..end]);
+            for c in 0..3 {
+                bc[c][k] = load_prefix(simd, &b.corner[c][k][base..end]);
+            }
         }
-        let hit = simd.select_u32s(aabbs_overlap_simd(simd, &v), one, zero);
-        store_u32::<S>(&mut out[k..k + lanes], hit);
-        count = simd.add_u32s(count, hit);
-        k += lanes;
-    }
-    if k < n {
-        let mut buf = [[f32::NAN; MAX_LANES]; 6];
-        for f in 0..6 {
-            buf[f][..n - k].copy_from_slice(&cols[f][k..n]);
-            v[6 + f] = load::<S>(&buf[f]);
+        let (bn, bm) = plane_simd(simd, &bc);
+        let bv = if pairing == Pairing::All {
+            None
+        } else {
+            Some([
+                load_prefix_u32(simd, &b.vertex[0][base..end]),
+                load_prefix_u32(simd, &b.vertex[1][base..end]),
+                load_prefix_u32(simd, &b.vertex[2][base..end]),
+            ])
+        };
+        for i in 0..na {
+            let mut valid = lanes_valid;
+            if pairing == Pairing::NoSharedVertexUpper {
+                // Only j > i.
+                valid &= !low_bits((i + 1).saturating_sub(base));
+            }
+            if valid == 0 {
+                continue;
+            }
+            let mut hit = simd.less_than_or_equal_f32s(simd.splat_f32s(a.lo[0][i]), bhi[0]);
+            hit = simd.and_m32s(
+                hit,
+                simd.less_than_or_equal_f32s(blo[0], simd.splat_f32s(a.hi[0][i])),
+            );
+            for k in 1..3 {
+                hit = simd.and_m32s(
+                    hit,
+                    simd.less_than_or_equal_f32s(simd.splat_f32s(a.lo[k][i]), bhi[k]),
+                );
+                hit = simd.and_m32s(
+                    hit,
+                    simd.less_than_or_equal_f32s(blo[k], simd.splat_f32s(a.hi[k][i])),
+                );
+            }
+            let mut bits = u64::from(mask_bits(simd, hit)) & valid;
+            if let Some(bv) = &bv {
+                let mut share = simd.equal_u32s(simd.splat_u32s(a.vertex[0][i]), bv[0]);
+                for k in 0..3 {
+                    let v = simd.splat_u32s(a.vertex[k][i]);
+                    for (c, w) in bv.iter().enumerate() {
+                        if k != 0 || c != 0 {
+                            share = simd.or_m32s(share, simd.equal_u32s(v, *w));
+                        }
+                    }
+                }
+                let share = u64::from(mask_bits(simd, share));
+                counted += u64::from((valid & !share).count_ones());
+                bits &= !share;
+            } else {
+                counted += u64::from(valid.count_ones());
+            }
+            if bits == 0 {
+                continue;
+            }
+            let ta = a.corners(i);
+            let (an, am) = plane(&ta);
+            let pc = [
+                splat3(simd, ta[0]),
+                splat3(simd, ta[1]),
+                splat3(simd, ta[2]),
+            ];
+            // The block's corners against triangle i's plane, then i's corners against the
+            // block's planes.
+            let sep_a = separated_simd(
+                simd,
+                [err, tiny, two, zero],
+                &pc[0],
+                &splat3(simd, an),
+                &splat3(simd, am),
+                &bc,
+            );
+            let sep_b = separated_simd(simd, [err, tiny, two, zero], &bc[0], &bn, &bm, &pc);
+            bits &= !u64::from(mask_bits(simd, simd.or_m32s(sep_a, sep_b)));
+            out[i] |= bits << base;
         }
-        let hit = simd.select_u32s(aabbs_overlap_simd(simd, &v), one, zero);
-        simd.partial_store_u32s(&mut out[k..n], hit);
-        count = simd.add_u32s(count, hit);
+        base += S::F32_LANES;
     }
-    let mut total = 0;
-    for &c in u32_array::<S>(&count) {
-        total += c as usize;
+    counted
+}
+
+/// The lane-wise [`plane`].
+#[inline(always)]
+fn plane_simd<S: Simd>(simd: S, t: &[[S::f32s; 3]; 3]) -> ([S::f32s; 3], [S::f32s; 3]) {
+    let mut u = t[0];
+    let mut v = t[0];
+    for k in 0..3 {
+        u[k] = simd.sub_f32s(t[1][k], t[0][k]);
+        v[k] = simd.sub_f32s(t[2][k], t[0][k]);
     }
-    total
+    let (yz, zy) = (simd.mul_f32s(u[1], v[2]), simd.mul_f32s(u[2], v[1]));
+    let (zx, xz) = (simd.mul_f32s(u[2], v[0]), simd.mul_f32s(u[0], v[2]));
+    let (xy, yx) = (simd.mul_f32s(u[0], v[1]), simd.mul_f32s(u[1], v[0]));
+    (
+        [
+            simd.sub_f32s(yz, zy),
+            simd.sub_f32s(zx, xz),
+            simd.sub_f32s(xy, yx),
+        ],
+        [
+            abs_sum(simd, yz, zy),
+            abs_sum(simd, zx, xz),
+            abs_sum(simd, xy, yx),
+        ],
+    )
+}
+
+#[inline(always)]
+fn abs_sum<S: Simd>(simd: S, a: S::f32s, b: S::f32s) -> S::f32s {
+    simd.add_f32s(simd.abs_f32s(a), simd.abs_f32s(b))
+}
+
+/// The lane-wise [`separated`] of the three points `d` against the plane `(a, n, m)`;
+/// `c = [PLANE_ERR, PLANE_TINY, 2, 0]` splatted.
+#[inline(always)]
+fn separated_simd<S: Simd>(
+    simd: S,
+    c: [S::f32s; 4],
+    a: &[S::f32s; 3],
+    n: &[S::f32s; 3],
+    m: &[S::f32s; 3],
+    d: &[[S::f32s; 3]; 3],
+) -> S::m32s {
+    let [err, tiny, two, zero] = c;
+    let mut pos = simd.less_than_or_equal_f32s(zero, two); // all lanes true
+    let mut neg = pos;
+    for p in d {
+        let e = [
+            simd.sub_f32s(p[0], a[0]),
+            simd.sub_f32s(p[1], a[1]),
+            simd.sub_f32s(p[2], a[2]),
+        ];
+        let s = simd.add_f32s(
+            simd.add_f32s(simd.mul_f32s(e[0], n[0]), simd.mul_f32s(e[1], n[1])),
+            simd.mul_f32s(e[2], n[2]),
+        );
+        let ae = [
+            simd.abs_f32s(e[0]),
+            simd.abs_f32s(e[1]),
+            simd.abs_f32s(e[2]),
+        ];
+        let perm = simd.add_f32s(
+            simd.add_f32s(simd.mul_f32s(ae[0], m[0]), simd.mul_f32s(ae[1], m[1])),
+            simd.mul_f32s(ae[2], m[2]),
+        );
+        let l = simd.add_f32s(simd.add_f32s(ae[0], ae[1]), ae[2]);
+        let bound = simd.add_f32s(
+            simd.mul_f32s(err, perm),
+            simd.mul_f32s(tiny, simd.add_f32s(l, two)),
+        );
+        pos = simd.and_m32s(pos, simd.greater_than_f32s(s, bound));
+        neg = simd.and_m32s(neg, simd.less_than_f32s(s, simd.sub_f32s(zero, bound)));
+    }
+    simd.or_m32s(pos, neg)
 }

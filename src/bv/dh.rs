@@ -2,9 +2,11 @@
 //! (the central vertex, fixed at build) whose radius is refitted after deformation. The
 //! centre moves with the mesh for free; only the radius is ever recomputed.
 
-use super::{conservative_radius, conservative_sum, dist2_f64, padded, sealed, BvKind, Method};
+use super::{conservative_radius, conservative_sum, dist2_f64, group_buffers, refit_groups, slot};
+use super::{sealed, BvKind, Method};
 use crate::points::Points;
 use crate::tree::RegionTree;
+use dhcd_kernels::lazy::LazySoa;
 use dhcd_kernels::{overlap, refit};
 
 /// The DH node record: central vertex (internal index) and radius — 8 bytes.
@@ -16,42 +18,93 @@ pub struct DhNode {
 }
 const _: () = assert!(std::mem::size_of::<DhNode>() == 8);
 
-/// DH nodes, structure-of-arrays. Padding entries have radius NaN (never overlap).
+/// DH nodes, structure-of-arrays: the central vertices (fixed at build) and, per step, the
+/// radii.
 ///
-/// `centre` is not part of the node record: it is a staging copy of the live position of
-/// each fitted node's central vertex, written when the node is fitted (positions do not
-/// change between two fits of a step), so the overlap test reads one array per coordinate
-/// instead of chasing `vertex[n]` into the positions (PERF: the two-level gather was the
-/// traversal's largest cost). The test is bit-for-bit the same.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// The lazily fitted buffers also hold a staging copy of each fitted node's centre (the live
+/// position of its central vertex), written when the node is fitted (positions do not change
+/// within a step), so the wide test reads contiguous arrays instead of chasing `vertex[n]`
+/// into the positions. It is scratch, not part of the 8-byte record; the test is bit for bit
+/// the sphere test on the same `f32` values.
+#[derive(Clone, Debug)]
 pub struct DhNodes {
     pub vertex: Vec<u32>,
-    pub radius: Vec<f32>,
-    pub(crate) centre: [Vec<f32>; 3],
+    /// `[cx, cy, cz, radius]` per node.
+    fitted: LazySoa<4>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Dh;
 impl sealed::Sealed for Dh {}
 
+/// Writes node `n`'s staged centre and radius.
+#[inline]
+fn write(fields: &mut [&mut [f32]; 4], i: usize, centre: [f32; 3], radius: f32) {
+    fields[0][i] = centre[0];
+    fields[1][i] = centre[1];
+    fields[2][i] = centre[2];
+    fields[3][i] = radius;
+}
+
+fn sphere_soa<'a>(f: [&'a [f32]; 4]) -> overlap::SphereSoa<'a> {
+    let [cx, cy, cz, r] = f;
+    overlap::SphereSoa { cx, cy, cz, r }
+}
+
 impl BvKind for Dh {
     const METHOD: Method = Method::Dh;
     type Record = DhNode;
     type Nodes = DhNodes;
+    type Block<'a> = overlap::SphereSoa<'a>;
 
     fn build(tree: &RegionTree, rest: &Points) -> DhNodes {
-        let n = tree.node_count();
+        let vertex = (0..tree.node_count())
+            .map(|n| central_vertex(tree, rest, n))
+            .collect();
         let mut nodes = DhNodes {
-            vertex: vec![0; padded(n)],
-            radius: vec![f32::NAN; padded(n)],
-            centre: std::array::from_fn(|_| vec![0.0; padded(n)]),
+            vertex,
+            fitted: group_buffers(tree, [0.0, 0.0, 0.0, f32::NAN]),
         };
-        for node in 0..n {
-            nodes.vertex[node] = central_vertex(tree, rest, node);
-            nodes.radius[node] = Dh::fit(&nodes, tree, rest, node).radius;
-            Dh::stage(&mut nodes, rest, node);
-        }
+        Dh::refit_all(&mut nodes, tree, rest, false);
         nodes
+    }
+
+    #[inline]
+    fn group<'a>(
+        nodes: &'a DhNodes,
+        tree: &RegionTree,
+        p: &Points,
+        g: usize,
+    ) -> (overlap::SphereSoa<'a>, bool) {
+        let (f, fitted) = nodes.fitted.get_or_fill(g, |_, mut fields| {
+            for (i, n) in tree.group_nodes(g).enumerate() {
+                let r = Dh::fit(nodes, tree, p, n);
+                write(&mut fields, i, p.get(r.vertex as usize), r.radius);
+            }
+        });
+        (sphere_soa(f), fitted)
+    }
+
+    #[inline]
+    fn group_current(nodes: &DhNodes, g: usize) -> bool {
+        nodes.fitted.is_current(g)
+    }
+
+    #[inline(always)]
+    fn test<S: pulp::Simd>(
+        simd: S,
+        a: overlap::SphereSoa<'_>,
+        i: usize,
+        b: overlap::SphereSoa<'_>,
+        n: usize,
+    ) -> u32 {
+        let (c, r) = a.get(i);
+        overlap::sphere_block_with(simd, c, r, b, n)
+    }
+
+    #[inline(always)]
+    fn extent(a: overlap::SphereSoa<'_>, i: usize) -> f32 {
+        a.r[i]
     }
 
     fn fit(nodes: &DhNodes, tree: &RegionTree, p: &Points, n: usize) -> DhNode {
@@ -65,64 +118,44 @@ impl BvKind for Dh {
         }
     }
 
-    fn merge(nodes: &DhNodes, tree: &RegionTree, p: &Points, n: usize) -> DhNode {
-        let vertex = nodes.vertex[n];
-        let c = p.get(vertex as usize);
-        let mut radius = 0.0f32;
-        for child in tree.children(n) {
-            let cc = p.get(nodes.vertex[child] as usize);
-            let d = (0..3).map(|k| (c[k] - cc[k]) * (c[k] - cc[k])).sum::<f32>();
-            radius = radius.max(conservative_sum(
-                conservative_radius(d),
-                nodes.radius[child],
-            ));
-        }
-        DhNode { vertex, radius }
-    }
-
-    #[inline]
-    fn get(nodes: &DhNodes, n: usize) -> DhNode {
-        DhNode {
+    fn record(nodes: &DhNodes, tree: &RegionTree, n: usize) -> Option<DhNode> {
+        let g = tree.group_of(n);
+        let f = nodes.fitted.get(g)?;
+        Some(DhNode {
             vertex: nodes.vertex[n],
-            radius: nodes.radius[n],
-        }
+            radius: f[3][n - tree.group_nodes(g).start],
+        })
     }
 
-    #[inline]
-    fn set(nodes: &mut DhNodes, n: usize, r: DhNode) {
-        nodes.vertex[n] = r.vertex;
-        nodes.radius[n] = r.radius;
+    fn invalidate(nodes: &mut DhNodes) {
+        nodes.fitted.invalidate();
     }
 
-    #[inline]
-    fn stage(nodes: &mut DhNodes, p: &Points, n: usize) {
-        let c = p.get(nodes.vertex[n] as usize);
-        for (k, ck) in c.into_iter().enumerate() {
-            nodes.centre[k][n] = ck;
-        }
-    }
-
-    /// `|P_a[c_a] - P_b[c_b]|^2 <= (r_a + r_b)^2`, with the centres read from the staged
-    /// copies (identical values; see [`DhNodes`]) by the sphere kernel.
-    fn overlap(
-        a: &DhNodes,
-        _pa: &Points,
-        b: &DhNodes,
-        _pb: &Points,
-        ia: &[u32],
-        ib: &[u32],
-        out: &mut [u32],
-    ) -> usize {
-        fn soa(d: &DhNodes) -> overlap::SphereSoa<'_> {
-            let [cx, cy, cz] = &d.centre;
-            overlap::SphereSoa {
-                cx,
-                cy,
-                cz,
-                r: &d.radius,
-            }
-        }
-        overlap::sphere_pairs(soa(a), soa(b), ia, ib, out)
+    fn refit_all(nodes: &mut DhNodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64 {
+        let vertex = &nodes.vertex;
+        let fit = |n: usize| {
+            let c = p.get(vertex[n] as usize);
+            let run = refit::max_dist_sq(p.soa().slice(tree.vert_run(n)), c);
+            let borrowed = refit::max_dist_sq_indexed(p.soa(), tree.borrowed(n), c);
+            conservative_radius(run.max(borrowed))
+        };
+        refit_groups(&mut nodes.fitted, tree, |f, n, s| {
+            let c = p.get(vertex[n] as usize);
+            let radius = if bottom_up && !tree.is_leaf(n) {
+                // r_p = max_c (|C_p - C_c| + r_c): children are fitted (deeper groups first).
+                let mut radius = 0.0f32;
+                for child in tree.children(n) {
+                    let cc = p.get(vertex[child] as usize);
+                    let d = (0..3).map(|k| (c[k] - cc[k]) * (c[k] - cc[k])).sum::<f32>();
+                    let rc = f[3][slot(tree, child)];
+                    radius = radius.max(conservative_sum(conservative_radius(d), rc));
+                }
+                radius
+            } else {
+                fit(n)
+            };
+            write(f, s, c, radius);
+        })
     }
 
     fn encloses(r: &DhNode, p: &Points, v: usize) -> bool {

@@ -2,9 +2,9 @@
 //! (`Sphere`, the paper's SBV) and axis-aligned boxes (`Aabb`).
 //!
 //! The kind is a compile-time policy ([`BvKind`]); node data lives in structure-of-arrays
-//! buffers (one array per record field, padded to [`PAD`] entries) so that one SIMD load
-//! covers a block of nodes. [`Method`] names a kind where it is chosen at run time; every
-//! kind is a row of the table in [`crate::kinds`].
+//! buffers (one array per record field) whose sibling groups are contiguous, so one SIMD
+//! load covers the children of a node. [`Method`] names a kind where it is chosen at run
+//! time; every kind is a row of the table in [`crate::kinds`].
 
 mod aabb;
 mod dh;
@@ -18,10 +18,7 @@ pub use crate::kinds::Method;
 
 use crate::points::Points;
 use crate::tree::RegionTree;
-
-/// Node buffers are padded to a multiple of this many entries (the widest SIMD block:
-/// 16 f32 lanes of AVX-512). Padding entries never overlap anything.
-pub const PAD: usize = 16;
+use dhcd_kernels::lazy::LazySoa;
 
 /// Relative inflation of every computed radius. Radii and overlap tests are evaluated in
 /// f32; each is off by a few ulps. Growing radii by 16 ulps keeps every sphere test
@@ -47,17 +44,19 @@ pub(crate) fn conservative_sum(a: f32, b: f32) -> f32 {
     ((a + b) * RADIUS_INFLATION).max(MIN_RADIUS)
 }
 
-pub(crate) fn padded(n: usize) -> usize {
-    n.div_ceil(PAD).max(1) * PAD
-}
-
 mod sealed {
     pub trait Sealed {}
 }
 
 /// A bounding-volume kind: its node record, its SoA buffers, how to fit a node to the
-/// current pose, and the batch overlap test. Sealed: the kinds are the rows of the table in
-/// [`crate::kinds`], the set the library compares.
+/// current pose, and the wide overlap test. Sealed: the kinds are the rows of the table in
+/// [`crate::kinds`], the set the library compares; everything generic over them is
+/// monomorphised (no per-node dispatch).
+///
+/// Node bounds live in [`LazySoa`] buffers grouped by *sibling group* (the children of one
+/// node, [`RegionTree::group_nodes`]): a group is fitted as a whole, just before its first
+/// test in a step, by whichever thread needs it first. A wide test reads one node of a
+/// fitted group against a block of another fitted group.
 pub trait BvKind:
     sealed::Sealed + Copy + Default + Send + Sync + std::fmt::Debug + 'static
 {
@@ -66,34 +65,87 @@ pub trait BvKind:
     type Record: bytemuck::Pod + std::fmt::Debug + PartialEq + Send + Sync;
     /// All nodes of one hierarchy, structure-of-arrays.
     type Nodes: Clone + std::fmt::Debug + Send + Sync;
+    /// The fitted bounds of one sibling group, as the overlap kernels read them.
+    type Block<'a>: Copy;
 
-    /// Allocates the buffers and fits every node to the rest pose `rest`.
+    /// Allocates the buffers and fits every node to the rest pose `rest` (all current).
     fn build(tree: &RegionTree, rest: &Points) -> Self::Nodes;
-    /// The tight BV of node `n` for the current positions `p` (reads the node's vertices).
+    /// The bounds of sibling group `g`, fitting the group exactly to the current pose `p`
+    /// first if it is stale (once per step, whichever thread asks first). Returns the block
+    /// and whether this call fitted it.
+    fn group<'a>(
+        nodes: &'a Self::Nodes,
+        tree: &RegionTree,
+        p: &Points,
+        g: usize,
+    ) -> (Self::Block<'a>, bool);
+    /// Whether sibling group `g` is fitted to the current pose.
+    fn group_current(nodes: &Self::Nodes, g: usize) -> bool;
+    /// Overlap bits of entry `i` of block `a` against the first `n` entries of block `b`.
+    /// Symmetric in the two volumes.
+    fn test<S: pulp::Simd>(
+        simd: S,
+        a: Self::Block<'_>,
+        i: usize,
+        b: Self::Block<'_>,
+        n: usize,
+    ) -> u32;
+    /// A size of entry `i` of a block, to descend the larger volume of an overlapping pair.
+    fn extent(a: Self::Block<'_>, i: usize) -> f32;
+    /// The exact bounding volume of node `n` for the current positions `p` (reads the
+    /// node's vertices).
     fn fit(nodes: &Self::Nodes, tree: &RegionTree, p: &Points, n: usize) -> Self::Record;
-    /// A BV of internal node `n` that encloses its children's current BVs (bottom-up refit).
-    fn merge(nodes: &Self::Nodes, tree: &RegionTree, p: &Points, n: usize) -> Self::Record;
-    fn get(nodes: &Self::Nodes, n: usize) -> Self::Record;
-    fn set(nodes: &mut Self::Nodes, n: usize, r: Self::Record);
-    /// Called right after node `n` is fitted to the current positions `p`: a kind may stage
-    /// data its overlap test derives from the pose (DH copies its centre's live position, so
-    /// the test reads one array instead of chasing the vertex index). Default: nothing.
-    #[inline]
-    fn stage(_nodes: &mut Self::Nodes, _p: &Points, _n: usize) {}
-    /// Batch overlap test of node pairs `(ia[k], ib[k])`; writes `out[k]` (1 = overlap) and
-    /// returns the number of overlapping pairs.
-    #[allow(clippy::too_many_arguments)]
-    fn overlap(
-        a: &Self::Nodes,
-        pa: &Points,
-        b: &Self::Nodes,
-        pb: &Points,
-        ia: &[u32],
-        ib: &[u32],
-        out: &mut [u32],
-    ) -> usize;
+    /// Node `n`'s record if its group is current.
+    fn record(nodes: &Self::Nodes, tree: &RegionTree, n: usize) -> Option<Self::Record>;
+    /// Makes every node stale (a new step).
+    fn invalidate(nodes: &mut Self::Nodes);
+    /// Fits every stale group now: exactly, or bottom-up (leaves exactly, each internal node
+    /// as a bound of its children's volumes: for DH `r_p = max_c(|C_p - C_c| + r_c)`).
+    /// Returns the number of nodes fitted.
+    fn refit_all(nodes: &mut Self::Nodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64;
     /// Whether record `r` encloses point `v` of `p` (checked in f64; for validation).
     fn encloses(r: &Self::Record, p: &Points, v: usize) -> bool;
+}
+
+/// The lazily fitted buffers of a kind, grouped by sibling group.
+/// Node `n`'s bounds are at slot `slot(n)` of the buffers: group `g` owns the padded slots
+/// `tree.group_slots(g)`, its nodes first in order (see [`crate::tree::BLOCK`]).
+pub(crate) fn group_buffers<const F: usize>(tree: &RegionTree, init: [f32; F]) -> LazySoa<F> {
+    let groups = (0..tree.group_count())
+        .map(|g| tree.group_slots(g))
+        .collect();
+    LazySoa::new(tree.slot_count(), init, groups)
+}
+
+/// The slot of node `n` in the padded node layout.
+#[inline]
+pub(crate) fn slot(tree: &RegionTree, n: usize) -> usize {
+    let g = tree.group_of(n);
+    tree.group_slots(g).start + (n - tree.group_nodes(g).start)
+}
+
+/// Fits every stale group of `buffers` with `write(fields, n, slot)` for each node `n`,
+/// deepest groups first (so a bottom-up fit finds its children current), and marks them
+/// current.
+pub(crate) fn refit_groups<const F: usize>(
+    buffers: &mut LazySoa<F>,
+    tree: &RegionTree,
+    mut write: impl FnMut(&mut [&mut [f32]; F], usize, usize),
+) -> u64 {
+    let mut fitted = 0;
+    for g in (0..tree.group_count()).rev() {
+        if buffers.is_current(g) {
+            continue;
+        }
+        let mut fields = buffers.fields_mut();
+        let first = tree.group_slots(g).start;
+        for (i, n) in tree.group_nodes(g).enumerate() {
+            write(&mut fields, n, first + i);
+            fitted += 1;
+        }
+        buffers.set_current(g);
+    }
+    fitted
 }
 
 #[inline]

@@ -1,9 +1,11 @@
 //! Sphere bounding volumes (the paper's SBV): centre = mean of the region's vertices,
 //! radius = largest distance from it. Refitting reads the region twice (mean, then radius).
 
-use super::{conservative_radius, conservative_sum, dist2_f64, padded, sealed, BvKind, Method};
+use super::{conservative_radius, conservative_sum, dist2_f64, group_buffers, refit_groups, slot};
+use super::{sealed, BvKind, Method};
 use crate::points::Points;
 use crate::tree::RegionTree;
+use dhcd_kernels::lazy::LazySoa;
 use dhcd_kernels::{overlap, refit};
 
 /// The sphere node record: centre and radius — 16 bytes.
@@ -15,127 +17,164 @@ pub struct SphereNode {
 }
 const _: () = assert!(std::mem::size_of::<SphereNode>() == 16);
 
-/// Sphere nodes, structure-of-arrays. Padding entries have radius NaN (never overlap).
-#[derive(Clone, Debug, Default, PartialEq)]
+/// Sphere nodes, structure-of-arrays: `[cx, cy, cz, radius]`, fitted lazily per sibling
+/// group.
+#[derive(Clone, Debug)]
 pub struct SphereNodes {
-    pub cx: Vec<f32>,
-    pub cy: Vec<f32>,
-    pub cz: Vec<f32>,
-    pub radius: Vec<f32>,
-}
-
-impl SphereNodes {
-    pub fn soa(&self) -> overlap::SphereSoa<'_> {
-        overlap::SphereSoa {
-            cx: &self.cx,
-            cy: &self.cy,
-            cz: &self.cz,
-            r: &self.radius,
-        }
-    }
+    fitted: LazySoa<4>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Sphere;
 impl sealed::Sealed for Sphere {}
 
+#[inline]
+fn write(fields: &mut [&mut [f32]; 4], i: usize, r: SphereNode) {
+    fields[0][i] = r.center[0];
+    fields[1][i] = r.center[1];
+    fields[2][i] = r.center[2];
+    fields[3][i] = r.radius;
+}
+
+#[inline]
+fn read(fields: &[&mut [f32]; 4], i: usize) -> SphereNode {
+    SphereNode {
+        center: [fields[0][i], fields[1][i], fields[2][i]],
+        radius: fields[3][i],
+    }
+}
+
+/// The exact sphere of node `n`.
+fn fit_node(tree: &RegionTree, p: &Points, n: usize) -> SphereNode {
+    let run = p.soa().slice(tree.vert_run(n));
+    let borrowed = tree.borrowed(n);
+    let s1 = refit::sum(run);
+    let s2 = refit::sum_indexed(p.soa(), borrowed);
+    let inv = 1.0 / tree.vertex_count(n) as f32;
+    let mut center = [0, 1, 2].map(|k| (s1[k] + s2[k]) * inv);
+    if !center.iter().all(|c| c.is_finite()) {
+        // The sum overflowed (coordinates near f32::MAX): any centre is correct, the
+        // radius below bounds the region from it; take the box midpoint.
+        let (lo, hi) =
+            refit::merge_bounds(refit::bounds(run), refit::bounds_indexed(p.soa(), borrowed));
+        center = [0, 1, 2].map(|k| lo[k] * 0.5 + hi[k] * 0.5);
+    }
+    let d2 =
+        refit::max_dist_sq(run, center).max(refit::max_dist_sq_indexed(p.soa(), borrowed, center));
+    SphereNode {
+        center,
+        radius: conservative_radius(d2),
+    }
+}
+
 impl BvKind for Sphere {
     const METHOD: Method = Method::Sphere;
     type Record = SphereNode;
     type Nodes = SphereNodes;
+    type Block<'a> = overlap::SphereSoa<'a>;
 
     fn build(tree: &RegionTree, rest: &Points) -> SphereNodes {
-        let n = tree.node_count();
         let mut nodes = SphereNodes {
-            cx: vec![0.0; padded(n)],
-            cy: vec![0.0; padded(n)],
-            cz: vec![0.0; padded(n)],
-            radius: vec![f32::NAN; padded(n)],
+            fitted: group_buffers(tree, [0.0, 0.0, 0.0, f32::NAN]),
         };
-        for node in 0..n {
-            let r = Sphere::fit(&nodes, tree, rest, node);
-            Sphere::set(&mut nodes, node, r);
-        }
+        Sphere::refit_all(&mut nodes, tree, rest, false);
         nodes
     }
 
-    fn fit(_: &SphereNodes, tree: &RegionTree, p: &Points, n: usize) -> SphereNode {
-        let run = p.soa().slice(tree.vert_run(n));
-        let borrowed = tree.borrowed(n);
-        let s1 = refit::sum(run);
-        let s2 = refit::sum_indexed(p.soa(), borrowed);
-        let inv = 1.0 / tree.vertex_count(n) as f32;
-        let mut center = [0, 1, 2].map(|k| (s1[k] + s2[k]) * inv);
-        if !center.iter().all(|c| c.is_finite()) {
-            // The sum overflowed (coordinates near f32::MAX): any centre is correct, the
-            // radius below bounds the region from it; take the box midpoint.
-            let (lo, hi) =
-                refit::merge_bounds(refit::bounds(run), refit::bounds_indexed(p.soa(), borrowed));
-            center = [0, 1, 2].map(|k| lo[k] * 0.5 + hi[k] * 0.5);
-        }
-        let d2 = refit::max_dist_sq(run, center).max(refit::max_dist_sq_indexed(
-            p.soa(),
-            borrowed,
-            center,
-        ));
-        SphereNode {
-            center,
-            radius: conservative_radius(d2),
-        }
-    }
-
-    fn merge(nodes: &SphereNodes, tree: &RegionTree, _: &Points, n: usize) -> SphereNode {
-        let children = tree.children(n);
-        let inv = 1.0 / children.len() as f32;
-        let mut center = [0.0f32; 3];
-        for c in children.clone() {
-            let cc = Sphere::get(nodes, c).center;
-            for k in 0..3 {
-                center[k] += cc[k] * inv;
+    #[inline]
+    fn group<'a>(
+        nodes: &'a SphereNodes,
+        tree: &RegionTree,
+        p: &Points,
+        g: usize,
+    ) -> (overlap::SphereSoa<'a>, bool) {
+        let (f, fitted) = nodes.fitted.get_or_fill(g, |_, mut fields| {
+            for (i, n) in tree.group_nodes(g).enumerate() {
+                write(&mut fields, i, fit_node(tree, p, n));
             }
-        }
-        if !center.iter().all(|c| c.is_finite()) {
-            center = Sphere::get(nodes, children.start).center;
-        }
-        let mut radius = 0.0f32;
-        for c in children {
-            let child = Sphere::get(nodes, c);
-            let d2 = (0..3)
-                .map(|k| (center[k] - child.center[k]).powi(2))
-                .sum::<f32>();
-            radius = radius.max(conservative_sum(conservative_radius(d2), child.radius));
-        }
-        SphereNode { center, radius }
+        });
+        let [cx, cy, cz, r] = f;
+        (overlap::SphereSoa { cx, cy, cz, r }, fitted)
     }
 
     #[inline]
-    fn get(nodes: &SphereNodes, n: usize) -> SphereNode {
-        SphereNode {
-            center: [nodes.cx[n], nodes.cy[n], nodes.cz[n]],
-            radius: nodes.radius[n],
-        }
+    fn group_current(nodes: &SphereNodes, g: usize) -> bool {
+        nodes.fitted.is_current(g)
     }
 
-    #[inline]
-    fn set(nodes: &mut SphereNodes, n: usize, r: SphereNode) {
-        [nodes.cx[n], nodes.cy[n], nodes.cz[n]] = r.center;
-        nodes.radius[n] = r.radius;
+    #[inline(always)]
+    fn test<S: pulp::Simd>(
+        simd: S,
+        a: overlap::SphereSoa<'_>,
+        i: usize,
+        b: overlap::SphereSoa<'_>,
+        n: usize,
+    ) -> u32 {
+        let (c, r) = a.get(i);
+        overlap::sphere_block_with(simd, c, r, b, n)
     }
 
-    fn overlap(
-        a: &SphereNodes,
-        _: &Points,
-        b: &SphereNodes,
-        _: &Points,
-        ia: &[u32],
-        ib: &[u32],
-        out: &mut [u32],
-    ) -> usize {
-        overlap::sphere_pairs(a.soa(), b.soa(), ia, ib, out)
+    #[inline(always)]
+    fn extent(a: overlap::SphereSoa<'_>, i: usize) -> f32 {
+        a.r[i]
+    }
+
+    fn fit(_: &SphereNodes, tree: &RegionTree, p: &Points, n: usize) -> SphereNode {
+        fit_node(tree, p, n)
+    }
+
+    fn record(nodes: &SphereNodes, tree: &RegionTree, n: usize) -> Option<SphereNode> {
+        let g = tree.group_of(n);
+        let f = nodes.fitted.get(g)?;
+        let i = n - tree.group_nodes(g).start;
+        Some(SphereNode {
+            center: [f[0][i], f[1][i], f[2][i]],
+            radius: f[3][i],
+        })
+    }
+
+    fn invalidate(nodes: &mut SphereNodes) {
+        nodes.fitted.invalidate();
+    }
+
+    fn refit_all(nodes: &mut SphereNodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64 {
+        refit_groups(&mut nodes.fitted, tree, |f, n, s| {
+            let r = if bottom_up && !tree.is_leaf(n) {
+                merge(f, tree, n)
+            } else {
+                fit_node(tree, p, n)
+            };
+            write(f, s, r);
+        })
     }
 
     fn encloses(r: &SphereNode, p: &Points, v: usize) -> bool {
         let rad = r.radius as f64;
         dist2_f64(r.center, p.get(v)) <= rad * rad
     }
+}
+
+/// A sphere enclosing the (fitted) spheres of `n`'s children: centred at their mean.
+fn merge(f: &[&mut [f32]; 4], tree: &RegionTree, n: usize) -> SphereNode {
+    let children = tree.children(n);
+    let inv = 1.0 / children.len() as f32;
+    let mut center = [0.0f32; 3];
+    for c in children.clone() {
+        let cc = read(f, slot(tree, c)).center;
+        for k in 0..3 {
+            center[k] += cc[k] * inv;
+        }
+    }
+    if !center.iter().all(|c| c.is_finite()) {
+        center = read(f, slot(tree, children.start)).center;
+    }
+    let mut radius = 0.0f32;
+    for c in children {
+        let child = read(f, slot(tree, c));
+        let d2 = (0..3)
+            .map(|k| (center[k] - child.center[k]).powi(2))
+            .sum::<f32>();
+        radius = radius.max(conservative_sum(conservative_radius(d2), child.radius));
+    }
+    SphereNode { center, radius }
 }

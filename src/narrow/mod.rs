@@ -21,6 +21,7 @@
 //! other's plane (early exit when all are strictly on one side). Only pairs surviving both
 //! filters pay for the edge tests (measured by `cargo bench --bench narrow`).
 
+pub(crate) mod leaves;
 mod oracle;
 mod predicates;
 mod tritri;

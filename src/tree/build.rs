@@ -8,7 +8,7 @@
 //! whose bounds never shrink). Ties in the median are broken by triangle index, so even
 //! coincident centroids are separated and the build is deterministic.
 
-use super::{RegionTree, TreeShape, MAX_CHILDREN};
+use super::{RegionTree, TreeShape, BLOCK, MAX_CHILDREN};
 use crate::error::Result;
 use crate::mesh::Mesh;
 
@@ -115,6 +115,47 @@ impl RegionTree {
         borrowed_start.push(borrowed.len() as u32);
         let tri_vertex = std::array::from_fn(|k| tris.iter().map(|t| t[k]).collect());
 
+        // Sibling groups: the root alone, then each internal node's children, in id order
+        // (breadth-first numbering makes them consecutive ranges tiling the node ids).
+        let mut group_start = vec![0u32, 1];
+        let mut node_group = vec![0u32; node_count];
+        let mut leaf_rank = vec![UNSET; node_count];
+        let mut leaves = 0u32;
+        for n in 0..node_count {
+            if child_count[n] == 0 {
+                leaf_rank[n] = leaves;
+                leaves += 1;
+                continue;
+            }
+            let g = group_start.len() as u32 - 1;
+            let (f, c) = (first_child[n], child_count[n] as u32);
+            debug_assert_eq!(group_start[g as usize], f);
+            node_group[f as usize..(f + c) as usize].fill(g);
+            group_start.push(f + c);
+        }
+
+        // Padded layouts: every sibling group and every leaf's triangle run takes a multiple
+        // of BLOCK slots, so the wide tests and row filters load whole vectors.
+        let mut group_slot = vec![0u32];
+        for g in 0..group_start.len() - 1 {
+            let len = (group_start[g + 1] - group_start[g]) as usize;
+            group_slot.push(group_slot[g] + len.next_multiple_of(BLOCK) as u32);
+        }
+        let mut leaf_slot = vec![0u32];
+        let mut slot_vertex: [Vec<u32>; 3] = Default::default();
+        for n in 0..node_count {
+            if child_count[n] != 0 {
+                continue;
+            }
+            let run = &tris[tri_start[n] as usize..tri_end[n] as usize];
+            let padded = run.len().next_multiple_of(BLOCK);
+            for (k, corner) in slot_vertex.iter_mut().enumerate() {
+                corner.extend(run.iter().map(|t| t[k]));
+                corner.resize(corner.len() + padded - run.len(), u32::MAX);
+            }
+            leaf_slot.push(leaf_slot.last().copied().unwrap_or(0) + padded as u32);
+        }
+
         let tree = RegionTree {
             shape,
             first_child,
@@ -128,6 +169,12 @@ impl RegionTree {
             borrowed_start,
             borrowed,
             level_start,
+            group_start,
+            node_group,
+            leaf_rank,
+            group_slot,
+            leaf_slot,
+            slot_vertex,
             tris,
             tri_vertex,
             tri_order: order,

@@ -32,6 +32,11 @@ pub const MAX_CHILDREN: usize = 8;
 pub const DEFAULT_LEAF_SIZE: usize = 8;
 /// Largest accepted leaf size (larger leaves only make the narrow phase quadratic).
 pub const MAX_LEAF_SIZE: usize = 4096;
+/// Sibling groups (node bounds) and leaf triangle runs (narrow-phase caches) are stored
+/// padded to a multiple of this many slots: a wide test or row filter then loads whole
+/// vectors of x86-v3 (partial loads are out-of-line calls there), and a node's children are
+/// one block whatever the backend.
+pub const BLOCK: usize = 8;
 
 /// How far the region tree is subdivided.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -83,6 +88,18 @@ pub struct RegionTree {
     borrowed_start: Vec<u32>,
     borrowed: Vec<u32>,
     level_start: Vec<u32>,
+    /// Sibling group `g` is nodes `group_start[g]..group_start[g + 1]`: group 0 the root,
+    /// then the children of each internal node in id order.
+    group_start: Vec<u32>,
+    node_group: Vec<u32>,
+    /// Index of each leaf among the leaves (`u32::MAX` for internal nodes).
+    leaf_rank: Vec<u32>,
+    /// Padded layouts: group `g` owns slots `group_slot[g]..group_slot[g + 1]`, leaf rank
+    /// `r` owns triangle slots `leaf_slot[r]..leaf_slot[r + 1]` (multiples of [`BLOCK`]).
+    group_slot: Vec<u32>,
+    leaf_slot: Vec<u32>,
+    /// Corner `k`'s vertex index of each triangle slot (`u32::MAX` in padding).
+    slot_vertex: [Vec<u32>; 3],
     tris: Vec<[u32; 3]>,
     /// `tris` as three arrays of corner indices (the narrow phase's shared-vertex mask).
     tri_vertex: [Vec<u32>; 3],
@@ -107,7 +124,73 @@ impl RegionTree {
 
     /// Number of leaves.
     pub fn leaf_count(&self) -> usize {
-        self.child_count.iter().filter(|&&c| c == 0).count()
+        self.node_count() - (self.group_start.len() - 2)
+    }
+
+    /// Number of sibling groups: the root's, and one per internal node (its children, which
+    /// a wide test reads as one block and the lazy refit fits together).
+    pub fn group_count(&self) -> usize {
+        self.group_start.len() - 1
+    }
+
+    /// The nodes of sibling group `g` (consecutive ids).
+    #[inline]
+    pub fn group_nodes(&self, g: usize) -> Range<usize> {
+        self.group_start[g] as usize..self.group_start[g + 1] as usize
+    }
+
+    /// The sibling group of node `n` (0 for the root).
+    #[inline]
+    pub fn group_of(&self, n: usize) -> usize {
+        self.node_group[n] as usize
+    }
+
+    /// The group of `n`'s children (`None` for a leaf).
+    #[inline]
+    pub fn child_group(&self, n: usize) -> Option<usize> {
+        (self.child_count[n] > 0).then(|| self.node_group[self.first_child[n] as usize] as usize)
+    }
+
+    /// Index of leaf `n` among the leaves (`0..leaf_count()`), `None` for internal nodes.
+    #[inline]
+    pub fn leaf_rank(&self, n: usize) -> Option<usize> {
+        let r = self.leaf_rank[n];
+        (r != u32::MAX).then_some(r as usize)
+    }
+
+    /// Number of slots of the padded node layout.
+    pub fn slot_count(&self) -> usize {
+        *self.group_slot.last().unwrap_or(&0) as usize
+    }
+
+    /// The slots of sibling group `g` (its nodes first, in order, then padding; a multiple
+    /// of [`BLOCK`]).
+    #[inline]
+    pub fn group_slots(&self, g: usize) -> Range<usize> {
+        self.group_slot[g] as usize..self.group_slot[g + 1] as usize
+    }
+
+    /// Number of slots of the padded triangle layout.
+    pub fn tri_slot_count(&self) -> usize {
+        *self.leaf_slot.last().unwrap_or(&0) as usize
+    }
+
+    /// The triangle slots of the leaf of rank `r` (its triangles first, in order, then
+    /// padding; a multiple of [`BLOCK`]).
+    #[inline]
+    pub fn leaf_slots(&self, r: usize) -> Range<usize> {
+        self.leaf_slot[r] as usize..self.leaf_slot[r + 1] as usize
+    }
+
+    /// Corner `k`'s vertex index of every triangle slot (`u32::MAX` in padding).
+    #[inline]
+    pub fn slot_vertex(&self, k: usize) -> &[u32] {
+        &self.slot_vertex[k]
+    }
+
+    /// The leaves, in id order (`leaves()[leaf_rank(n)] == n`).
+    pub fn leaves(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.node_count()).filter(|&n| self.is_leaf(n))
     }
 
     pub fn node_count(&self) -> usize {
@@ -228,6 +311,16 @@ impl RegionTree {
         size_of_val(&self.first_child[..])
             + size_of_val(&self.child_count[..])
             + size_of_val(&self.parent[..])
+            + size_of_val(&self.group_start[..])
+            + size_of_val(&self.node_group[..])
+            + size_of_val(&self.leaf_rank[..])
+            + size_of_val(&self.group_slot[..])
+            + size_of_val(&self.leaf_slot[..])
+            + self
+                .slot_vertex
+                .iter()
+                .map(|v| size_of_val(&v[..]))
+                .sum::<usize>()
             + size_of_val(&self.depth[..])
             + size_of_val(&self.tri_start[..])
             + size_of_val(&self.tri_end[..])

@@ -34,6 +34,32 @@ impl RegionTree {
                 return fail(0, "deeper than the requested levels");
             }
         }
+        let mut leaves = 0;
+        for g in 0..self.group_count() {
+            let nodes = self.group_nodes(g);
+            if nodes.is_empty() || nodes.clone().any(|n| self.group_of(n) != g) {
+                return fail(nodes.start, format!("sibling group {g} broken"));
+            }
+            let parent = nodes.clone().map(|n| self.parent(n)).collect::<Vec<_>>();
+            if parent.windows(2).any(|w| w[0] != w[1])
+                || parent[0].is_some_and(|p| self.child_group(p) != Some(g))
+                || (g == 0) != parent[0].is_none()
+            {
+                return fail(
+                    nodes.start,
+                    format!("sibling group {g} is not one node's children"),
+                );
+            }
+        }
+        if self.group_nodes(self.group_count() - 1).end != nodes {
+            return fail(0, "sibling groups do not tile the nodes");
+        }
+        for n in 0..nodes {
+            if self.leaf_rank(n) != self.is_leaf(n).then_some(leaves) {
+                return fail(n, "leaf rank out of order");
+            }
+            leaves += self.is_leaf(n) as usize;
+        }
         if self.parent[0] != u32::MAX {
             return fail(0, "the root has a parent");
         }

@@ -174,6 +174,12 @@ pub(super) fn calibrate_frame(
     for &(i, j) in pairs {
         let (a, b) = two_mut(hs, i, j);
         counters += a.collide(b, &mut ws, par)?.counters;
+    }
+    // The query runs the narrow phase as it finds leaf pairs; record them with a broad
+    // phase over the now fitted hierarchies (it refits nothing).
+    for &(i, j) in pairs {
+        let (a, b) = two_mut(hs, i, j);
+        a.broad_phase(b, &mut ws, par)?;
         leaves.push(ws.leaf_pairs().to_vec());
     }
     let fitted: Vec<Vec<u32>> = hs.iter().map(AnyHierarchy::fitted_nodes).collect();
