@@ -98,6 +98,7 @@ impl<'a> TriSoa<'a> {
 
 /// Which pairs `(i, j)` of two blocks are allowed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Pairing {
     /// Every pair (two objects).
     All,

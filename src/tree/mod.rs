@@ -40,6 +40,7 @@ pub const BLOCK: usize = 8;
 
 /// How far the region tree is subdivided.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum TreeShape {
     /// Split every node holding more than `leaf_size` triangles (the default: the depth
     /// follows the mesh).
