@@ -93,12 +93,16 @@ fn counters(py: Python<'_>, c: Counters) -> PyResult<Py<PyDict>> {
     Ok(d.unbind())
 }
 
-/// `numpy.asarray(obj)` checked to be a 2-D array with 3 columns of a numeric kind in
-/// `kinds` (numpy's dtype kind letters); `what` names it in messages.
+/// Real numbers and integers, as numpy's dtype kind letters and in words.
+const REAL: (&str, &str) = ("fiu", "a real number type");
+const INTEGER: (&str, &str) = ("iu", "an integer type");
+
+/// `numpy.asarray(obj)` checked to be a 2-D array with 3 columns whose dtype is one of
+/// `kinds` (`REAL` or `INTEGER`); `what` names it in messages.
 fn numeric_n3<'py>(
     obj: &Bound<'py, PyAny>,
     what: &str,
-    kinds: &str,
+    (kinds, kinds_text): (&str, &str),
 ) -> PyResult<Bound<'py, PyAny>> {
     let np = obj.py().import("numpy")?;
     let arr = np
@@ -116,12 +120,7 @@ fn numeric_n3<'py>(
     if !kinds.contains(kind.as_str()) {
         let name = dtype.str()?;
         return Err(value_error(format!(
-            "{what} has dtype {name}, which is not {kinds_text}",
-            kinds_text = if kinds == "fiu" {
-                "a real number type"
-            } else {
-                "an integer type"
-            }
+            "{what} has dtype {name}, which is not {kinds_text}"
         )));
     }
     Ok(arr)
@@ -133,7 +132,7 @@ struct Vertices<'py>(PyReadonlyArray2<'py, f32>);
 
 impl<'py> Vertices<'py> {
     fn new(obj: &Bound<'py, PyAny>) -> PyResult<Self> {
-        let arr = numeric_n3(obj, "vertices", "fiu")?;
+        let arr = numeric_n3(obj, "vertices", REAL)?;
         let np = obj.py().import("numpy")?;
         // No copy if `arr` is already float32 and C-contiguous.
         let arr = np.call_method1("ascontiguousarray", (arr, "float32"))?;
@@ -152,7 +151,7 @@ impl<'py> Vertices<'py> {
 /// Faces as `u32` triangles (negative or too large indices are errors here; indices beyond
 /// the vertex count are the library's `IndexOutOfRange`).
 fn faces(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
-    index_rows(&numeric_n3(obj, "faces", "iu")?, "face")
+    index_rows(&numeric_n3(obj, "faces", INTEGER)?, "face")
 }
 
 /// Contact pairs `(K, 2)` from Python: non-negative integers below 2^32.
