@@ -17,7 +17,7 @@ use dhcd_kernels::narrow::{self, Pairing, TriSoa};
 use dhcd_kernels::overlap::{self, AabbSoa, SphereSoa};
 use dhcd_kernels::pulp::{Simd, WithSimd};
 use dhcd_kernels::refit;
-use dhcd_kernels::Soa3;
+use dhcd_kernels::{Soa3, Tile};
 use std::hint::black_box;
 
 const SIZES: [usize; 2] = [1024, 16384];
@@ -55,55 +55,45 @@ impl Rng {
     }
 }
 
-/// `BLOCKS` blocks of `BLOCK` spheres and boxes (one array per field, block `k` at
-/// `k * BLOCK..`), and `BLOCKS` probes; about a third of the pairs overlap.
+/// `BLOCKS` blocks of `BLOCK` spheres and boxes (each block one tile, as a node's children
+/// are stored), and `BLOCKS` probes; about a third of the pairs overlap.
 struct Blocks {
-    sphere: [Vec<f32>; 4],
-    boxes: [Vec<f32>; 6],
+    sphere: Vec<f32>,
+    boxes: Vec<f32>,
     probes: Vec<([f32; 3], f32)>,
 }
 
 impl Blocks {
     fn new(rng: &mut Rng) -> Self {
-        let n = BLOCKS * BLOCK;
-        let c = [0; 3].map(|_| rng.vec(n, -1.0, 1.0));
-        let r = rng.vec(n, 0.0, 0.5);
-        let boxes = core::array::from_fn(|f| {
-            let a = f % 3;
-            let s = if f < 3 { -1.0 } else { 1.0 };
-            (0..n).map(|i| c[a][i] + s * r[i] * 0.8).collect()
-        });
+        let mut sphere = Vec::with_capacity(BLOCKS * 4 * BLOCK);
+        let mut boxes = Vec::with_capacity(BLOCKS * 6 * BLOCK);
+        for _ in 0..BLOCKS {
+            let c = [0; 3].map(|_| rng.vec(BLOCK, -1.0, 1.0));
+            let r = rng.vec(BLOCK, 0.0, 0.5);
+            for f in c.iter().chain([&r]) {
+                sphere.extend_from_slice(f);
+            }
+            for f in 0..6 {
+                let (a, s) = (f % 3, if f < 3 { -1.0 } else { 1.0 });
+                boxes.extend((0..BLOCK).map(|i| c[a][i] + s * r[i] * 0.8));
+            }
+        }
         let probes = (0..BLOCKS)
             .map(|_| ([0; 3].map(|_| rng.f32_in(-1.0, 1.0)), rng.f32_in(0.0, 0.5)))
             .collect();
-        let [x, y, z] = c;
         Blocks {
-            sphere: [x, y, z, r],
+            sphere,
             boxes,
             probes,
         }
     }
     fn sphere(&self, k: usize) -> SphereSoa<'_> {
-        let r = k * BLOCK..(k + 1) * BLOCK;
-        let s = &self.sphere;
-        SphereSoa {
-            cx: &s[0][r.clone()],
-            cy: &s[1][r.clone()],
-            cz: &s[2][r.clone()],
-            r: &s[3][r],
-        }
+        let t = &self.sphere[k * 4 * BLOCK..(k + 1) * 4 * BLOCK];
+        SphereSoa::new(Tile::new(t, BLOCK))
     }
     fn aabb(&self, k: usize) -> AabbSoa<'_> {
-        let r = k * BLOCK..(k + 1) * BLOCK;
-        let b = &self.boxes;
-        AabbSoa {
-            min_x: &b[0][r.clone()],
-            min_y: &b[1][r.clone()],
-            min_z: &b[2][r.clone()],
-            max_x: &b[3][r.clone()],
-            max_y: &b[4][r.clone()],
-            max_z: &b[5][r],
-        }
+        let t = &self.boxes[k * 6 * BLOCK..(k + 1) * 6 * BLOCK];
+        AabbSoa::new(Tile::new(t, BLOCK))
     }
 }
 
@@ -166,54 +156,40 @@ fn block_benches(c: &mut Criterion) {
     }
 }
 
-/// `LEAF_PAIRS` pairs of leaves of 8 nearby triangles (SoA, with corner indices), as
-/// the narrow phase meets them.
+/// `LEAF_PAIRS` pairs of leaves of 8 nearby triangles (one tile per leaf, with corner
+/// indices), as the narrow phase meets them.
 struct LeafPairs {
-    corner: [[Vec<f32>; 3]; 3],
-    lo: [Vec<f32>; 3],
-    hi: [Vec<f32>; 3],
-    vertex: [Vec<u32>; 3],
+    tiles: Vec<f32>,
+    vertex: Vec<u32>,
 }
 
 impl LeafPairs {
     fn new(rng: &mut Rng) -> Self {
-        let n = 2 * LEAF_PAIRS * LEAF;
-        let mut tris = Vec::with_capacity(n);
+        let mut tiles = Vec::with_capacity(2 * LEAF_PAIRS * 15 * LEAF);
+        let mut vertex = Vec::with_capacity(2 * LEAF_PAIRS * 3 * LEAF);
         for _ in 0..LEAF_PAIRS {
             let c = [0; 3].map(|_| rng.f32_in(-1.0, 1.0));
-            for _ in 0..2 * LEAF {
-                let t: [[f32; 3]; 3] =
-                    [0; 3].map(|_| [0, 1, 2].map(|k| c[k] + rng.f32_in(-0.3, 0.3)));
-                tris.push(t);
+            for _ in 0..2 {
+                let tris: Vec<[[f32; 3]; 3]> = (0..LEAF)
+                    .map(|_| [0; 3].map(|_| [0, 1, 2].map(|k| c[k] + rng.f32_in(-0.3, 0.3))))
+                    .collect();
+                for f in 0..15 {
+                    tiles.extend(tris.iter().map(|t| match f {
+                        0..9 => t[f / 3][f % 3],
+                        9..12 => t[0][f - 9].min(t[1][f - 9]).min(t[2][f - 9]),
+                        _ => t[0][f - 12].max(t[1][f - 12]).max(t[2][f - 12]),
+                    }));
+                }
+                vertex.extend((0..3 * LEAF).map(|_| rng.below(4000)));
             }
         }
-        LeafPairs {
-            corner: core::array::from_fn(|c| {
-                core::array::from_fn(|k| tris.iter().map(|t| t[c][k]).collect())
-            }),
-            lo: core::array::from_fn(|k| {
-                tris.iter()
-                    .map(|t| t[0][k].min(t[1][k]).min(t[2][k]))
-                    .collect()
-            }),
-            hi: core::array::from_fn(|k| {
-                tris.iter()
-                    .map(|t| t[0][k].max(t[1][k]).max(t[2][k]))
-                    .collect()
-            }),
-            vertex: core::array::from_fn(|_| (0..n).map(|_| rng.below(4000)).collect()),
-        }
+        LeafPairs { tiles, vertex }
     }
     /// Leaf `l` (of `2 * LEAF_PAIRS`).
     fn leaf(&self, l: usize) -> TriSoa<'_> {
-        let r = l * LEAF..(l + 1) * LEAF;
-        let c = &self.corner;
-        TriSoa {
-            corner: core::array::from_fn(|i| core::array::from_fn(|k| &c[i][k][r.clone()])),
-            lo: core::array::from_fn(|k| &self.lo[k][r.clone()]),
-            hi: core::array::from_fn(|k| &self.hi[k][r.clone()]),
-            vertex: core::array::from_fn(|k| &self.vertex[k][r.clone()]),
-        }
+        let t = &self.tiles[l * 15 * LEAF..(l + 1) * 15 * LEAF];
+        let v = &self.vertex[l * 3 * LEAF..(l + 1) * 3 * LEAF];
+        TriSoa::new(Tile::new(t, LEAF), v)
     }
 }
 

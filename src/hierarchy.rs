@@ -8,8 +8,9 @@ use crate::error::{Error, Result};
 use crate::mesh::{check_positions, Mesh};
 use crate::points::Points;
 use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
-use dhcd_kernels::lazy::LazySoa;
+use dhcd_kernels::lazy::LazyTiles;
 use dhcd_kernels::narrow::TriSoa;
+use dhcd_kernels::Tile;
 
 /// When bounding volumes follow a deformation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -103,31 +104,38 @@ pub struct Hierarchy<K: BvKind> {
     tris: TriCache,
 }
 
-/// Every triangle's corners and closed box in the current pose (internal triangle order,
-/// structure-of-arrays), refreshed lazily one leaf at a time by the narrow phase: a leaf
-/// meets several leaves, so its triangles are gathered once per step instead of once per
-/// leaf pair, and the narrow phase's row filters read contiguous arrays.
+/// Every triangle's corners and closed box in the current pose, refreshed lazily one leaf at
+/// a time by the narrow phase: a leaf meets several leaves, so its triangles are gathered
+/// once per step instead of once per leaf pair. One tile per leaf over its padded slots
+/// (fields: the nine corner coordinates, then box min xyz and max xyz), so the narrow
+/// phase's filter reads a few contiguous cache lines per leaf.
 #[derive(Clone, Debug)]
 pub(crate) struct TriCache {
-    /// `corner[c][k]` = coordinate `k` of corner `c` (9 arrays), then box min xyz and max
-    /// xyz (6 arrays); one group per leaf (its triangle run).
-    data: LazySoa<15>,
+    tiles: LazyTiles,
 }
 
-/// The cached triangles of one leaf: slices of its padded slot range (its `len`
-/// triangles first, then padding up to a multiple of [`crate::tree::BLOCK`]).
+/// Fields per triangle of the cache tiles.
+const TRI_FIELDS: usize = 15;
+
+/// The cached triangles of one leaf: the tile of its padded slots (its `len` triangles
+/// first, then padding up to a multiple of [`crate::tree::BLOCK`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LeafTris<'a> {
-    /// Number of triangles (the slices are longer: padding).
+    /// Number of triangles (the tile is longer: padding).
     pub(crate) len: usize,
     pub(crate) soa: TriSoa<'a>,
 }
 
 impl TriCache {
     fn new(tree: &RegionTree) -> Self {
-        let groups = (0..tree.leaf_count()).map(|r| tree.leaf_slots(r)).collect();
+        let groups = (0..tree.leaf_count())
+            .map(|r| {
+                let s = tree.leaf_slots(r);
+                TRI_FIELDS * s.start..TRI_FIELDS * s.end
+            })
+            .collect();
         Self {
-            data: LazySoa::new(tree.tri_slot_count(), [0.0; 15], groups),
+            tiles: LazyTiles::new(TRI_FIELDS * tree.tri_slot_count(), groups),
         }
     }
 
@@ -139,36 +147,26 @@ impl TriCache {
         p: &Points,
         leaf: usize,
     ) -> LeafTris<'a> {
-        let g = tree.leaf_rank(leaf).expect("a leaf");
+        let r = tree.leaf_rank(leaf).expect("a leaf");
         let tris = tree.tri_range(leaf);
-        let (f, _) = self.data.get_or_fill(g, |_, fields| {
+        let stride = tree.leaf_slots(r).len();
+        let (tile, _) = self.tiles.get_or_fill(r, |tile| {
             for (i, t) in tris.clone().enumerate() {
                 let c = tree.triangles()[t].map(|v| p.get(v as usize));
                 for corner in 0..3 {
                     for k in 0..3 {
-                        fields[3 * corner + k][i] = c[corner][k];
+                        tile[(3 * corner + k) * stride + i] = c[corner][k];
                     }
                 }
                 for k in 0..3 {
-                    fields[9 + k][i] = c[0][k].min(c[1][k]).min(c[2][k]);
-                    fields[12 + k][i] = c[0][k].max(c[1][k]).max(c[2][k]);
+                    tile[(9 + k) * stride + i] = c[0][k].min(c[1][k]).min(c[2][k]);
+                    tile[(12 + k) * stride + i] = c[0][k].max(c[1][k]).max(c[2][k]);
                 }
             }
         });
-        let [c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z, lx, ly, lz, hx, hy, hz] = f;
-        let slots = tree.leaf_slots(g);
         LeafTris {
             len: tris.len(),
-            soa: TriSoa {
-                corner: [[c0x, c0y, c0z], [c1x, c1y, c1z], [c2x, c2y, c2z]],
-                lo: [lx, ly, lz],
-                hi: [hx, hy, hz],
-                vertex: [
-                    &tree.slot_vertex(0)[slots.clone()],
-                    &tree.slot_vertex(1)[slots.clone()],
-                    &tree.slot_vertex(2)[slots],
-                ],
-            },
+            soa: TriSoa::new(Tile::new(tile, stride), tree.leaf_vertex_tile(r)),
         }
     }
 }
@@ -225,7 +223,7 @@ impl<K: BvKind> Hierarchy<K> {
     /// what it tests). Used by calibration and benchmarks to repeat a step's refit work.
     pub fn invalidate(&mut self) {
         K::invalidate(&mut self.nodes);
-        self.tris.data.invalidate();
+        self.tris.tiles.invalidate();
     }
 
     /// Refits the stale sibling groups of the nodes `ids` (each group once), as the lazy

@@ -1,11 +1,11 @@
-//! [`LazySoa`]: structure-of-arrays buffers whose *groups* (disjoint ranges of entries) are
-//! filled lazily, at most once per *epoch*, by whichever thread needs them first, and read
-//! by any number of threads afterwards.
+//! [`LazyTiles`]: one `f32` buffer whose *groups* (disjoint ranges, each a tile of
+//! structure-of-arrays fields) are filled lazily, at most once per *epoch*, by whichever
+//! thread needs them first, and read by any number of threads afterwards.
 //!
-//! In `dhcd`, this is what lets the lazy refit run inside a parallel traversal: node bounds are
-//! refitted one sibling group at a time (the block a wide test reads), triangle data one
-//! leaf at a time, each exactly once per step whatever the thread count, so the work done
-//! (and `N_U`) does not depend on scheduling. It is a `OnceLock` per group without the
+//! In `dhcd`, this is what lets the lazy refit run inside a parallel traversal: node bounds
+//! are refitted one sibling group at a time (the block a wide test reads), triangle data
+//! one leaf at a time, each exactly once per step whatever the thread count, so the work
+//! done (and `N_U`) does not depend on scheduling. It is a `OnceLock` per group without the
 //! reset: advancing the epoch (`&mut self`) makes every group stale at once.
 //!
 //! Protocol, per group: its state is the epoch its data belongs to, or [`BUSY`] while one
@@ -28,9 +28,9 @@ const BUSY: u32 = u32::MAX;
 /// A state no epoch ever has: stale.
 const STALE: u32 = 0;
 
-/// `F` lazily filled `f32` arrays sharing one grouping (see the module doc).
-pub struct LazySoa<const F: usize> {
-    data: [Box<[UnsafeCell<f32>]>; F],
+/// A lazily filled `f32` buffer split into groups (see the module doc).
+pub struct LazyTiles {
+    data: Box<[UnsafeCell<f32>]>,
     /// Group `g` owns entries `groups[g]`; disjoint, inside `0..len`.
     groups: Box<[(u32, u32)]>,
     state: Box<[AtomicU32]>,
@@ -43,30 +43,26 @@ pub struct LazySoa<const F: usize> {
 // `&mut self`; shared references to a group's data are handed out only after an acquire load
 // of the current epoch, and that data is not written again until `&mut self` advances the
 // epoch. Groups are disjoint (checked in `new`), so a claim never overlaps another's data.
-unsafe impl<const F: usize> Sync for LazySoa<F> {}
+unsafe impl Sync for LazyTiles {}
 
-/// What a fill writes: the group's slice of each of the `F` arrays.
-pub type Fields<'a, const F: usize> = [&'a mut [f32]; F];
-
-impl<const F: usize> LazySoa<F> {
-    /// Arrays of `len` entries, every entry `init[field]`, split into `groups` (disjoint
-    /// ranges inside `0..len`; entries in no group are never filled lazily). Every group
-    /// starts stale.
+impl LazyTiles {
+    /// A buffer of `len` zeros split into `groups` (disjoint ranges inside `0..len`; entries
+    /// in no group are never filled lazily). Every group starts stale.
     ///
     /// Panics if two groups overlap or one ends past `len` (a bug in the caller).
-    pub fn new(len: usize, init: [f32; F], groups: Vec<Range<usize>>) -> Self {
-        assert!(len <= u32::MAX as usize, "LazySoa: too many entries");
+    pub fn new(len: usize, groups: Vec<Range<usize>>) -> Self {
+        assert!(len <= u32::MAX as usize, "LazyTiles: too many entries");
         let mut sorted: Vec<(usize, usize)> = groups.iter().map(|r| (r.start, r.end)).collect();
         sorted.sort_unstable();
         for w in sorted.windows(2) {
-            assert!(w[0].1 <= w[1].0, "LazySoa: groups overlap");
+            assert!(w[0].1 <= w[1].0, "LazyTiles: groups overlap");
         }
         assert!(
             sorted.iter().all(|&(s, e)| s <= e && e <= len),
-            "LazySoa: a group ends past the arrays"
+            "LazyTiles: a group ends past the buffer"
         );
         Self {
-            data: init.map(|v| (0..len).map(|_| UnsafeCell::new(v)).collect()),
+            data: (0..len).map(|_| UnsafeCell::new(0.0)).collect(),
             groups: groups
                 .iter()
                 .map(|r| (r.start as u32, r.end as u32))
@@ -76,10 +72,10 @@ impl<const F: usize> LazySoa<F> {
         }
     }
 
-    /// Number of entries of each array.
+    /// Number of entries.
     #[allow(clippy::len_without_is_empty)]
     pub fn len(&self) -> usize {
-        self.data[0].len()
+        self.data.len()
     }
 
     /// The entries of group `g`.
@@ -95,32 +91,42 @@ impl<const F: usize> LazySoa<F> {
         self.state[g].load(Ordering::Acquire) == self.epoch
     }
 
-    /// Group `g`'s slices, or `None` if it is not current.
+    /// Group `g`'s entries, or `None` if it is not current.
     #[inline]
-    pub fn get(&self, g: usize) -> Option<[&[f32]; F]> {
+    pub fn get(&self, g: usize) -> Option<&[f32]> {
         self.is_current(g).then(|| self.read(g))
     }
 
-    /// Group `g`'s slices of the current epoch, filling them first with `fill(range,
-    /// fields)` if they are stale (once per epoch, whichever thread comes first; others
-    /// wait). Returns the slices and whether this call did the fill.
+    /// Group `g`'s entries of the current epoch, filling them first with `fill` if they are
+    /// stale (once per epoch, whichever thread comes first; others wait). Returns the
+    /// entries and whether this call did the fill.
     ///
     /// `fill` must not wait for another group or run work on a thread pool: a thread waiting
     /// for this group could be the one that has to run that work.
     #[inline]
-    pub fn get_or_fill(
-        &self,
-        g: usize,
-        fill: impl FnOnce(Range<usize>, Fields<'_, F>),
-    ) -> ([&[f32]; F], bool) {
+    pub fn get_or_fill(&self, g: usize, fill: impl FnOnce(&mut [f32])) -> (&[f32], bool) {
         let state = &self.state[g];
         let mut seen = state.load(Ordering::Acquire);
+        if seen == self.epoch {
+            return (self.read(g), false);
+        }
+        self.claim_and_fill(g, state, &mut seen, fill)
+    }
+
+    #[inline(never)]
+    fn claim_and_fill(
+        &self,
+        g: usize,
+        state: &AtomicU32,
+        seen: &mut u32,
+        fill: impl FnOnce(&mut [f32]),
+    ) -> (&[f32], bool) {
         let mut spins = 0u32;
         loop {
-            if seen == self.epoch {
+            if *seen == self.epoch {
                 return (self.read(g), false);
             }
-            if seen == BUSY {
+            if *seen == BUSY {
                 // Another thread is filling it: a fill is short, spin a little, then yield.
                 spins += 1;
                 if spins < 64 {
@@ -128,12 +134,12 @@ impl<const F: usize> LazySoa<F> {
                 } else {
                     std::thread::yield_now();
                 }
-                seen = state.load(Ordering::Acquire);
+                *seen = state.load(Ordering::Acquire);
                 continue;
             }
-            match state.compare_exchange_weak(seen, BUSY, Ordering::Acquire, Ordering::Acquire) {
+            match state.compare_exchange_weak(*seen, BUSY, Ordering::Acquire, Ordering::Acquire) {
                 Ok(_) => break,
-                Err(now) => seen = now,
+                Err(now) => *seen = now,
             }
         }
         // This thread holds the claim. If `fill` panics, hand the group back stale so that
@@ -147,36 +153,37 @@ impl<const F: usize> LazySoa<F> {
                 self.state.store(self.to, Ordering::Release);
             }
         }
-        let mut release = Release { state, to: seen };
+        let mut release = Release { state, to: *seen };
         let range = self.range(g);
         // SAFETY: the claim gives this thread exclusive access to the group's entries: no
         // other thread writes them (a writer needs the claim) or reads them (readers need
-        // the state to equal the epoch). Groups are disjoint, so the slices alias nothing.
-        let fields = std::array::from_fn(|k| unsafe {
+        // the state to equal the epoch). Groups are disjoint, so the slice aliases nothing.
+        // `UnsafeCell<f32>` has the layout of `f32`.
+        let entries = unsafe {
             std::slice::from_raw_parts_mut(
-                UnsafeCell::raw_get(self.data[k].as_ptr().add(range.start)),
+                UnsafeCell::raw_get(self.data.as_ptr().add(range.start)),
                 range.len(),
             )
-        });
-        fill(range, fields);
+        };
+        fill(entries);
         release.to = self.epoch;
         drop(release);
         (self.read(g), true)
     }
 
-    /// The slices of a group known to be current.
+    /// The entries of a group known to be current.
     #[inline]
-    fn read(&self, g: usize) -> [&[f32]; F] {
+    fn read(&self, g: usize) -> &[f32] {
         let range = self.range(g);
         // SAFETY: the caller observed (acquire) the group's state equal to the current
         // epoch, so its writer has published; nothing writes a current group before
-        // `&mut self` advances the epoch, which ends these borrows.
-        std::array::from_fn(|k| unsafe {
+        // `&mut self` advances the epoch, which ends this borrow.
+        unsafe {
             std::slice::from_raw_parts(
-                UnsafeCell::raw_get(self.data[k].as_ptr().add(range.start)).cast_const(),
+                UnsafeCell::raw_get(self.data.as_ptr().add(range.start)).cast_const(),
                 range.len(),
             )
-        })
+        }
     }
 
     /// Makes every group stale (a new epoch).
@@ -191,41 +198,29 @@ impl<const F: usize> LazySoa<F> {
         }
     }
 
-    /// Exclusive access to the whole arrays (eager refits); mark what was filled with
-    /// [`LazySoa::set_current`].
-    pub fn fields_mut(&mut self) -> [&mut [f32]; F] {
-        self.data.each_mut().map(|d| {
-            let cells: &mut [UnsafeCell<f32>] = d;
-            // SAFETY: `&mut self` excludes every other access; `UnsafeCell<f32>` has the
-            // layout of `f32`.
-            unsafe {
-                std::slice::from_raw_parts_mut(UnsafeCell::raw_get(cells.as_mut_ptr()), cells.len())
-            }
-        })
+    /// Exclusive access to the whole buffer (eager refits); mark what was filled with
+    /// [`LazyTiles::set_current`].
+    pub fn data_mut(&mut self) -> &mut [f32] {
+        let cells: &mut [UnsafeCell<f32>] = &mut self.data;
+        // SAFETY: `&mut self` excludes every other access; `UnsafeCell<f32>` has the layout
+        // of `f32`.
+        unsafe {
+            std::slice::from_raw_parts_mut(UnsafeCell::raw_get(cells.as_mut_ptr()), cells.len())
+        }
     }
 
-    /// Marks group `g` current (after filling it through [`LazySoa::fields_mut`]).
+    /// Marks group `g` current (after filling it through [`LazyTiles::data_mut`]).
     pub fn set_current(&mut self, g: usize) {
         *self.state[g].get_mut() = self.epoch;
     }
-
-    /// Marks every group current.
-    #[cfg(test)]
-    pub fn set_all_current(&mut self) {
-        let epoch = self.epoch;
-        for s in self.state.iter_mut() {
-            *s.get_mut() = epoch;
-        }
-    }
 }
 
-impl<const F: usize> Clone for LazySoa<F> {
+impl Clone for LazyTiles {
     /// Copies the current groups; the others are stale in the copy (their entries may be
     /// mid-fill in another thread, so they are not read).
     fn clone(&self) -> Self {
-        let len = self.len();
         let mut copy = Self {
-            data: std::array::from_fn(|_| (0..len).map(|_| UnsafeCell::new(f32::NAN)).collect()),
+            data: (0..self.len()).map(|_| UnsafeCell::new(0.0)).collect(),
             groups: self.groups.clone(),
             state: self.groups.iter().map(|_| AtomicU32::new(STALE)).collect(),
             epoch: self.epoch,
@@ -233,9 +228,7 @@ impl<const F: usize> Clone for LazySoa<F> {
         for g in 0..self.groups.len() {
             if let Some(src) = self.get(g) {
                 let range = self.range(g);
-                for (dst, src) in copy.fields_mut().into_iter().zip(src) {
-                    dst[range.clone()].copy_from_slice(src);
-                }
+                copy.data_mut()[range].copy_from_slice(src);
                 copy.set_current(g);
             }
         }
@@ -243,13 +236,12 @@ impl<const F: usize> Clone for LazySoa<F> {
     }
 }
 
-impl<const F: usize> std::fmt::Debug for LazySoa<F> {
+impl std::fmt::Debug for LazyTiles {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let current = (0..self.groups.len())
             .filter(|&g| self.is_current(g))
             .count();
-        f.debug_struct("LazySoa")
-            .field("fields", &F)
+        f.debug_struct("LazyTiles")
             .field("len", &self.len())
             .field("groups", &self.groups.len())
             .field("current", &current)
@@ -263,25 +255,22 @@ mod tests {
     use super::*;
     use rayon::prelude::*;
 
-    fn soa() -> LazySoa<2> {
-        LazySoa::new(10, [0.0, -1.0], vec![0..3, 3..4, 6..10])
+    fn tiles() -> LazyTiles {
+        LazyTiles::new(10, vec![0..3, 3..4, 6..10])
     }
 
     #[test]
     fn fills_once_per_epoch() {
-        let mut s = soa();
+        let mut s = tiles();
         let mut fills = 0;
         for epoch in 1..4 {
             for _ in 0..3 {
-                let (f, did) = s.get_or_fill(2, |r, [a, b]| {
+                let (f, _) = s.get_or_fill(2, |t| {
                     fills += 1;
-                    assert_eq!(r, 6..10);
-                    a.fill(epoch as f32);
-                    b.copy_from_slice(&[1.0, 2.0, 3.0, 4.0]);
+                    assert_eq!(t.len(), 4);
+                    t.copy_from_slice(&[epoch as f32, 2.0, 3.0, 4.0]);
                 });
-                assert_eq!(f[0], &[epoch as f32; 4]);
-                assert_eq!(f[1], &[1.0, 2.0, 3.0, 4.0]);
-                let _ = did;
+                assert_eq!(f, &[epoch as f32, 2.0, 3.0, 4.0]);
             }
             assert!(s.is_current(2) && !s.is_current(0));
             assert!(s.get(0).is_none());
@@ -293,18 +282,18 @@ mod tests {
 
     #[test]
     fn parallel_fills_happen_once_and_are_seen_whole() {
-        let s = LazySoa::<1>::new(4096, [0.0], (0..512).map(|g| g * 8..g * 8 + 8).collect());
+        let s = LazyTiles::new(4096, (0..512).map(|g| g * 8..g * 8 + 8).collect());
         let filled: usize = (0..64 * 512)
             .into_par_iter()
             .map(|k| {
                 let g = (k * 7919) % 512;
-                let (f, did) = s.get_or_fill(g, |r, [a]| {
-                    for (i, v) in r.zip(a.iter_mut()) {
-                        *v = i as f32;
+                let (f, did) = s.get_or_fill(g, |t| {
+                    for (i, v) in t.iter_mut().enumerate() {
+                        *v = (g * 8 + i) as f32;
                     }
                 });
                 let want: Vec<f32> = (g * 8..g * 8 + 8).map(|i| i as f32).collect();
-                assert_eq!(f[0], &want[..]);
+                assert_eq!(f, &want[..]);
                 did as usize
             })
             .sum();
@@ -313,42 +302,44 @@ mod tests {
 
     #[test]
     fn a_panicking_fill_leaves_the_group_stale() {
-        let s = soa();
+        let s = tiles();
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            s.get_or_fill(0, |_, _| panic!("boom"));
+            s.get_or_fill(0, |_| panic!("boom"));
         }));
         assert!(r.is_err());
         assert!(!s.is_current(0));
-        let (f, did) = s.get_or_fill(0, |_, [a, _]| a.fill(5.0));
+        let (f, did) = s.get_or_fill(0, |t| t.fill(5.0));
         assert!(did);
-        assert_eq!(f[0], &[5.0; 3]);
+        assert_eq!(f, &[5.0; 3]);
     }
 
     #[test]
     fn clone_copies_current_groups_only() {
-        let s = soa();
-        s.get_or_fill(1, |_, [a, _]| a.fill(9.0));
+        let s = tiles();
+        s.get_or_fill(1, |t| t.fill(9.0));
         let c = s.clone();
-        assert_eq!(c.get(1).unwrap()[0], &[9.0]);
+        assert_eq!(c.get(1).unwrap(), &[9.0]);
         assert!(c.get(0).is_none());
     }
 
     #[test]
     fn epoch_wrap_keeps_states_consistent() {
-        let mut s = soa();
+        let mut s = tiles();
         s.epoch = BUSY - 2;
-        s.get_or_fill(0, |_, [a, _]| a.fill(1.0));
+        s.get_or_fill(0, |t| t.fill(1.0));
         s.invalidate(); // BUSY - 1
         s.invalidate(); // wraps to 1, every state reset
         assert_eq!(s.epoch, 1);
         assert!((0..3).all(|g| !s.is_current(g)));
-        s.set_all_current();
+        for g in 0..3 {
+            s.set_current(g);
+        }
         assert!((0..3).all(|g| s.is_current(g)));
     }
 
     #[test]
     #[should_panic(expected = "overlap")]
     fn overlapping_groups_are_refused() {
-        LazySoa::<1>::new(10, [0.0], vec![0..5, 4..6]);
+        LazyTiles::new(10, vec![0..5, 4..6]);
     }
 }

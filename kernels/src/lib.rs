@@ -189,6 +189,46 @@ pub(crate) mod lanes {
     }
 }
 
+/// Fields stored side by side in one slice: field `f` is `data[f * stride..(f + 1) *
+/// stride]`. The layout of every block the kernels read (a node's children, a leaf's
+/// triangles): one contiguous tile, so a block is two words to pass and a few cache lines to
+/// load.
+#[derive(Clone, Copy, Debug)]
+pub struct Tile<'a> {
+    data: &'a [f32],
+    stride: usize,
+}
+
+impl<'a> Tile<'a> {
+    /// A tile of `data.len() / stride` fields. Panics if `stride` is zero or does not divide
+    /// the length.
+    pub fn new(data: &'a [f32], stride: usize) -> Self {
+        assert!(
+            stride > 0 && data.len().is_multiple_of(stride),
+            "Tile: the length must be a multiple of the stride"
+        );
+        Self { data, stride }
+    }
+
+    /// Entries per field.
+    #[inline(always)]
+    pub fn stride(&self) -> usize {
+        self.stride
+    }
+
+    /// Number of fields.
+    #[inline(always)]
+    pub fn fields(&self) -> usize {
+        self.data.len() / self.stride
+    }
+
+    /// Field `f`.
+    #[inline(always)]
+    pub fn field(&self, f: usize) -> &'a [f32] {
+        &self.data[f * self.stride..(f + 1) * self.stride]
+    }
+}
+
 /// Points (or centres) in structure-of-arrays form: `x[i], y[i], z[i]` is point `i`.
 #[derive(Clone, Copy, Debug)]
 pub struct Soa3<'a> {

@@ -30,6 +30,7 @@
 //! order, no fused multiply-add).
 
 use crate::lanes::{load_prefix, load_prefix_u32, mask_bits};
+use crate::Tile;
 use pulp::{Simd, WithSimd};
 
 /// Largest second block: the bits of one row.
@@ -40,22 +41,59 @@ pub const PLANE_ERR: f32 = 8.0 * (f32::EPSILON / 2.0);
 /// The absolute factor for gradual underflow: `2^-147` (a subnormal).
 pub const PLANE_TINY: f32 = f32::from_bits(4);
 
-/// Triangles in structure-of-arrays form: `corner[c][k][t]` is coordinate `k` of corner `c`
-/// of triangle `t`, `lo`/`hi` its closed box, `vertex[c][t]` its corner indices (used by
-/// the self pairings only). All slices of equal length (padding allowed past the tested
-/// count).
+/// Triangles in structure-of-arrays form: a [`Tile`] of fifteen fields (coordinate `k` of
+/// corner `c` is field `3c + k`, then the closed box: min x, y, z, max x, y, z) and a tile of
+/// their three corner indices (used by the self pairings only), from entry `offset` on.
+/// Padding past the tested count is allowed.
 #[derive(Clone, Copy, Debug)]
 pub struct TriSoa<'a> {
-    pub corner: [[&'a [f32]; 3]; 3],
-    pub lo: [&'a [f32]; 3],
-    pub hi: [&'a [f32]; 3],
-    pub vertex: [&'a [u32]; 3],
+    tile: Tile<'a>,
+    vertex: &'a [u32],
+    offset: usize,
 }
 
 impl<'a> TriSoa<'a> {
+    /// Panics unless `tile` has 15 fields and `vertex` 3 fields of the same stride.
+    pub fn new(tile: Tile<'a>, vertex: &'a [u32]) -> Self {
+        assert_eq!(
+            tile.fields(),
+            15,
+            "TriSoa: 9 corner coordinates, 6 box bounds"
+        );
+        assert_eq!(vertex.len(), 3 * tile.stride(), "TriSoa: 3 corner indices");
+        Self {
+            tile,
+            vertex,
+            offset: 0,
+        }
+    }
+
+    /// Coordinate `k` of corner `c`.
+    #[inline(always)]
+    pub fn corner(&self, c: usize, k: usize) -> &'a [f32] {
+        &self.tile.field(3 * c + k)[self.offset..]
+    }
+    /// Box min along `k`.
+    #[inline(always)]
+    pub fn lo(&self, k: usize) -> &'a [f32] {
+        &self.tile.field(9 + k)[self.offset..]
+    }
+    /// Box max along `k`.
+    #[inline(always)]
+    pub fn hi(&self, k: usize) -> &'a [f32] {
+        &self.tile.field(12 + k)[self.offset..]
+    }
+    /// Corner `c`'s vertex index.
+    #[inline(always)]
+    pub fn vertex(&self, c: usize) -> &'a [u32] {
+        let s = self.tile.stride();
+        &self.vertex[c * s + self.offset..(c + 1) * s]
+    }
+
+    /// Entries from the offset on.
     #[inline(always)]
     pub fn len(&self) -> usize {
-        self.lo[0].len()
+        self.tile.stride() - self.offset
     }
 
     #[inline(always)]
@@ -66,32 +104,21 @@ impl<'a> TriSoa<'a> {
     /// Triangle `t`'s corners.
     #[inline(always)]
     pub fn corners(&self, t: usize) -> [[f32; 3]; 3] {
-        let c = &self.corner;
+        let c = |c: usize, k: usize| self.corner(c, k)[t];
         [
-            [c[0][0][t], c[0][1][t], c[0][2][t]],
-            [c[1][0][t], c[1][1][t], c[1][2][t]],
-            [c[2][0][t], c[2][1][t], c[2][2][t]],
+            [c(0, 0), c(0, 1), c(0, 2)],
+            [c(1, 0), c(1, 1), c(1, 2)],
+            [c(2, 0), c(2, 1), c(2, 2)],
         ]
     }
 
-    /// Triangles `range`.
+    /// The triangles from `start` on.
     #[inline(always)]
-    pub fn slice(&self, range: core::ops::Range<usize>) -> TriSoa<'a> {
-        let r = || range.clone();
-        let c = &self.corner;
+    pub fn skip(&self, start: usize) -> TriSoa<'a> {
+        assert!(start <= self.len());
         TriSoa {
-            corner: [
-                [&c[0][0][r()], &c[0][1][r()], &c[0][2][r()]],
-                [&c[1][0][r()], &c[1][1][r()], &c[1][2][r()]],
-                [&c[2][0][r()], &c[2][1][r()], &c[2][2][r()]],
-            ],
-            lo: [&self.lo[0][r()], &self.lo[1][r()], &self.lo[2][r()]],
-            hi: [&self.hi[0][r()], &self.hi[1][r()], &self.hi[2][r()]],
-            vertex: [
-                &self.vertex[0][r()],
-                &self.vertex[1][r()],
-                &self.vertex[2][r()],
-            ],
+            offset: self.offset + start,
+            ..*self
         }
     }
 }
@@ -182,17 +209,17 @@ pub fn leaf_candidates_scalar(
     let mut counted = 0;
     for i in 0..na {
         let ta = a.corners(i);
-        let va = [a.vertex[0][i], a.vertex[1][i], a.vertex[2][i]];
+        let va = [a.vertex(0)[i], a.vertex(1)[i], a.vertex(2)[i]];
         let mut row = 0;
         for j in 0..nb {
             if pairing == Pairing::NoSharedVertexUpper && j <= i {
                 continue;
             }
-            if pairing != Pairing::All && (0..3).any(|c| va.contains(&b.vertex[c][j])) {
+            if pairing != Pairing::All && (0..3).any(|c| va.contains(&b.vertex(c)[j])) {
                 continue;
             }
             counted += 1;
-            let boxes = (0..3).all(|k| a.lo[k][i] <= b.hi[k][j] && b.lo[k][j] <= a.hi[k][i]);
+            let boxes = (0..3).all(|k| a.lo(k)[i] <= b.hi(k)[j] && b.lo(k)[j] <= a.hi(k)[i]);
             if boxes && !plane_separated(&ta, &b.corners(j)) {
                 row |= 1 << j;
             }
@@ -305,10 +332,10 @@ pub fn leaf_candidates_with<S: Simd>(
         let mut bhi = [zero; 3];
         let mut bc = [[zero; 3]; 3];
         for k in 0..3 {
-            blo[k] = load_prefix(simd, &b.lo[k][base..end]);
-            bhi[k] = load_prefix(simd, &b.hi[k][base..end]);
+            blo[k] = load_prefix(simd, &b.lo(k)[base..end]);
+            bhi[k] = load_prefix(simd, &b.hi(k)[base..end]);
             for c in 0..3 {
-                bc[c][k] = load_prefix(simd, &b.corner[c][k][base..end]);
+                bc[c][k] = load_prefix(simd, &b.corner(c, k)[base..end]);
             }
         }
         let (bn, bm) = plane_simd(simd, &bc);
@@ -316,9 +343,9 @@ pub fn leaf_candidates_with<S: Simd>(
             None
         } else {
             Some([
-                load_prefix_u32(simd, &b.vertex[0][base..end]),
-                load_prefix_u32(simd, &b.vertex[1][base..end]),
-                load_prefix_u32(simd, &b.vertex[2][base..end]),
+                load_prefix_u32(simd, &b.vertex(0)[base..end]),
+                load_prefix_u32(simd, &b.vertex(1)[base..end]),
+                load_prefix_u32(simd, &b.vertex(2)[base..end]),
             ])
         };
         for i in 0..na {
@@ -330,26 +357,26 @@ pub fn leaf_candidates_with<S: Simd>(
             if valid == 0 {
                 continue;
             }
-            let mut hit = simd.less_than_or_equal_f32s(simd.splat_f32s(a.lo[0][i]), bhi[0]);
+            let mut hit = simd.less_than_or_equal_f32s(simd.splat_f32s(a.lo(0)[i]), bhi[0]);
             hit = simd.and_m32s(
                 hit,
-                simd.less_than_or_equal_f32s(blo[0], simd.splat_f32s(a.hi[0][i])),
+                simd.less_than_or_equal_f32s(blo[0], simd.splat_f32s(a.hi(0)[i])),
             );
             for k in 1..3 {
                 hit = simd.and_m32s(
                     hit,
-                    simd.less_than_or_equal_f32s(simd.splat_f32s(a.lo[k][i]), bhi[k]),
+                    simd.less_than_or_equal_f32s(simd.splat_f32s(a.lo(k)[i]), bhi[k]),
                 );
                 hit = simd.and_m32s(
                     hit,
-                    simd.less_than_or_equal_f32s(blo[k], simd.splat_f32s(a.hi[k][i])),
+                    simd.less_than_or_equal_f32s(blo[k], simd.splat_f32s(a.hi(k)[i])),
                 );
             }
             let mut bits = u64::from(mask_bits(simd, hit)) & valid;
             if let Some(bv) = &bv {
-                let mut share = simd.equal_u32s(simd.splat_u32s(a.vertex[0][i]), bv[0]);
+                let mut share = simd.equal_u32s(simd.splat_u32s(a.vertex(0)[i]), bv[0]);
                 for k in 0..3 {
-                    let v = simd.splat_u32s(a.vertex[k][i]);
+                    let v = simd.splat_u32s(a.vertex(k)[i]);
                     for (c, w) in bv.iter().enumerate() {
                         if k != 0 || c != 0 {
                             share = simd.or_m32s(share, simd.equal_u32s(v, *w));

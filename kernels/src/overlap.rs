@@ -15,90 +15,102 @@
 //! probe or an entry makes the pair not overlap, on every backend.
 
 use crate::lanes::{load_prefix, mask_bits};
+use crate::Tile;
 use pulp::{Simd, WithSimd};
 
 /// Largest block: the bits of the mask.
 pub const MAX_BLOCK: usize = 32;
 
-/// Spheres (the SBV hierarchy; DH nodes with their staged centres) in SoA form.
+/// Spheres (the SBV hierarchy; DH nodes with their staged centres): a [`Tile`] of four
+/// fields, centre x, y, z and radius.
 #[derive(Clone, Copy, Debug)]
 pub struct SphereSoa<'a> {
-    pub cx: &'a [f32],
-    pub cy: &'a [f32],
-    pub cz: &'a [f32],
-    pub r: &'a [f32],
+    tile: Tile<'a>,
 }
 
 impl<'a> SphereSoa<'a> {
-    /// Entries `range` of the block.
-    #[inline(always)]
-    pub fn slice(&self, range: core::ops::Range<usize>) -> SphereSoa<'a> {
-        SphereSoa {
-            cx: &self.cx[range.clone()],
-            cy: &self.cy[range.clone()],
-            cz: &self.cz[range.clone()],
-            r: &self.r[range],
-        }
+    /// Panics unless `tile` has four fields.
+    pub fn new(tile: Tile<'a>) -> Self {
+        assert_eq!(tile.fields(), 4, "SphereSoa: cx, cy, cz, r");
+        Self { tile }
     }
 
     #[inline(always)]
+    pub fn cx(&self) -> &'a [f32] {
+        self.tile.field(0)
+    }
+    #[inline(always)]
+    pub fn cy(&self) -> &'a [f32] {
+        self.tile.field(1)
+    }
+    #[inline(always)]
+    pub fn cz(&self) -> &'a [f32] {
+        self.tile.field(2)
+    }
+    #[inline(always)]
+    pub fn r(&self) -> &'a [f32] {
+        self.tile.field(3)
+    }
+
+    /// Entries per field.
+    #[inline(always)]
     pub fn len(&self) -> usize {
-        self.cx.len()
+        self.tile.stride()
     }
 
     #[inline(always)]
     pub fn is_empty(&self) -> bool {
-        self.cx.is_empty()
+        self.len() == 0
     }
 
     /// Entry `k` as `(centre, radius)`.
     #[inline(always)]
     pub fn get(&self, k: usize) -> ([f32; 3], f32) {
-        ([self.cx[k], self.cy[k], self.cz[k]], self.r[k])
+        ([self.cx()[k], self.cy()[k], self.cz()[k]], self.r()[k])
     }
 }
 
-/// Axis-aligned boxes in SoA form.
+/// Axis-aligned boxes: a [`Tile`] of six fields, min x, y, z and max x, y, z.
 #[derive(Clone, Copy, Debug)]
 pub struct AabbSoa<'a> {
-    pub min_x: &'a [f32],
-    pub min_y: &'a [f32],
-    pub min_z: &'a [f32],
-    pub max_x: &'a [f32],
-    pub max_y: &'a [f32],
-    pub max_z: &'a [f32],
+    tile: Tile<'a>,
 }
 
 impl<'a> AabbSoa<'a> {
-    /// Entries `range` of the block.
-    #[inline(always)]
-    pub fn slice(&self, range: core::ops::Range<usize>) -> AabbSoa<'a> {
-        AabbSoa {
-            min_x: &self.min_x[range.clone()],
-            min_y: &self.min_y[range.clone()],
-            min_z: &self.min_z[range.clone()],
-            max_x: &self.max_x[range.clone()],
-            max_y: &self.max_y[range.clone()],
-            max_z: &self.max_z[range],
-        }
+    /// Panics unless `tile` has six fields.
+    pub fn new(tile: Tile<'a>) -> Self {
+        assert_eq!(tile.fields(), 6, "AabbSoa: min xyz, max xyz");
+        Self { tile }
     }
 
+    /// Min (`k` = 0, 1, 2) of every box.
+    #[inline(always)]
+    pub fn min(&self, k: usize) -> &'a [f32] {
+        self.tile.field(k)
+    }
+    /// Max (`k` = 0, 1, 2) of every box.
+    #[inline(always)]
+    pub fn max(&self, k: usize) -> &'a [f32] {
+        self.tile.field(3 + k)
+    }
+
+    /// Entries per field.
     #[inline(always)]
     pub fn len(&self) -> usize {
-        self.min_x.len()
+        self.tile.stride()
     }
 
     #[inline(always)]
     pub fn is_empty(&self) -> bool {
-        self.min_x.is_empty()
+        self.len() == 0
     }
 
     /// Entry `k` as `(min, max)`.
     #[inline(always)]
     pub fn get(&self, k: usize) -> ([f32; 3], [f32; 3]) {
         (
-            [self.min_x[k], self.min_y[k], self.min_z[k]],
-            [self.max_x[k], self.max_y[k], self.max_z[k]],
+            [self.min(0)[k], self.min(1)[k], self.min(2)[k]],
+            [self.max(0)[k], self.max(1)[k], self.max(2)[k]],
         )
     }
 }
@@ -178,7 +190,7 @@ impl WithSimd for SphereBlock<'_> {
 #[inline(always)]
 pub fn sphere_block_with<S: Simd>(simd: S, c: [f32; 3], r: f32, b: SphereSoa, n: usize) -> u32 {
     let len = block_len(b.len(), n);
-    let (cy, cz, rr) = (&b.cy[..len], &b.cz[..len], &b.r[..len]);
+    let (cx, cy, cz, rr) = (b.cx(), b.cy(), b.cz(), b.r());
     let (px, py, pz, pr) = (
         simd.splat_f32s(c[0]),
         simd.splat_f32s(c[1]),
@@ -189,7 +201,7 @@ pub fn sphere_block_with<S: Simd>(simd: S, c: [f32; 3], r: f32, b: SphereSoa, n:
     let mut base = 0;
     while base < n {
         let end = (base + S::F32_LANES).min(len);
-        let dx = simd.sub_f32s(px, load_prefix(simd, &b.cx[base..end]));
+        let dx = simd.sub_f32s(px, load_prefix(simd, &cx[base..end]));
         let dy = simd.sub_f32s(py, load_prefix(simd, &cy[base..end]));
         let dz = simd.sub_f32s(pz, load_prefix(simd, &cz[base..end]));
         let d2 = simd.add_f32s(
@@ -242,8 +254,8 @@ impl WithSimd for AabbBlock<'_> {
 #[inline(always)]
 pub fn aabb_block_with<S: Simd>(simd: S, lo: [f32; 3], hi: [f32; 3], b: AabbSoa, n: usize) -> u32 {
     let len = block_len(b.len(), n);
-    let mins = [&b.min_x[..len], &b.min_y[..len], &b.min_z[..len]];
-    let maxs = [&b.max_x[..len], &b.max_y[..len], &b.max_z[..len]];
+    let mins = [b.min(0), b.min(1), b.min(2)];
+    let maxs = [b.max(0), b.max(1), b.max(2)];
     // No closures in SIMD bodies: they may be compiled without the dispatched target
     // features and turn every intrinsic into a call.
     let plo = [

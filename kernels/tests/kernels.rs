@@ -8,7 +8,7 @@ use dhcd_kernels::narrow;
 use dhcd_kernels::overlap::{self, AabbSoa, SphereSoa};
 use dhcd_kernels::pulp::{self, Simd, WithSimd};
 use dhcd_kernels::refit;
-use dhcd_kernels::Soa3;
+use dhcd_kernels::{Soa3, Tile};
 
 /// xorshift64*: small, deterministic, good enough for test data.
 struct Rng(u64);
@@ -139,13 +139,30 @@ fn spheres(rng: &mut Rng, n: usize, every: usize) -> [Vec<f32>; 4] {
     ]
 }
 
-fn sphere_soa(s: &[Vec<f32>; 4]) -> SphereSoa<'_> {
-    SphereSoa {
-        cx: &s[0],
-        cy: &s[1],
-        cz: &s[2],
-        r: &s[3],
+/// Fields of equal length concatenated into one tile (stride at least 1: empty fields are
+/// padded with one NaN).
+struct Owned {
+    data: Vec<f32>,
+    stride: usize,
+}
+
+impl Owned {
+    fn sphere(&self) -> SphereSoa<'_> {
+        SphereSoa::new(Tile::new(&self.data, self.stride))
     }
+    fn aabb(&self) -> AabbSoa<'_> {
+        AabbSoa::new(Tile::new(&self.data, self.stride))
+    }
+}
+
+fn tile<const K: usize>(fields: &[Vec<f32>; K]) -> Owned {
+    let stride = fields[0].len().max(1);
+    let mut data = Vec::with_capacity(K * stride);
+    for (k, f) in fields.iter().enumerate() {
+        data.extend_from_slice(f);
+        data.resize((k + 1) * stride, f32::NAN);
+    }
+    Owned { data, stride }
 }
 
 fn boxes(rng: &mut Rng, n: usize, every: usize) -> [Vec<f32>; 6] {
@@ -160,17 +177,6 @@ fn boxes(rng: &mut Rng, n: usize, every: usize) -> [Vec<f32>; 6] {
         lo[1].iter().zip(&ext[1]).map(|(a, e)| a + e).collect(),
         lo[2].iter().zip(&ext[2]).map(|(a, e)| a + e).collect(),
     ]
-}
-
-fn aabb_soa(b: &[Vec<f32>; 6]) -> AabbSoa<'_> {
-    AabbSoa {
-        min_x: &b[0],
-        min_y: &b[1],
-        min_z: &b[2],
-        max_x: &b[3],
-        max_y: &b[4],
-        max_z: &b[5],
-    }
 }
 
 /// Block sizes: 0, 1, lanes - 1, lanes, lanes + 1, and the largest block.
@@ -204,17 +210,17 @@ fn check_blocks<S: Simd>(simd: S) {
             ] {
                 let s = spheres(&mut rng, len, every);
                 let probe = spheres(&mut rng, 1, every);
-                let (c, r) = sphere_soa(&probe).get(0);
-                let want = overlap::sphere_block_scalar(c, r, sphere_soa(&s), n);
-                let got = overlap::sphere_block_with(simd, c, r, sphere_soa(&s), n);
+                let (c, r) = tile(&probe).sphere().get(0);
+                let want = overlap::sphere_block_scalar(c, r, tile(&s).sphere(), n);
+                let got = overlap::sphere_block_with(simd, c, r, tile(&s).sphere(), n);
                 assert_eq!(got, want, "{simd:?} sphere n={n} len={len} every={every}");
                 assert_eq!(u64::from(got) >> n, 0, "bits past n");
 
                 let b = boxes(&mut rng, len, every);
                 let p = boxes(&mut rng, 1, every);
-                let (lo, hi) = aabb_soa(&p).get(0);
-                let want = overlap::aabb_block_scalar(lo, hi, aabb_soa(&b), n);
-                let got = overlap::aabb_block_with(simd, lo, hi, aabb_soa(&b), n);
+                let (lo, hi) = tile(&p).aabb().get(0);
+                let want = overlap::aabb_block_scalar(lo, hi, tile(&b).aabb(), n);
+                let got = overlap::aabb_block_with(simd, lo, hi, tile(&b).aabb(), n);
                 assert_eq!(got, want, "{simd:?} aabb n={n} len={len} every={every}");
                 assert_eq!(u64::from(got) >> n, 0, "bits past n");
             }
@@ -235,16 +241,16 @@ fn dispatched_blocks_match_reference() {
         let b = boxes(&mut rng, n, 4);
         for _ in 0..20 {
             let probe = spheres(&mut rng, 1, 0);
-            let (c, r) = sphere_soa(&probe).get(0);
+            let (c, r) = tile(&probe).sphere().get(0);
             assert_eq!(
-                overlap::sphere_block(c, r, sphere_soa(&s), n),
-                overlap::sphere_block_scalar(c, r, sphere_soa(&s), n)
+                overlap::sphere_block(c, r, tile(&s).sphere(), n),
+                overlap::sphere_block_scalar(c, r, tile(&s).sphere(), n)
             );
             let p = boxes(&mut rng, 1, 0);
-            let (lo, hi) = aabb_soa(&p).get(0);
+            let (lo, hi) = tile(&p).aabb().get(0);
             assert_eq!(
-                overlap::aabb_block(lo, hi, aabb_soa(&b), n),
-                overlap::aabb_block_scalar(lo, hi, aabb_soa(&b), n)
+                overlap::aabb_block(lo, hi, tile(&b).aabb(), n),
+                overlap::aabb_block_scalar(lo, hi, tile(&b).aabb(), n)
             );
         }
     }
@@ -288,7 +294,7 @@ fn check_block_special_values<S: Simd>(simd: S) {
                     s[k][pos] = cb[k];
                 }
                 s[3][pos] = rb;
-                let got = overlap::sphere_block_with(simd, ca, ra, sphere_soa(&s), n);
+                let got = overlap::sphere_block_with(simd, ca, ra, tile(&s).sphere(), n);
                 assert_eq!(
                     got,
                     (want as u32) << pos,
@@ -305,7 +311,7 @@ fn check_block_special_values<S: Simd>(simd: S) {
                     t[k][pos] = ca[k];
                 }
                 t[3][pos] = ra;
-                let got = overlap::sphere_block_with(simd, cb, rb, sphere_soa(&t), n);
+                let got = overlap::sphere_block_with(simd, cb, rb, tile(&t).sphere(), n);
                 assert_eq!(
                     got,
                     (want as u32) << pos,
@@ -342,7 +348,7 @@ fn check_block_special_values<S: Simd>(simd: S) {
                     b[3 + k][pos] = bb.1[k];
                 }
                 if n <= overlap::MAX_BLOCK {
-                    let got = overlap::aabb_block_with(simd, ba.0, ba.1, aabb_soa(&b), n);
+                    let got = overlap::aabb_block_with(simd, ba.0, ba.1, tile(&b).aabb(), n);
                     assert_eq!(got, (want as u32) << pos, "{simd:?} box case {ci} n={n}");
                 }
                 // As triangles: the degenerate triangle (lo, hi, lo) has exactly this box
@@ -381,63 +387,50 @@ fn block_special_values_on_all_backends() {
 #[test]
 #[should_panic(expected = "at most 32")]
 fn oversized_block_is_refused() {
-    let v = vec![0.0; 33];
-    overlap::sphere_block(
-        [0.0; 3],
-        1.0,
-        SphereSoa {
-            cx: &v,
-            cy: &v,
-            cz: &v,
-            r: &v,
-        },
-        33,
-    );
+    let v = vec![0.0; 4 * 33];
+    overlap::sphere_block([0.0; 3], 1.0, SphereSoa::new(Tile::new(&v, 33)), 33);
 }
 
 // ---------------------------------------------------------------------------------------
 // narrow: leaf candidates
 
-/// Triangles in SoA form with corner indices `first + 3t, first + 3t + 1, first + 3t + 2`.
+/// Triangles in SoA form (a tile of 15 fields, stride at least 1) with corner indices
+/// `first + 3t, first + 3t + 1, first + 3t + 2`.
 struct Tris {
-    corner: [[Vec<f32>; 3]; 3],
-    lo: [Vec<f32>; 3],
-    hi: [Vec<f32>; 3],
-    vertex: [Vec<u32>; 3],
+    tile: Vec<f32>,
+    vertex: Vec<u32>,
+    stride: usize,
 }
 
 impl Tris {
     fn new(tris: &[[[f32; 3]; 3]], first: u32) -> Self {
-        let n = tris.len() as u32;
+        let stride = tris.len().max(1);
+        let mut tile = vec![f32::NAN; 15 * stride];
+        let mut vertex = vec![u32::MAX; 3 * stride];
+        for (t, tri) in tris.iter().enumerate() {
+            for c in 0..3 {
+                for k in 0..3 {
+                    tile[(3 * c + k) * stride + t] = tri[c][k];
+                }
+                vertex[c * stride + t] = first + 3 * t as u32 + c as u32;
+            }
+            for k in 0..3 {
+                tile[(9 + k) * stride + t] = tri[0][k].min(tri[1][k]).min(tri[2][k]);
+                tile[(12 + k) * stride + t] = tri[0][k].max(tri[1][k]).max(tri[2][k]);
+            }
+        }
         Tris {
-            corner: std::array::from_fn(|c| {
-                std::array::from_fn(|k| tris.iter().map(|t| t[c][k]).collect())
-            }),
-            lo: std::array::from_fn(|k| {
-                tris.iter()
-                    .map(|t| t[0][k].min(t[1][k]).min(t[2][k]))
-                    .collect()
-            }),
-            hi: std::array::from_fn(|k| {
-                tris.iter()
-                    .map(|t| t[0][k].max(t[1][k]).max(t[2][k]))
-                    .collect()
-            }),
-            vertex: std::array::from_fn(|c| (0..n).map(|t| first + 3 * t + c as u32).collect()),
+            tile,
+            vertex,
+            stride,
         }
     }
     fn soa(&self) -> narrow::TriSoa<'_> {
-        let c = &self.corner;
-        narrow::TriSoa {
-            corner: std::array::from_fn(|i| std::array::from_fn(|k| &c[i][k][..])),
-            lo: [&self.lo[0][..], &self.lo[1][..], &self.lo[2][..]],
-            hi: [&self.hi[0][..], &self.hi[1][..], &self.hi[2][..]],
-            vertex: [
-                &self.vertex[0][..],
-                &self.vertex[1][..],
-                &self.vertex[2][..],
-            ],
-        }
+        narrow::TriSoa::new(Tile::new(&self.tile, self.stride), &self.vertex)
+    }
+    /// Sets corner `c`'s index of triangle `t`.
+    fn set_vertex(&mut self, c: usize, t: usize, v: u32) {
+        self.vertex[c * self.stride + t] = v;
     }
 }
 
@@ -592,7 +585,7 @@ fn leaf_candidates_count_allowed_pairs() {
         .collect();
     let a = Tris::new(&tris, 0);
     let mut shared = Tris::new(&tris, 0);
-    shared.vertex[1][3] = 0; // triangle 3 of b shares vertex 0 with triangle 0 of a
+    shared.set_vertex(1, 3, 0); // triangle 3 of b shares vertex 0 with triangle 0 of a
     let mut out = [0u64; 10];
     assert_eq!(
         narrow::leaf_candidates(a.soa(), 10, a.soa(), 10, narrow::Pairing::All, &mut out),

@@ -1,9 +1,8 @@
 //! Axis-aligned bounding boxes: min/max over the region's vertices (exact in f32).
 
-use super::{group_buffers, refit_groups, sealed, slot, BvKind, Method};
+use super::{sealed, Bounds, BvKind, Method};
 use crate::points::Points;
 use crate::tree::RegionTree;
-use dhcd_kernels::lazy::LazySoa;
 use dhcd_kernels::{overlap, refit};
 
 /// The box node record: min and max corners — 24 bytes.
@@ -16,10 +15,10 @@ pub struct AabbNode {
 const _: () = assert!(std::mem::size_of::<AabbNode>() == 24);
 
 /// Box nodes, structure-of-arrays: `[min_x, min_y, min_z, max_x, max_y, max_z]`, fitted
-/// lazily per sibling group. Unfitted entries are empty boxes (min = +inf, max = -inf).
+/// lazily per sibling group.
 #[derive(Clone, Debug)]
 pub struct AabbNodes {
-    fitted: LazySoa<6>,
+    fitted: Bounds<6>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -27,11 +26,8 @@ pub struct Aabb;
 impl sealed::Sealed for Aabb {}
 
 #[inline]
-fn write(fields: &mut [&mut [f32]; 6], i: usize, r: AabbNode) {
-    for k in 0..3 {
-        fields[k][i] = r.min[k];
-        fields[3 + k][i] = r.max[k];
-    }
+fn fields(r: AabbNode) -> [f32; 6] {
+    [r.min[0], r.min[1], r.min[2], r.max[0], r.max[1], r.max[2]]
 }
 
 fn fit_node(tree: &RegionTree, p: &Points, n: usize) -> AabbNode {
@@ -49,9 +45,8 @@ impl BvKind for Aabb {
     type Block<'a> = overlap::AabbSoa<'a>;
 
     fn build(tree: &RegionTree, rest: &Points) -> AabbNodes {
-        let (inf, ninf) = (f32::INFINITY, f32::NEG_INFINITY);
         let mut nodes = AabbNodes {
-            fitted: group_buffers(tree, [inf, inf, inf, ninf, ninf, ninf]),
+            fitted: Bounds::new(tree),
         };
         Aabb::refit_all(&mut nodes, tree, rest, false);
         nodes
@@ -64,23 +59,10 @@ impl BvKind for Aabb {
         p: &Points,
         g: usize,
     ) -> (overlap::AabbSoa<'a>, bool) {
-        let (f, fitted) = nodes.fitted.get_or_fill(g, |_, mut fields| {
-            for (i, n) in tree.group_nodes(g).enumerate() {
-                write(&mut fields, i, fit_node(tree, p, n));
-            }
-        });
-        let [min_x, min_y, min_z, max_x, max_y, max_z] = f;
-        (
-            overlap::AabbSoa {
-                min_x,
-                min_y,
-                min_z,
-                max_x,
-                max_y,
-                max_z,
-            },
-            fitted,
-        )
+        let (tile, fitted) = nodes
+            .fitted
+            .group(tree, g, |n| fields(fit_node(tree, p, n)));
+        (overlap::AabbSoa::new(tile), fitted)
     }
 
     #[inline]
@@ -103,7 +85,7 @@ impl BvKind for Aabb {
     /// Half the box's perimeter (sum of the extents).
     #[inline(always)]
     fn extent(a: overlap::AabbSoa<'_>, i: usize) -> f32 {
-        (a.max_x[i] - a.min_x[i]) + (a.max_y[i] - a.min_y[i]) + (a.max_z[i] - a.min_z[i])
+        (a.max(0)[i] - a.min(0)[i]) + (a.max(1)[i] - a.min(1)[i]) + (a.max(2)[i] - a.min(2)[i])
     }
 
     fn fit(_: &AabbNodes, tree: &RegionTree, p: &Points, n: usize) -> AabbNode {
@@ -111,12 +93,10 @@ impl BvKind for Aabb {
     }
 
     fn record(nodes: &AabbNodes, tree: &RegionTree, n: usize) -> Option<AabbNode> {
-        let g = tree.group_of(n);
-        let f = nodes.fitted.get(g)?;
-        let i = n - tree.group_nodes(g).start;
+        let f = nodes.fitted.get(tree, n)?;
         Some(AabbNode {
-            min: [f[0][i], f[1][i], f[2][i]],
-            max: [f[3][i], f[4][i], f[5][i]],
+            min: [f[0], f[1], f[2]],
+            max: [f[3], f[4], f[5]],
         })
     }
 
@@ -125,19 +105,17 @@ impl BvKind for Aabb {
     }
 
     fn refit_all(nodes: &mut AabbNodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64 {
-        refit_groups(&mut nodes.fitted, tree, |f, n, s| {
-            let r = if bottom_up && !tree.is_leaf(n) {
+        nodes.fitted.refit_all(tree, |n, child| {
+            if bottom_up && !tree.is_leaf(n) {
                 let mut b = refit::EMPTY_BOUNDS;
                 for c in tree.children(n) {
-                    let c = slot(tree, c);
-                    let child = ([f[0][c], f[1][c], f[2][c]], [f[3][c], f[4][c], f[5][c]]);
-                    b = refit::merge_bounds(b, child);
+                    let f = child(c);
+                    b = refit::merge_bounds(b, ([f[0], f[1], f[2]], [f[3], f[4], f[5]]));
                 }
-                AabbNode { min: b.0, max: b.1 }
+                fields(AabbNode { min: b.0, max: b.1 })
             } else {
-                fit_node(tree, p, n)
-            };
-            write(f, s, r);
+                fields(fit_node(tree, p, n))
+            }
         })
     }
 

@@ -2,11 +2,10 @@
 //! (the central vertex, fixed at build) whose radius is refitted after deformation. The
 //! centre moves with the mesh for free; only the radius is ever recomputed.
 
-use super::{conservative_radius, conservative_sum, dist2_f64, group_buffers, refit_groups, slot};
+use super::{conservative_radius, conservative_sum, dist2_f64, Bounds};
 use super::{sealed, BvKind, Method};
 use crate::points::Points;
 use crate::tree::RegionTree;
-use dhcd_kernels::lazy::LazySoa;
 use dhcd_kernels::{overlap, refit};
 
 /// The DH node record: central vertex (internal index) and radius — 8 bytes.
@@ -21,7 +20,7 @@ const _: () = assert!(std::mem::size_of::<DhNode>() == 8);
 /// DH nodes, structure-of-arrays: the central vertices (fixed at build) and, per step, the
 /// radii.
 ///
-/// The lazily fitted buffers also hold a staging copy of each fitted node's centre (the live
+/// The lazily fitted tiles also hold a staging copy of each fitted node's centre (the live
 /// position of its central vertex), written when the node is fitted (positions do not change
 /// within a step), so the wide test reads contiguous arrays instead of chasing `vertex[n]`
 /// into the positions. It is scratch, not part of the 8-byte record; the test is bit for bit
@@ -30,25 +29,18 @@ const _: () = assert!(std::mem::size_of::<DhNode>() == 8);
 pub struct DhNodes {
     pub vertex: Vec<u32>,
     /// `[cx, cy, cz, radius]` per node.
-    fitted: LazySoa<4>,
+    fitted: Bounds<4>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Dh;
 impl sealed::Sealed for Dh {}
 
-/// Writes node `n`'s staged centre and radius.
-#[inline]
-fn write(fields: &mut [&mut [f32]; 4], i: usize, centre: [f32; 3], radius: f32) {
-    fields[0][i] = centre[0];
-    fields[1][i] = centre[1];
-    fields[2][i] = centre[2];
-    fields[3][i] = radius;
-}
-
-fn sphere_soa<'a>(f: [&'a [f32]; 4]) -> overlap::SphereSoa<'a> {
-    let [cx, cy, cz, r] = f;
-    overlap::SphereSoa { cx, cy, cz, r }
+/// The exact radius of node `n` around its central vertex `c`.
+fn radius(tree: &RegionTree, p: &Points, n: usize, c: [f32; 3]) -> f32 {
+    let run = refit::max_dist_sq(p.soa().slice(tree.vert_run(n)), c);
+    let borrowed = refit::max_dist_sq_indexed(p.soa(), tree.borrowed(n), c);
+    conservative_radius(run.max(borrowed))
 }
 
 impl BvKind for Dh {
@@ -63,7 +55,7 @@ impl BvKind for Dh {
             .collect();
         let mut nodes = DhNodes {
             vertex,
-            fitted: group_buffers(tree, [0.0, 0.0, 0.0, f32::NAN]),
+            fitted: Bounds::new(tree),
         };
         Dh::refit_all(&mut nodes, tree, rest, false);
         nodes
@@ -76,13 +68,11 @@ impl BvKind for Dh {
         p: &Points,
         g: usize,
     ) -> (overlap::SphereSoa<'a>, bool) {
-        let (f, fitted) = nodes.fitted.get_or_fill(g, |_, mut fields| {
-            for (i, n) in tree.group_nodes(g).enumerate() {
-                let r = Dh::fit(nodes, tree, p, n);
-                write(&mut fields, i, p.get(r.vertex as usize), r.radius);
-            }
+        let (tile, fitted) = nodes.fitted.group(tree, g, |n| {
+            let c = p.get(nodes.vertex[n] as usize);
+            [c[0], c[1], c[2], radius(tree, p, n, c)]
         });
-        (sphere_soa(f), fitted)
+        (overlap::SphereSoa::new(tile), fitted)
     }
 
     #[inline]
@@ -104,26 +94,22 @@ impl BvKind for Dh {
 
     #[inline(always)]
     fn extent(a: overlap::SphereSoa<'_>, i: usize) -> f32 {
-        a.r[i]
+        a.r()[i]
     }
 
     fn fit(nodes: &DhNodes, tree: &RegionTree, p: &Points, n: usize) -> DhNode {
         let vertex = nodes.vertex[n];
-        let c = p.get(vertex as usize);
-        let run = refit::max_dist_sq(p.soa().slice(tree.vert_run(n)), c);
-        let borrowed = refit::max_dist_sq_indexed(p.soa(), tree.borrowed(n), c);
         DhNode {
             vertex,
-            radius: conservative_radius(run.max(borrowed)),
+            radius: radius(tree, p, n, p.get(vertex as usize)),
         }
     }
 
     fn record(nodes: &DhNodes, tree: &RegionTree, n: usize) -> Option<DhNode> {
-        let g = tree.group_of(n);
-        let f = nodes.fitted.get(g)?;
+        let [_, _, _, radius] = nodes.fitted.get(tree, n)?;
         Some(DhNode {
             vertex: nodes.vertex[n],
-            radius: f[3][n - tree.group_nodes(g).start],
+            radius,
         })
     }
 
@@ -133,28 +119,22 @@ impl BvKind for Dh {
 
     fn refit_all(nodes: &mut DhNodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64 {
         let vertex = &nodes.vertex;
-        let fit = |n: usize| {
+        nodes.fitted.refit_all(tree, |n, child| {
             let c = p.get(vertex[n] as usize);
-            let run = refit::max_dist_sq(p.soa().slice(tree.vert_run(n)), c);
-            let borrowed = refit::max_dist_sq_indexed(p.soa(), tree.borrowed(n), c);
-            conservative_radius(run.max(borrowed))
-        };
-        refit_groups(&mut nodes.fitted, tree, |f, n, s| {
-            let c = p.get(vertex[n] as usize);
-            let radius = if bottom_up && !tree.is_leaf(n) {
+            let r = if bottom_up && !tree.is_leaf(n) {
                 // r_p = max_c (|C_p - C_c| + r_c): children are fitted (deeper groups first).
-                let mut radius = 0.0f32;
-                for child in tree.children(n) {
-                    let cc = p.get(vertex[child] as usize);
-                    let d = (0..3).map(|k| (c[k] - cc[k]) * (c[k] - cc[k])).sum::<f32>();
-                    let rc = f[3][slot(tree, child)];
-                    radius = radius.max(conservative_sum(conservative_radius(d), rc));
+                let mut r = 0.0f32;
+                for ch in tree.children(n) {
+                    let [x, y, z, rc] = child(ch);
+                    let d =
+                        (c[0] - x) * (c[0] - x) + (c[1] - y) * (c[1] - y) + (c[2] - z) * (c[2] - z);
+                    r = r.max(conservative_sum(conservative_radius(d), rc));
                 }
-                radius
+                r
             } else {
-                fit(n)
+                radius(tree, p, n, c)
             };
-            write(f, s, c, radius);
+            [c[0], c[1], c[2], r]
         })
     }
 

@@ -18,7 +18,8 @@ pub use crate::kinds::Method;
 
 use crate::points::Points;
 use crate::tree::RegionTree;
-use dhcd_kernels::lazy::LazySoa;
+use dhcd_kernels::lazy::LazyTiles;
+use dhcd_kernels::Tile;
 
 /// Relative inflation of every computed radius. Radii and overlap tests are evaluated in
 /// f32; each is off by a few ulps. Growing radii by 16 ulps keeps every sphere test
@@ -108,44 +109,99 @@ pub trait BvKind:
 }
 
 /// The lazily fitted buffers of a kind, grouped by sibling group.
-/// Node `n`'s bounds are at slot `slot(n)` of the buffers: group `g` owns the padded slots
-/// `tree.group_slots(g)`, its nodes first in order (see [`crate::tree::BLOCK`]).
-pub(crate) fn group_buffers<const F: usize>(tree: &RegionTree, init: [f32; F]) -> LazySoa<F> {
-    let groups = (0..tree.group_count())
-        .map(|g| tree.group_slots(g))
-        .collect();
-    LazySoa::new(tree.slot_count(), init, groups)
+/// The lazily fitted bounds of one kind, `F` `f32` fields per node, one [`Tile`] per
+/// sibling group: the group's `F` fields over its padded slots (`tree.group_slots(g)`, its
+/// nodes first in order; see [`crate::tree::BLOCK`]), side by side in one buffer. This is
+/// the one place that knows the layout.
+#[derive(Clone, Debug)]
+pub(crate) struct Bounds<const F: usize> {
+    tiles: LazyTiles,
 }
 
-/// The slot of node `n` in the padded node layout.
-#[inline]
-pub(crate) fn slot(tree: &RegionTree, n: usize) -> usize {
-    let g = tree.group_of(n);
-    tree.group_slots(g).start + (n - tree.group_nodes(g).start)
-}
-
-/// Fits every stale group of `buffers` with `write(fields, n, slot)` for each node `n`,
-/// deepest groups first (so a bottom-up fit finds its children current), and marks them
-/// current.
-pub(crate) fn refit_groups<const F: usize>(
-    buffers: &mut LazySoa<F>,
-    tree: &RegionTree,
-    mut write: impl FnMut(&mut [&mut [f32]; F], usize, usize),
-) -> u64 {
-    let mut fitted = 0;
-    for g in (0..tree.group_count()).rev() {
-        if buffers.is_current(g) {
-            continue;
+impl<const F: usize> Bounds<F> {
+    pub(crate) fn new(tree: &RegionTree) -> Self {
+        let groups = (0..tree.group_count())
+            .map(|g| {
+                let s = tree.group_slots(g);
+                F * s.start..F * s.end
+            })
+            .collect();
+        Self {
+            tiles: LazyTiles::new(F * tree.slot_count(), groups),
         }
-        let mut fields = buffers.fields_mut();
-        let first = tree.group_slots(g).start;
-        for (i, n) in tree.group_nodes(g).enumerate() {
-            write(&mut fields, n, first + i);
-            fitted += 1;
-        }
-        buffers.set_current(g);
     }
-    fitted
+
+    /// Group `g`'s tile, filled first with `fit(n)` for each of its nodes if stale.
+    #[inline]
+    pub(crate) fn group(
+        &self,
+        tree: &RegionTree,
+        g: usize,
+        fit: impl Fn(usize) -> [f32; F],
+    ) -> (Tile<'_>, bool) {
+        let stride = tree.group_slots(g).len();
+        let (data, fitted) = self.tiles.get_or_fill(g, |tile| {
+            for (i, n) in tree.group_nodes(g).enumerate() {
+                for (f, v) in fit(n).into_iter().enumerate() {
+                    tile[f * stride + i] = v;
+                }
+            }
+        });
+        (Tile::new(data, stride), fitted)
+    }
+
+    #[inline]
+    pub(crate) fn is_current(&self, g: usize) -> bool {
+        self.tiles.is_current(g)
+    }
+
+    /// Node `n`'s fields if its group is current.
+    pub(crate) fn get(&self, tree: &RegionTree, n: usize) -> Option<[f32; F]> {
+        let g = tree.group_of(n);
+        let tile = self.tiles.get(g)?;
+        let (stride, i) = (tree.group_slots(g).len(), n - tree.group_nodes(g).start);
+        Some(std::array::from_fn(|f| tile[f * stride + i]))
+    }
+
+    pub(crate) fn invalidate(&mut self) {
+        self.tiles.invalidate();
+    }
+
+    /// Fits every stale group now, deepest groups first, with `fit(n, child)` for each node
+    /// (`child(c)` reads a child's fields: its group is deeper, so already current); returns
+    /// the number of nodes fitted.
+    pub(crate) fn refit_all(
+        &mut self,
+        tree: &RegionTree,
+        fit: impl Fn(usize, &dyn Fn(usize) -> [f32; F]) -> [f32; F],
+    ) -> u64 {
+        let mut fitted = 0;
+        for g in (0..tree.group_count()).rev() {
+            if self.tiles.is_current(g) {
+                continue;
+            }
+            let values: Vec<[f32; F]> = {
+                let data: &[f32] = self.tiles.data_mut();
+                let child = |c: usize| {
+                    let g = tree.group_of(c);
+                    let s = tree.group_slots(g);
+                    let i = c - tree.group_nodes(g).start;
+                    std::array::from_fn(|f| data[F * s.start + f * s.len() + i])
+                };
+                tree.group_nodes(g).map(|n| fit(n, &child)).collect()
+            };
+            let s = tree.group_slots(g);
+            let tile = &mut self.tiles.data_mut()[F * s.start..F * s.end];
+            for (i, v) in values.iter().enumerate() {
+                for (f, &x) in v.iter().enumerate() {
+                    tile[f * s.len() + i] = x;
+                }
+            }
+            self.tiles.set_current(g);
+            fitted += values.len() as u64;
+        }
+        fitted
+    }
 }
 
 #[inline]

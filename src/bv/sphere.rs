@@ -1,11 +1,10 @@
 //! Sphere bounding volumes (the paper's SBV): centre = mean of the region's vertices,
 //! radius = largest distance from it. Refitting reads the region twice (mean, then radius).
 
-use super::{conservative_radius, conservative_sum, dist2_f64, group_buffers, refit_groups, slot};
+use super::{conservative_radius, conservative_sum, dist2_f64, Bounds};
 use super::{sealed, BvKind, Method};
 use crate::points::Points;
 use crate::tree::RegionTree;
-use dhcd_kernels::lazy::LazySoa;
 use dhcd_kernels::{overlap, refit};
 
 /// The sphere node record: centre and radius — 16 bytes.
@@ -21,7 +20,7 @@ const _: () = assert!(std::mem::size_of::<SphereNode>() == 16);
 /// group.
 #[derive(Clone, Debug)]
 pub struct SphereNodes {
-    fitted: LazySoa<4>,
+    fitted: Bounds<4>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -29,19 +28,8 @@ pub struct Sphere;
 impl sealed::Sealed for Sphere {}
 
 #[inline]
-fn write(fields: &mut [&mut [f32]; 4], i: usize, r: SphereNode) {
-    fields[0][i] = r.center[0];
-    fields[1][i] = r.center[1];
-    fields[2][i] = r.center[2];
-    fields[3][i] = r.radius;
-}
-
-#[inline]
-fn read(fields: &[&mut [f32]; 4], i: usize) -> SphereNode {
-    SphereNode {
-        center: [fields[0][i], fields[1][i], fields[2][i]],
-        radius: fields[3][i],
-    }
+fn fields(r: SphereNode) -> [f32; 4] {
+    [r.center[0], r.center[1], r.center[2], r.radius]
 }
 
 /// The exact sphere of node `n`.
@@ -75,7 +63,7 @@ impl BvKind for Sphere {
 
     fn build(tree: &RegionTree, rest: &Points) -> SphereNodes {
         let mut nodes = SphereNodes {
-            fitted: group_buffers(tree, [0.0, 0.0, 0.0, f32::NAN]),
+            fitted: Bounds::new(tree),
         };
         Sphere::refit_all(&mut nodes, tree, rest, false);
         nodes
@@ -88,13 +76,10 @@ impl BvKind for Sphere {
         p: &Points,
         g: usize,
     ) -> (overlap::SphereSoa<'a>, bool) {
-        let (f, fitted) = nodes.fitted.get_or_fill(g, |_, mut fields| {
-            for (i, n) in tree.group_nodes(g).enumerate() {
-                write(&mut fields, i, fit_node(tree, p, n));
-            }
-        });
-        let [cx, cy, cz, r] = f;
-        (overlap::SphereSoa { cx, cy, cz, r }, fitted)
+        let (tile, fitted) = nodes
+            .fitted
+            .group(tree, g, |n| fields(fit_node(tree, p, n)));
+        (overlap::SphereSoa::new(tile), fitted)
     }
 
     #[inline]
@@ -116,7 +101,7 @@ impl BvKind for Sphere {
 
     #[inline(always)]
     fn extent(a: overlap::SphereSoa<'_>, i: usize) -> f32 {
-        a.r[i]
+        a.r()[i]
     }
 
     fn fit(_: &SphereNodes, tree: &RegionTree, p: &Points, n: usize) -> SphereNode {
@@ -124,12 +109,10 @@ impl BvKind for Sphere {
     }
 
     fn record(nodes: &SphereNodes, tree: &RegionTree, n: usize) -> Option<SphereNode> {
-        let g = tree.group_of(n);
-        let f = nodes.fitted.get(g)?;
-        let i = n - tree.group_nodes(g).start;
+        let [x, y, z, radius] = nodes.fitted.get(tree, n)?;
         Some(SphereNode {
-            center: [f[0][i], f[1][i], f[2][i]],
-            radius: f[3][i],
+            center: [x, y, z],
+            radius,
         })
     }
 
@@ -138,13 +121,12 @@ impl BvKind for Sphere {
     }
 
     fn refit_all(nodes: &mut SphereNodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64 {
-        refit_groups(&mut nodes.fitted, tree, |f, n, s| {
-            let r = if bottom_up && !tree.is_leaf(n) {
-                merge(f, tree, n)
+        nodes.fitted.refit_all(tree, |n, child| {
+            fields(if bottom_up && !tree.is_leaf(n) {
+                merge(tree, n, child)
             } else {
                 fit_node(tree, p, n)
-            };
-            write(f, s, r);
+            })
         })
     }
 
@@ -155,26 +137,25 @@ impl BvKind for Sphere {
 }
 
 /// A sphere enclosing the (fitted) spheres of `n`'s children: centred at their mean.
-fn merge(f: &[&mut [f32]; 4], tree: &RegionTree, n: usize) -> SphereNode {
+fn merge(tree: &RegionTree, n: usize, child: &dyn Fn(usize) -> [f32; 4]) -> SphereNode {
     let children = tree.children(n);
     let inv = 1.0 / children.len() as f32;
     let mut center = [0.0f32; 3];
     for c in children.clone() {
-        let cc = read(f, slot(tree, c)).center;
+        let cc = child(c);
         for k in 0..3 {
             center[k] += cc[k] * inv;
         }
     }
     if !center.iter().all(|c| c.is_finite()) {
-        center = read(f, slot(tree, children.start)).center;
+        let first = child(children.start);
+        center = [first[0], first[1], first[2]];
     }
     let mut radius = 0.0f32;
     for c in children {
-        let child = read(f, slot(tree, c));
-        let d2 = (0..3)
-            .map(|k| (center[k] - child.center[k]).powi(2))
-            .sum::<f32>();
-        radius = radius.max(conservative_sum(conservative_radius(d2), child.radius));
+        let [x, y, z, rc] = child(c);
+        let d2 = (center[0] - x).powi(2) + (center[1] - y).powi(2) + (center[2] - z).powi(2);
+        radius = radius.max(conservative_sum(conservative_radius(d2), rc));
     }
     SphereNode { center, radius }
 }

@@ -41,49 +41,66 @@ pub(crate) fn leaf_pair<S: Simd>(
     out: &mut Vec<[u32; 2]>,
 ) -> u64 {
     let (na, nb) = (a.tris.len, b.tris.len);
-    let (sa, sb) = (&a.tris.soa, &b.tris.soa);
-    let mut rows = [0u64; MAX_ROW];
+    let pairing = match leaves {
+        Leaves::Objects => Pairing::All,
+        Leaves::SelfDistinct => Pairing::NoSharedVertex,
+        Leaves::SelfSame => Pairing::NoSharedVertexUpper,
+    };
+    if na <= MAX_ROW && nb <= MAX_ROW {
+        // Adaptive trees: one block per leaf.
+        return blocks(simd, a, 0, na, b, 0, nb, pairing, out);
+    }
+    // Leaves longer than a block (fixed-depth trees): blocks of MAX_ROW triangles.
     let mut counted = 0;
-    // Blocks of at most MAX_ROW triangles on each side (one block unless a leaf is larger:
-    // fixed-depth trees).
     for a0 in (0..na).step_by(MAX_ROW) {
-        let ra = (na - a0).min(MAX_ROW);
         for b0 in (0..nb).step_by(MAX_ROW) {
-            let rb = (nb - b0).min(MAX_ROW);
-            let pairing = match leaves {
-                Leaves::Objects => Pairing::All,
-                Leaves::SelfDistinct => Pairing::NoSharedVertex,
+            let pairing = match pairing {
                 // One leaf with itself: blocks below the diagonal hold only j < i.
-                Leaves::SelfSame if b0 < a0 => continue,
-                Leaves::SelfSame if b0 > a0 => Pairing::NoSharedVertex,
-                Leaves::SelfSame => Pairing::NoSharedVertexUpper,
+                Pairing::NoSharedVertexUpper if b0 < a0 => continue,
+                Pairing::NoSharedVertexUpper if b0 > a0 => Pairing::NoSharedVertex,
+                p => p,
             };
-            let (ba, bb) = if na <= MAX_ROW && nb <= MAX_ROW {
-                (*sa, *sb)
-            } else {
-                let ea = (a0 + MAX_ROW).min(sa.len());
-                let eb = (b0 + MAX_ROW).min(sb.len());
-                (sa.slice(a0..ea), sb.slice(b0..eb))
-            };
-            counted += leaf_candidates_with(simd, ba, ra, bb, rb, pairing, &mut rows[..ra]);
-            for (i, &row) in rows[..ra].iter().enumerate() {
-                let mut bits = row;
-                if bits == 0 {
-                    continue;
-                }
-                let ti = ba.corners(i);
-                while bits != 0 {
-                    let j = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    if triangles_intersect(&ti, &bb.corners(j)) {
-                        let (oi, oj) = (a.order[a0 + i], b.order[b0 + j]);
-                        out.push(if leaves == Leaves::Objects {
-                            [oi, oj]
-                        } else {
-                            [oi.min(oj), oi.max(oj)]
-                        });
-                    }
-                }
+            let (ra, rb) = ((na - a0).min(MAX_ROW), (nb - b0).min(MAX_ROW));
+            counted += blocks(simd, a, a0, ra, b, b0, rb, pairing, out);
+        }
+    }
+    counted
+}
+
+/// Triangles `a0..a0 + na` of `a` against `b0..b0 + nb` of `b` (`nb <= MAX_ROW`).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn blocks<S: Simd>(
+    simd: S,
+    a: &LeafSide,
+    a0: usize,
+    na: usize,
+    b: &LeafSide,
+    b0: usize,
+    nb: usize,
+    pairing: Pairing,
+    out: &mut Vec<[u32; 2]>,
+) -> u64 {
+    let (sa, sb) = (a.tris.soa.skip(a0), b.tris.soa.skip(b0));
+    let mut rows = [0u64; MAX_ROW];
+    debug_assert!(na <= MAX_ROW);
+    let counted = leaf_candidates_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
+    for (i, &row) in rows[..na].iter().enumerate() {
+        let mut bits = row;
+        if bits == 0 {
+            continue;
+        }
+        let ti = sa.corners(i);
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if triangles_intersect(&ti, &sb.corners(j)) {
+                let (oi, oj) = (a.order[a0 + i], b.order[b0 + j]);
+                out.push(if pairing == Pairing::All {
+                    [oi, oj]
+                } else {
+                    [oi.min(oj), oi.max(oj)]
+                });
             }
         }
     }

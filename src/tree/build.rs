@@ -142,16 +142,16 @@ impl RegionTree {
             group_slot.push(group_slot[g] + len.next_multiple_of(BLOCK) as u32);
         }
         let mut leaf_slot = vec![0u32];
-        let mut slot_vertex: [Vec<u32>; 3] = Default::default();
+        let mut leaf_vertex = Vec::with_capacity(3 * tri_count);
         for n in 0..node_count {
             if child_count[n] != 0 {
                 continue;
             }
             let run = &tris[tri_start[n] as usize..tri_end[n] as usize];
             let padded = run.len().next_multiple_of(BLOCK);
-            for (k, corner) in slot_vertex.iter_mut().enumerate() {
-                corner.extend(run.iter().map(|t| t[k]));
-                corner.resize(corner.len() + padded - run.len(), u32::MAX);
+            for k in 0..3 {
+                leaf_vertex.extend(run.iter().map(|t| t[k]));
+                leaf_vertex.resize(leaf_vertex.len() + padded - run.len(), u32::MAX);
             }
             leaf_slot.push(leaf_slot.last().copied().unwrap_or(0) + padded as u32);
         }
@@ -174,7 +174,7 @@ impl RegionTree {
             leaf_rank,
             group_slot,
             leaf_slot,
-            slot_vertex,
+            leaf_vertex,
             tris,
             tri_vertex,
             tri_order: order,

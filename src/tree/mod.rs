@@ -99,8 +99,9 @@ pub struct RegionTree {
     /// `r` owns triangle slots `leaf_slot[r]..leaf_slot[r + 1]` (multiples of [`BLOCK`]).
     group_slot: Vec<u32>,
     leaf_slot: Vec<u32>,
-    /// Corner `k`'s vertex index of each triangle slot (`u32::MAX` in padding).
-    slot_vertex: [Vec<u32>; 3],
+    /// Per leaf, a tile of its triangles' corner indices: corner `k` of slot `i` at
+    /// `3 * leaf_slot[r] + k * stride + i` (`u32::MAX` in padding).
+    leaf_vertex: Vec<u32>,
     tris: Vec<[u32; 3]>,
     /// `tris` as three arrays of corner indices (the narrow phase's shared-vertex mask).
     tri_vertex: [Vec<u32>; 3],
@@ -183,10 +184,12 @@ impl RegionTree {
         self.leaf_slot[r] as usize..self.leaf_slot[r + 1] as usize
     }
 
-    /// Corner `k`'s vertex index of every triangle slot (`u32::MAX` in padding).
+    /// The corner indices of the leaf of rank `r`, as a tile over its padded slots: corner
+    /// `k` of triangle `i` at `k * stride + i` (`u32::MAX` in padding).
     #[inline]
-    pub fn slot_vertex(&self, k: usize) -> &[u32] {
-        &self.slot_vertex[k]
+    pub fn leaf_vertex_tile(&self, r: usize) -> &[u32] {
+        let s = self.leaf_slots(r);
+        &self.leaf_vertex[3 * s.start..3 * s.end]
     }
 
     /// The leaves, in id order (`leaves()[leaf_rank(n)] == n`).
@@ -317,11 +320,7 @@ impl RegionTree {
             + size_of_val(&self.leaf_rank[..])
             + size_of_val(&self.group_slot[..])
             + size_of_val(&self.leaf_slot[..])
-            + self
-                .slot_vertex
-                .iter()
-                .map(|v| size_of_val(&v[..]))
-                .sum::<usize>()
+            + size_of_val(&self.leaf_vertex[..])
             + size_of_val(&self.depth[..])
             + size_of_val(&self.tri_start[..])
             + size_of_val(&self.tri_end[..])
