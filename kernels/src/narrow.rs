@@ -162,6 +162,7 @@ impl Fields<'_> {
 
 /// Which pairs `(i, j)` of two blocks are allowed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Pairing {
     /// Every pair (two objects).
     All,

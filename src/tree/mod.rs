@@ -41,6 +41,7 @@ const _: () = assert!(MAX_CHILDREN <= BLOCK, "a sibling group fits one block");
 
 /// How far the region tree is subdivided.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum TreeShape {
     /// Split every node holding more than `leaf_size` triangles (the default: the depth
     /// follows the mesh).

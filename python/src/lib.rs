@@ -1,0 +1,550 @@
+//! The native module `dhcd._dhcd` of the Python package (see `python/dhcd/__init__.pyi` for
+//! the documented API and `docs/PYTHON.md`). A thin layer: numpy arrays in, the library's
+//! calls with the GIL released, numpy arrays out, library errors as `ValueError` (`OSError`
+//! for files that cannot be read).
+//!
+//! Copies: a C-contiguous float32 `(n, 3)` vertex array is read in place (the library then
+//! copies it once into its own vertex order); any other vertex array is first converted once
+//! into a float32 buffer by numpy. Faces are converted to `u32` once, at construction.
+#![forbid(unsafe_code)]
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+use dhcd::{AnyHierarchy, Counters, Error, Mesh, Method, ObjectId, Options, Par, Workspace};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+
+/// A library error as a Python exception: `OSError` (`FileNotFoundError` for a missing file)
+/// when a file cannot be read, `ValueError` for everything else (bad input).
+fn to_py(e: Error) -> PyErr {
+    match &e {
+        Error::Io { path, .. } if !path.exists() => {
+            PyFileNotFoundError::new_err((2, e.to_string(), path.display().to_string()))
+        }
+        Error::Io { .. } => PyOSError::new_err(e.to_string()),
+        _ => PyValueError::new_err(e.to_string()),
+    }
+}
+
+fn value_error(message: String) -> PyErr {
+    PyValueError::new_err(message)
+}
+
+/// An integer argument; one beyond 64 bits is a `ValueError` like any other bad value
+/// (Python would raise `OverflowError`).
+fn int_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<i64> {
+    obj.extract::<i64>().map_err(|e| {
+        if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()) {
+            value_error(format!("{what} {obj} is out of range"))
+        } else {
+            e
+        }
+    })
+}
+
+/// The largest thread count accepted (larger counts are mistakes, not machines).
+// TODO(issue 9): use the library's one thread-count check (`Par::threads`) once it lands.
+const MAX_THREADS: i64 = 1024;
+
+/// The thread count of a query: `1` (the default, `None` here) the calling thread, `0` all
+/// cores, `n` a pool of `n`.
+fn par(threads: Option<&Bound<'_, PyAny>>) -> PyResult<Par> {
+    let threads = match threads {
+        None => 1,
+        Some(t) => int_arg(t, "threads")?,
+    };
+    match threads {
+        1 => Ok(Par::Seq),
+        n @ 0..=MAX_THREADS => Ok(Par::Rayon(n as usize)),
+        n => Err(value_error(format!(
+            "threads must be between 0 (all cores) and {MAX_THREADS}, got {n}"
+        ))),
+    }
+}
+
+fn options(levels: Option<&Bound<'_, PyAny>>) -> PyResult<Options> {
+    let levels = match levels.map(|l| int_arg(l, "levels")).transpose()? {
+        None => None,
+        Some(n) if n > 0 => Some(n as usize),
+        Some(n) => return Err(value_error(format!("levels must be positive, got {n}"))),
+    };
+    let options = Options {
+        levels,
+        ..Options::default()
+    };
+    options.shape().check().map_err(to_py)?;
+    Ok(options)
+}
+
+fn method(name: &str) -> PyResult<Method> {
+    name.parse::<Method>().map_err(to_py)
+}
+
+fn counters(py: Python<'_>, c: Counters) -> PyResult<Py<PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("bv_tests", c.bv_tests)?;
+    d.set_item("prim_tests", c.prim_tests)?;
+    d.set_item("bv_updates", c.bv_updates)?;
+    d.set_item("contacts", c.contacts)?;
+    Ok(d.unbind())
+}
+
+/// Real numbers and integers, as numpy's dtype kind letters and in words.
+const REAL: (&str, &str) = ("fiu", "a real number type");
+const INTEGER: (&str, &str) = ("iu", "an integer type");
+
+/// `numpy.asarray(obj)` checked to be a 2-D array with 3 columns whose dtype is one of
+/// `kinds` (`REAL` or `INTEGER`); `what` names it in messages.
+fn numeric_n3<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+    (kinds, kinds_text): (&str, &str),
+) -> PyResult<Bound<'py, PyAny>> {
+    let np = obj.py().import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| value_error(format!("{what}: cannot convert to an array ({e})")))?;
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    if shape.len() != 2 || shape[1] != 3 {
+        let shape = arr.getattr("shape")?.repr()?;
+        return Err(value_error(format!(
+            "{what} must be an (n, 3) array, got shape {shape}"
+        )));
+    }
+    let dtype = arr.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    if !kinds.contains(kind.as_str()) {
+        let name = dtype.str()?;
+        return Err(value_error(format!(
+            "{what} has dtype {name}, which is not {kinds_text}"
+        )));
+    }
+    Ok(arr)
+}
+
+/// Vertex positions: a float32 C-contiguous view of the caller's array when it is one, else a
+/// float32 copy made by numpy.
+struct Vertices<'py>(PyReadonlyArray2<'py, f32>);
+
+impl<'py> Vertices<'py> {
+    fn new(obj: &Bound<'py, PyAny>) -> PyResult<Self> {
+        let arr = numeric_n3(obj, "vertices", REAL)?;
+        let np = obj.py().import("numpy")?;
+        // No copy if `arr` is already float32 and C-contiguous.
+        let arr = np.call_method1("ascontiguousarray", (arr, "float32"))?;
+        Ok(Self(arr.extract()?))
+    }
+
+    fn as_slice(&self) -> PyResult<&[[f32; 3]]> {
+        let flat = self
+            .0
+            .as_slice()
+            .map_err(|e| value_error(format!("vertices: {e}")))?;
+        Ok(bytemuck::cast_slice(flat))
+    }
+}
+
+/// Faces as `u32` triangles (negative or too large indices are errors here; indices beyond
+/// the vertex count are the library's `IndexOutOfRange`).
+fn faces(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
+    index_rows(&numeric_n3(obj, "faces", INTEGER)?, "face")
+}
+
+/// Contact pairs `(K, 2)` from Python: non-negative integers below 2^32.
+fn pairs(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 2]>> {
+    let np = obj.py().import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| value_error(format!("pairs: cannot convert to an array ({e})")))?;
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+    let empty = shape.first() == Some(&0);
+    // `[]` (shape (0,)) is an empty list of pairs too.
+    let well_shaped = shape.len() == 2 && shape[1] == 2 || empty && shape.len() <= 2;
+    if !well_shaped {
+        let shape = arr.getattr("shape")?.repr()?;
+        return Err(value_error(format!(
+            "pairs must be a (K, 2) array, got shape {shape}"
+        )));
+    }
+    if empty {
+        return Ok(Vec::new());
+    }
+    if !"iu".contains(kind.as_str()) {
+        return Err(value_error(format!(
+            "pairs must be integers, got dtype kind {kind:?}"
+        )));
+    }
+    index_rows(&arr, "pair")
+}
+
+/// The rows of a 2-D integer array of `N` columns as `u32` indices; a value outside
+/// `0..2^32` is an error naming the `item` (row) it is in.
+fn index_rows<const N: usize>(arr: &Bound<'_, PyAny>, item: &str) -> PyResult<Vec<[u32; N]>> {
+    let np = arr.py().import("numpy")?;
+    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+    // int64 holds every valid index; uint64 values beyond it would wrap, so refuse them here.
+    let size: usize = arr.getattr("size")?.extract()?;
+    if kind == "u" && size > 0 && arr.call_method0("max")?.gt(u32::MAX)? {
+        return Err(value_error(format!(
+            "a {item} has an index above 2^32 - 1, which is out of range"
+        )));
+    }
+    let a: PyReadonlyArray2<'_, i64> = np
+        .call_method1("ascontiguousarray", (arr, "int64"))?
+        .extract()?;
+    a.as_array()
+        .rows()
+        .into_iter()
+        .enumerate()
+        .map(|(k, row)| {
+            let mut out = [0u32; N];
+            for (o, &v) in out.iter_mut().zip(row.iter()) {
+                *o = u32::try_from(v).map_err(|_| {
+                    value_error(format!("{item} {k} has index {v}, which is out of range"))
+                })?;
+            }
+            Ok(out)
+        })
+        .collect()
+}
+
+/// The result of a query: `.pairs` (a sorted `(K, 2)` or `(K, 4)` int64 array) and
+/// `.counters` (a dict: `bv_tests`, `prim_tests`, `bv_updates`, `contacts`).
+#[pyclass(module = "dhcd", frozen)]
+struct Contacts {
+    #[pyo3(get)]
+    pairs: Py<PyArray2<i64>>,
+    #[pyo3(get)]
+    counters: Py<PyDict>,
+}
+
+impl Contacts {
+    fn new<const N: usize>(py: Python<'_>, rows: Vec<[u64; N]>, c: Counters) -> PyResult<Self> {
+        let k = rows.len();
+        let flat: Vec<i64> = rows.into_iter().flatten().map(|v| v as i64).collect();
+        let arr = Array2::from_shape_vec((k, N), flat)
+            .map_err(|e| value_error(format!("internal error: {e}")))?;
+        Ok(Self {
+            pairs: arr.into_pyarray(py).unbind(),
+            counters: counters(py, c)?,
+        })
+    }
+}
+
+#[pymethods]
+impl Contacts {
+    fn __len__(&self, py: Python<'_>) -> usize {
+        self.pairs.bind(py).shape()[0]
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let c = self.counters.bind(py);
+        Ok(format!(
+            "Contacts({} pairs, counters={})",
+            self.pairs.bind(py).shape()[0],
+            c.repr()?
+        ))
+    }
+}
+
+/// The bounding-volume hierarchy of one deformable triangle mesh.
+#[pyclass(module = "dhcd")]
+struct Hierarchy {
+    h: AnyHierarchy,
+    ws: Workspace,
+}
+
+#[pymethods]
+impl Hierarchy {
+    #[new]
+    #[pyo3(signature = (vertices, faces, method = "dh", levels = None))]
+    fn new(
+        py: Python<'_>,
+        vertices: &Bound<'_, PyAny>,
+        faces: &Bound<'_, PyAny>,
+        method: &str,
+        levels: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let m = self::method(method)?;
+        let options = self::options(levels)?;
+        let v = Vertices::new(vertices)?;
+        let f = self::faces(faces)?;
+        let positions = v.as_slice()?;
+        let h = py
+            .detach(|| {
+                let mesh = Mesh::new(positions.to_vec(), f)?;
+                AnyHierarchy::new(m, &mesh, options)
+            })
+            .map_err(to_py)?;
+        Ok(Self {
+            h,
+            ws: Workspace::default(),
+        })
+    }
+
+    /// New vertex positions (same shape); the hierarchy is refitted (lazily), not rebuilt.
+    fn update(&mut self, py: Python<'_>, vertices: &Bound<'_, PyAny>) -> PyResult<()> {
+        let v = Vertices::new(vertices)?;
+        let positions = v.as_slice()?;
+        let h = &mut self.h;
+        py.detach(|| h.update_positions(positions)).map_err(to_py)
+    }
+
+    /// Intersecting face pairs `[i, j]`, `i < j`, of this mesh, sharing no vertex.
+    #[pyo3(signature = (threads = None), text_signature = "(self, threads=1)")]
+    fn self_collide(
+        &mut self,
+        py: Python<'_>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Contacts> {
+        let par = par(threads)?;
+        let (h, ws) = (&mut self.h, &mut self.ws);
+        let c = py.detach(|| h.self_collide(ws, par));
+        Contacts::new(py, widen(c.pairs), c.counters)
+    }
+
+    #[getter]
+    fn method(&self) -> &'static str {
+        self.h.method().name()
+    }
+
+    #[getter]
+    fn bytes_per_node(&self) -> usize {
+        self.h.bytes_per_node()
+    }
+
+    #[getter]
+    fn vertex_count(&self) -> usize {
+        self.h.tree().vertex_total()
+    }
+
+    #[getter]
+    fn face_count(&self) -> usize {
+        self.h.tree().triangle_total()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Hierarchy(method={:?}, vertex_count={}, face_count={}, nodes={})",
+            self.h.method().name(),
+            self.h.tree().vertex_total(),
+            self.h.tree().triangle_total(),
+            self.h.node_count()
+        )
+    }
+}
+
+fn widen(pairs: Vec<[u32; 2]>) -> Vec<[u64; 2]> {
+    pairs.into_iter().map(|p| p.map(u64::from)).collect()
+}
+
+/// Intersecting face pairs `[face of a, face of b]` between two hierarchies of one kind.
+#[pyfunction]
+#[pyo3(signature = (a, b, threads = None), text_signature = "(a, b, threads=1)")]
+fn collide(
+    py: Python<'_>,
+    a: &Bound<'_, Hierarchy>,
+    b: &Bound<'_, Hierarchy>,
+    threads: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Contacts> {
+    let par = par(threads)?;
+    if a.is(b) {
+        return Err(value_error(
+            "collide needs two different hierarchies (use a.self_collide() for one)".into(),
+        ));
+    }
+    let (mut a, mut b) = (a.try_borrow_mut()?, b.try_borrow_mut()?);
+    let (a, b) = (&mut *a, &mut *b);
+    let c = py
+        .detach(|| a.h.collide(&mut b.h, &mut a.ws, par))
+        .map_err(to_py)?;
+    Contacts::new(py, widen(c.pairs), c.counters)
+}
+
+/// The intersection segment of each pair, in the current poses: a `(K, 2, 3)` float32 array.
+#[pyfunction]
+fn contact_segments<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, Hierarchy>,
+    b: &Bound<'py, Hierarchy>,
+    pairs: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let pairs = self::pairs(pairs)?;
+    let (a, b) = (a.try_borrow()?, b.try_borrow()?);
+    let (ha, hb) = (&a.h, &b.h);
+    let segments = py
+        .detach(|| ha.contact_segments(hb, &pairs))
+        .map_err(to_py)?;
+    let flat: Vec<f32> = segments.iter().flatten().flatten().copied().collect();
+    let arr = Array3::from_shape_vec((segments.len(), 2, 3), flat)
+        .map_err(|e| value_error(format!("internal error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// `(vertices, faces)` as numpy arrays.
+type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<i64>>);
+
+/// `(vertices, faces)` of an OBJ, STL or PLY file: float32 `(n, 3)` and int64 `(m, 3)`.
+#[pyfunction]
+fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshArrays<'py>> {
+    let mesh = py.detach(|| dhcd::io::load(&path)).map_err(to_py)?;
+    let v: Vec<f32> = mesh.positions().iter().flatten().copied().collect();
+    let f: Vec<i64> = mesh
+        .triangles()
+        .iter()
+        .flatten()
+        .map(|&i| i64::from(i))
+        .collect();
+    let shape = |n: usize| (n, 3);
+    let v = Array2::from_shape_vec(shape(mesh.vertex_count()), v)
+        .map_err(|e| value_error(format!("internal error: {e}")))?;
+    let f = Array2::from_shape_vec(shape(mesh.triangle_count()), f)
+        .map_err(|e| value_error(format!("internal error: {e}")))?;
+    Ok((v.into_pyarray(py), f.into_pyarray(py)))
+}
+
+/// Many deformable objects of one kind; object ids are ints from 0 up, never reused.
+#[pyclass(module = "dhcd")]
+struct Scene {
+    scene: dhcd::Scene,
+    /// Names given to `add`, both ways; unique among the live objects.
+    ids: HashMap<String, u64>,
+    names: HashMap<u64, String>,
+}
+
+impl Scene {
+    /// An object given by id (int) or by the name it was added with (str).
+    fn object(&self, id: &Bound<'_, PyAny>) -> PyResult<ObjectId> {
+        if id.is_instance_of::<PyString>() {
+            let name: String = id.extract()?;
+            let name = name.as_str();
+            return self
+                .ids
+                .get(name)
+                .map(|&i| ObjectId(i))
+                .ok_or_else(|| value_error(format!("no object named {name:?} in the scene")));
+        }
+        let i = int_arg(id, "object id")?;
+        match u64::try_from(i).map(ObjectId) {
+            Ok(o) if self.scene.contains(o) => Ok(o),
+            _ => Err(value_error(format!("no object with id {i} in the scene"))),
+        }
+    }
+}
+
+#[pymethods]
+impl Scene {
+    #[new]
+    #[pyo3(signature = (method = "dh", levels = None))]
+    fn new(method: &str, levels: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        Ok(Self {
+            scene: dhcd::Scene::new(self::method(method)?, options(levels)?),
+            ids: HashMap::new(),
+            names: HashMap::new(),
+        })
+    }
+
+    /// Adds an object (self-collision off); returns its id.
+    #[pyo3(signature = (vertices, faces, name = None))]
+    fn add(
+        &mut self,
+        py: Python<'_>,
+        vertices: &Bound<'_, PyAny>,
+        faces: &Bound<'_, PyAny>,
+        name: Option<String>,
+    ) -> PyResult<u64> {
+        if let Some(n) = &name {
+            if self.ids.contains_key(n) {
+                return Err(value_error(format!("an object is already named {n:?}")));
+            }
+        }
+        let v = Vertices::new(vertices)?;
+        let f = self::faces(faces)?;
+        let positions = v.as_slice()?;
+        let scene = &mut self.scene;
+        let id = py
+            .detach(|| scene.add(&Mesh::new(positions.to_vec(), f)?))
+            .map_err(to_py)?;
+        if let Some(n) = name {
+            self.ids.insert(n.clone(), id.0);
+            self.names.insert(id.0, n);
+        }
+        Ok(id.0)
+    }
+
+    /// New vertex positions of an object (by id or name).
+    fn update(
+        &mut self,
+        py: Python<'_>,
+        id: &Bound<'_, PyAny>,
+        vertices: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let id = self.object(id)?;
+        let v = Vertices::new(vertices)?;
+        let positions = v.as_slice()?;
+        let scene = &mut self.scene;
+        py.detach(|| scene.update_positions(id, positions))
+            .map_err(to_py)
+    }
+
+    /// Removes an object (by id or name); its id is never handed out again.
+    fn remove(&mut self, id: &Bound<'_, PyAny>) -> PyResult<()> {
+        let id = self.object(id)?;
+        self.scene.remove(id).map_err(to_py)?;
+        if let Some(n) = self.names.remove(&id.0) {
+            self.ids.remove(&n);
+        }
+        Ok(())
+    }
+
+    /// Reports (or stops reporting) an object's self-contacts in `contacts`.
+    fn set_self_collision(&mut self, id: &Bound<'_, PyAny>, on: bool) -> PyResult<()> {
+        let id = self.object(id)?;
+        self.scene.set_self_collision(id, on).map_err(to_py)
+    }
+
+    /// Every contact: rows `[object_a, face_a, object_b, face_b]`, sorted.
+    #[pyo3(signature = (threads = None), text_signature = "(self, threads=1)")]
+    fn contacts(
+        &mut self,
+        py: Python<'_>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Contacts> {
+        let par = par(threads)?;
+        let scene = &mut self.scene;
+        let c = py.detach(|| scene.contacts(par));
+        Contacts::new(py, c.pairs, c.counters)
+    }
+
+    fn __len__(&self) -> usize {
+        self.scene.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene(method={:?}, objects={})",
+            self.scene.method().name(),
+            self.scene.len()
+        )
+    }
+}
+
+/// Collision detection between deformable triangle meshes (Distance Hierarchy, sphere and
+/// AABB hierarchies, exact contacts); the native part of the `dhcd` package.
+#[pymodule(name = "_dhcd")]
+mod dhcd_native {
+    #[pymodule_export]
+    use super::{collide, contact_segments, load_mesh, Contacts, Hierarchy, Scene};
+
+    #[pymodule_init]
+    fn init(m: &pyo3::Bound<'_, pyo3::types::PyModule>) -> pyo3::PyResult<()> {
+        use pyo3::types::PyModuleMethods;
+        let names: Vec<&str> = dhcd::Method::ALL.iter().map(|k| k.name()).collect();
+        m.add("METHODS", names)
+    }
+}
