@@ -11,8 +11,11 @@
  *  - arrays are flat: positions are x,y,z per vertex (3 * vertex_count floats),
  *    triangles are 3 vertex indices each (3 * triangle_count uint32_t);
  *  - triangle indices in results are the caller's original indices;
- *  - `threads`: 1 = calling thread, 0 = all cores, n = a pool of n threads
- *    (results never depend on it);
+ *  - `threads`: 1 = calling thread, 0 = all cores, n = a pool of n threads, never
+ *    more than the machine's cores; above 1024 is DHCD_ERR_INVALID_ARGUMENT (results
+ *    never depend on it);
+ *  - a handle or result output (`*out`) is emptied first (NULL handle, empty result),
+ *    so it is empty after any error;
  *  - a handle must not be used from two threads at once.
  */
 
@@ -44,7 +47,7 @@
 
 /**
  * A bad argument: unknown method, levels out of range, misaligned or oversized array,
- * the same hierarchy passed twice to `dhcd_collide`.
+ * the same hierarchy passed twice to `dhcd_collide`, a thread count above 1024.
  */
 #define DHCD_ERR_INVALID_ARGUMENT -2
 

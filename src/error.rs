@@ -1,7 +1,8 @@
 //! Typed errors. Kernels and traversal cannot fail: every precondition is checked once, here,
 //! at construction, update and I/O.
 
-use std::path::PathBuf;
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
 
 /// Everything that can go wrong when building, updating, querying or loading a mesh or
 /// hierarchy. One variant per failure, so callers (the C ABI, the Python module) map
@@ -76,9 +77,22 @@ pub enum Error {
     /// for contacts of an earlier pose).
     #[error("triangles {pair:?} do not intersect in the current pose (stale contacts?)")]
     StaleContact { pair: [u32; 2] },
-    #[error("{path}: {message}")]
+    #[error(
+        "thread count {got} is out of range: threads must be 0 (all cores), 1 (the calling \
+         thread) or up to {max} (at most {cores} are used on this machine)",
+        max = crate::par::MAX_THREADS,
+        cores = crate::par::max_threads()
+    )]
+    InvalidThreads { got: usize },
+    #[error("{}: {}", escaped_path(.path), escaped(.message))]
     Io { path: PathBuf, message: String },
-    #[error("{path}:{line}: {message}")]
+    #[error(
+        "{}: the file is larger than the limit of {limit} bytes for mesh files (raise it \
+         with --max-file-bytes, or io::Limits in the library)",
+        escaped_path(.path)
+    )]
+    FileTooLarge { path: PathBuf, limit: u64 },
+    #[error("{}:{line}: {}", escaped_path(.path), escaped(.message))]
     Parse {
         path: PathBuf,
         line: usize,
@@ -87,3 +101,27 @@ pub enum Error {
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// `text` with every control character (newlines and NUL included) and line separator
+/// written as an escape (`\n`, `\0`, `\u{1b}`), so that a message that echoes a path or a
+/// token from a file is always one line of printable text.
+pub fn escaped(text: &str) -> Cow<'_, str> {
+    let special = |c: char| c.is_control() || matches!(c, '\u{2028}' | '\u{2029}');
+    if !text.contains(special) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        match c {
+            '\0' => out.push_str("\\0"),
+            c if special(c) => out.extend(c.escape_default()),
+            c => out.push(c),
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// A path as [`escaped`] text (bytes that are not UTF-8 shown as U+FFFD).
+pub fn escaped_path(path: &Path) -> String {
+    escaped(&path.to_string_lossy()).into_owned()
+}

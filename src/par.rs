@@ -1,8 +1,26 @@
 //! Parallelism as a parameter: [`Par::Seq`] or [`Par::Rayon`] with a thread count.
 //! Results never depend on it: parallel work is split into fixed chunks whose outputs are
 //! concatenated in chunk order.
+//!
+//! Thread counts are bounded here, in one place (`docs/LIMITS.md`):
+//!
+//! - A count a user gives (command line, C ABI, experiment) enters through [`Par::threads`],
+//!   which rejects counts above [`MAX_THREADS`] with [`Error::InvalidThreads`].
+//! - The count actually used never exceeds [`max_threads`], the machine's available
+//!   parallelism: [`Par::Rayon`]`(n)` with a larger `n` runs on `max_threads()` threads.
+//! - Pools are cached, at most [`MAX_POOLS`] of them (least recently used evicted), so a host
+//!   that asks for many different counts holds at most `MAX_POOLS * max_threads()` threads.
 
 use std::sync::{Arc, Mutex, OnceLock};
+
+use crate::error::{Error, Result};
+
+/// The largest thread count [`Par::threads`] accepts; larger counts are typos or garbage
+/// (`UINT32_MAX` from C), not machines. Counts up to it are clamped to [`max_threads`].
+pub const MAX_THREADS: usize = 1024;
+
+/// The most thread pools kept alive at once.
+pub const MAX_POOLS: usize = 4;
 
 /// How a query or refit runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -11,19 +29,59 @@ pub enum Par {
     /// On the calling thread.
     #[default]
     Seq,
-    /// On a rayon pool of this many threads (`0`: rayon's global pool).
+    /// On a pool of this many threads, at most [`max_threads`] (`0`: the ambient rayon pool,
+    /// i.e. rayon's global pool, or the pool the caller already runs in).
     Rayon(usize),
 }
 
+/// The machine's available parallelism (at least 1): no [`Par`] runs on more threads.
+pub fn max_threads() -> usize {
+    static MAX: OnceLock<usize> = OnceLock::new();
+    *MAX.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
 impl Par {
-    pub fn is_parallel(self) -> bool {
-        !matches!(self, Par::Seq | Par::Rayon(1))
+    /// The parallelism for a thread count a user gave: `0` all cores (the ambient rayon
+    /// pool), `1` the calling thread, `n` a pool of `min(n, max_threads())` threads.
+    /// Counts above [`MAX_THREADS`] are an [`Error::InvalidThreads`].
+    pub fn threads(n: usize) -> Result<Par> {
+        match n {
+            0 => Ok(Par::Rayon(0)),
+            1 => Ok(Par::Seq),
+            n if n <= MAX_THREADS => Ok(Par::Rayon(n)),
+            got => Err(Error::InvalidThreads { got }),
+        }
     }
 
-    /// Runs `f` inside the pool this `Par` names (pools are built once per thread count and
-    /// cached), or directly for `Seq`.
-    pub fn install<R: Send>(self, f: impl FnOnce() -> R + Send) -> R {
+    /// What actually runs: `Rayon(n)` clamped to [`max_threads`], and [`Par::Seq`] when that
+    /// leaves one thread.
+    pub fn effective(self) -> Par {
         match self {
+            Par::Seq | Par::Rayon(0) => self,
+            Par::Rayon(n) => match n.min(max_threads()) {
+                1 => Par::Seq,
+                n => Par::Rayon(n),
+            },
+        }
+    }
+
+    /// The number of threads the work runs on.
+    pub fn thread_count(self) -> usize {
+        match self.effective() {
+            Par::Seq => 1,
+            Par::Rayon(0) => rayon::current_num_threads(),
+            Par::Rayon(n) => n,
+        }
+    }
+
+    pub fn is_parallel(self) -> bool {
+        self.effective() != Par::Seq
+    }
+
+    /// Runs `f` inside the pool this `Par` names (see the module docs for the cache), or
+    /// directly for `Seq` and `Rayon(0)`.
+    pub fn install<R: Send>(self, f: impl FnOnce() -> R + Send) -> R {
+        match self.effective() {
             Par::Seq | Par::Rayon(0) => f(),
             // A pool that cannot be built (no threads to be had) runs the work here: the
             // result is the same, only slower.
@@ -35,25 +93,63 @@ impl Par {
     }
 }
 
-/// Pools built so far, by thread count.
-type PoolCache = Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>>;
+/// Pools built so far, by thread count, least recently used first.
+#[derive(Default)]
+struct PoolCache {
+    pools: Vec<(usize, Arc<rayon::ThreadPool>)>,
+}
+
+impl PoolCache {
+    /// The pool of `threads` threads, built if needed; evicts the least recently used pool
+    /// beyond [`MAX_POOLS`]. An evicted pool's threads end once the work already running on
+    /// it (which holds its own `Arc`) is done.
+    fn get(&mut self, threads: usize) -> Option<Arc<rayon::ThreadPool>> {
+        if let Some(i) = self.pools.iter().position(|(n, _)| *n == threads) {
+            let hit = self.pools.remove(i);
+            self.pools.push(hit);
+        } else {
+            let p = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .thread_name(move |i| format!("dhcd-{threads}-{i}"))
+                .build()
+                .ok()?;
+            if self.pools.len() == MAX_POOLS {
+                self.pools.remove(0);
+            }
+            self.pools.push((threads, Arc::new(p)));
+        }
+        self.pools.last().map(|(_, p)| Arc::clone(p))
+    }
+}
 
 fn pool(threads: usize) -> Option<Arc<rayon::ThreadPool>> {
-    static POOLS: OnceLock<PoolCache> = OnceLock::new();
-    let mut pools = POOLS
+    static POOLS: OnceLock<Mutex<PoolCache>> = OnceLock::new();
+    POOLS
         .get_or_init(Default::default)
         .lock()
-        .unwrap_or_else(|e| e.into_inner());
-    if let Some((_, p)) = pools.iter().find(|(n, _)| *n == threads) {
-        return Some(Arc::clone(p));
+        .unwrap_or_else(|e| e.into_inner())
+        .get(threads)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cache_keeps_at_most_max_pools_most_recent_first() {
+        let mut cache = PoolCache::default();
+        for n in [1, 2, 3, 1, 4, 5, 6] {
+            let p = cache.get(n).unwrap();
+            assert_eq!(p.current_num_threads(), n);
+            assert!(cache.pools.len() <= MAX_POOLS);
+        }
+        // 1 was used again after 2 and 3, so 2 and 3 went first.
+        let kept: Vec<usize> = cache.pools.iter().map(|(n, _)| *n).collect();
+        assert_eq!(kept, [1, 4, 5, 6]);
+        let again = cache.get(5).unwrap();
+        assert!(
+            Arc::ptr_eq(&again, &cache.pools[3].1),
+            "a hit reuses the pool"
+        );
     }
-    let p = Arc::new(
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .thread_name(move |i| format!("dhcd-{threads}-{i}"))
-            .build()
-            .ok()?,
-    );
-    pools.push((threads, Arc::clone(&p)));
-    Some(p)
 }

@@ -299,8 +299,14 @@ impl<'h, K: BvKind> Walk<'h, K> {
             leaves: std::mem::take(&mut ws.leaves),
             ..Output::default()
         };
-        let threads = rayon::current_num_threads();
-        let seed_target = if parallel && threads > 1 {
+        // Only a parallel query asks for the pool's size: asking starts rayon's global pool,
+        // which a sequential query must not (one idle thread per core).
+        let threads = if parallel {
+            rayon::current_num_threads()
+        } else {
+            1
+        };
+        let seed_target = if threads > 1 {
             SEEDS_PER_THREAD * threads
         } else {
             0

@@ -1,9 +1,14 @@
 //! One integration-test binary; each module is a suite. (The CLI, experiment and simulator
 //! suites live in `cli/tests/`, the C ABI's in `capi/tests/`.)
 
+mod fixtures;
+mod fuzz;
 mod hierarchies;
 mod io;
 mod kinds;
+mod mutation;
 mod narrow;
 mod scene;
 mod self_collision;
+mod support;
+mod threads;

@@ -13,8 +13,13 @@
 //!   released by `dhcd_contacts_free` / `dhcd_scene_contacts_free`;
 //! - a handle must not be used from two threads at once (queries refit it lazily).
 //!
+//! - a function with a handle or result output (`*out`) empties it first (NULL handle,
+//!   empty result), so it is empty after any error; scalar outputs (`dhcd_hierarchy_method`,
+//!   `dhcd_scene_add`'s id, `dhcd_contact_segments`' segments) are written only on success.
+//!
 //! `threads` arguments: `1` runs on the calling thread, `0` on rayon's global pool (all
-//! cores), `n` on a pool of `n` threads. Results never depend on it.
+//! cores), `n` on a pool of `n` threads but never more than the machine's cores; above
+//! `dhcd::par::MAX_THREADS` (1024) is `DHCD_ERR_INVALID_ARGUMENT`. Results never depend on it.
 
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CString};
@@ -35,7 +40,7 @@ pub const DHCD_OK: c_int = 0;
 /// A required pointer argument is null.
 pub const DHCD_ERR_NULL: c_int = -1;
 /// A bad argument: unknown method, levels out of range, misaligned or oversized array,
-/// the same hierarchy passed twice to `dhcd_collide`.
+/// the same hierarchy passed twice to `dhcd_collide`, a thread count above 1024.
 pub const DHCD_ERR_INVALID_ARGUMENT: c_int = -2;
 /// The mesh is invalid: no vertices or triangles, an index out of range, a repeated index
 /// in a triangle, a non-finite coordinate.
@@ -136,7 +141,9 @@ impl From<Error> for Fail {
             | Error::TreeMismatch { .. }
             | Error::TriangleOutOfRange { .. }
             | Error::InvalidLeafSize { .. }
+            | Error::InvalidThreads { .. }
             | Error::Io { .. }
+            | Error::FileTooLarge { .. }
             | Error::Parse { .. } => DHCD_ERR_INVALID_ARGUMENT,
             // `Error` is non-exhaustive: a variant added later is a bad argument until it
             // gets a code of its own.
@@ -260,11 +267,9 @@ fn options(levels: u32) -> Options {
     }
 }
 
-fn par(threads: u32) -> Par {
-    match threads {
-        1 => Par::Seq,
-        n => Par::Rayon(n as usize),
-    }
+/// A `threads` argument, checked where every thread count is (`Par::threads`).
+fn par(threads: u32) -> Result<Par, Fail> {
+    Ok(Par::threads(threads as usize)?)
 }
 
 /// A validated mesh from C arrays.
@@ -342,9 +347,8 @@ pub unsafe extern "C" fn dhcd_hierarchy_new(
     out: *mut *mut DhcdHierarchy,
 ) -> c_int {
     guard(|| {
-        if out.is_null() {
-            return Err(null("out"));
-        }
+        // SAFETY: caller's contract on `out`: NULL until there is a handle.
+        unsafe { write(out, std::ptr::null_mut(), "out")? };
         let m = method_of(method)?;
         // SAFETY: the caller's contract on the arrays.
         let mesh = unsafe { mesh(positions, vertex_count, triangles, triangle_count)? };
@@ -424,10 +428,7 @@ pub unsafe extern "C" fn dhcd_collide(
     out: *mut DhcdContacts,
 ) -> c_int {
     guard(|| {
-        if out.is_null() {
-            return Err(null("out"));
-        }
-        // SAFETY: caller's contract on `out`.
+        // SAFETY: caller's contract on `out`: empty until there are contacts.
         unsafe { write(out, NO_CONTACTS, "out")? };
         if a == b && !a.is_null() {
             return Err(Fail(
@@ -437,8 +438,8 @@ pub unsafe extern "C" fn dhcd_collide(
         }
         // SAFETY: live, distinct handles (checked above), so the two `&mut` do not alias.
         let (a, b) = unsafe { (handle(a, "a")?, handle(b, "b")?) };
-        let c = a.h.collide(&mut b.h, &mut a.ws, par(threads))?;
-        // SAFETY: as above.
+        let c = a.h.collide(&mut b.h, &mut a.ws, par(threads)?)?;
+        // SAFETY: caller's contract on `out` (written above).
         unsafe { write(out, contacts_out(c), "out") }
     })
 }
@@ -455,15 +456,12 @@ pub unsafe extern "C" fn dhcd_self_collide(
     out: *mut DhcdContacts,
 ) -> c_int {
     guard(|| {
-        if out.is_null() {
-            return Err(null("out"));
-        }
-        // SAFETY: caller's contract on `out` and `h`.
+        // SAFETY: caller's contract on `out`: empty until there are contacts.
         unsafe { write(out, NO_CONTACTS, "out")? };
-        // SAFETY: as above.
+        // SAFETY: caller's contract on `h`.
         let h = unsafe { handle(h, "hierarchy")? };
-        let c = h.h.self_collide(&mut h.ws, par(threads));
-        // SAFETY: as above.
+        let c = h.h.self_collide(&mut h.ws, par(threads)?);
+        // SAFETY: caller's contract on `out` (written above).
         unsafe { write(out, contacts_out(c), "out") }
     })
 }
@@ -540,9 +538,8 @@ pub unsafe extern "C" fn dhcd_scene_new(
     out: *mut *mut DhcdScene,
 ) -> c_int {
     guard(|| {
-        if out.is_null() {
-            return Err(null("out"));
-        }
+        // SAFETY: caller's contract on `out`: NULL until there is a handle.
+        unsafe { write(out, std::ptr::null_mut(), "out")? };
         let m = method_of(method)?;
         options(levels).shape().check()?;
         let s = Box::new(DhcdScene {
@@ -665,19 +662,16 @@ pub unsafe extern "C" fn dhcd_scene_contacts(
     out: *mut DhcdSceneContacts,
 ) -> c_int {
     guard(|| {
-        if out.is_null() {
-            return Err(null("out"));
-        }
         let empty = DhcdSceneContacts {
             pairs: std::ptr::null_mut(),
             count: 0,
             counters: DhcdCounters::default(),
         };
-        // SAFETY: caller's contract on `out`.
+        // SAFETY: caller's contract on `out`: empty until there are contacts.
         unsafe { write(out, empty, "out")? };
         // SAFETY: caller's contract.
         let s = unsafe { handle(s, "scene")? };
-        let c = s.scene.contacts(par(threads));
+        let c = s.scene.contacts(par(threads)?);
         let count = c.pairs.len();
         let pairs = if count == 0 {
             std::ptr::null_mut()

@@ -441,3 +441,130 @@ fn struct_layouts() {
         2 * std::mem::size_of::<usize>() + 32
     );
 }
+
+/// A pointer no valid handle or array has: what a C caller's uninitialised variable holds.
+fn garbage<T>() -> *mut T {
+    std::ptr::dangling_mut::<T>().wrapping_add(7)
+}
+
+fn garbage_contacts() -> DhcdContacts {
+    DhcdContacts {
+        pairs: garbage(),
+        count: 99,
+        counters: DhcdCounters {
+            bv_tests: 1,
+            prim_tests: 2,
+            bv_updates: 3,
+            contacts: 99,
+        },
+    }
+}
+
+/// Every entry point with a handle or result output empties it on error, whatever the
+/// error (issue 9: `dhcd_hierarchy_new` and `dhcd_scene_new` left `*out` unchanged).
+#[test]
+fn every_output_is_empty_after_an_error() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let (p, t) = flat(&m);
+    let ha = new_h(DHCD_METHOD_DH, &m);
+    let hb = new_h(DHCD_METHOD_DH, &m);
+    let hs = new_h(DHCD_METHOD_SPHERE, &m);
+    let mut scene = null_mut();
+    // SAFETY: live handles; arrays of the stated lengths or null; writable outputs.
+    unsafe {
+        assert_eq!(dhcd_scene_new(DHCD_METHOD_DH, 4, &mut scene), DHCD_OK);
+        for (method, levels, positions, vertices) in [
+            (99, 4, p.as_ptr(), m.vertex_count()),
+            (DHCD_METHOD_DH, 99, p.as_ptr(), m.vertex_count()),
+            (DHCD_METHOD_DH, 4, null(), m.vertex_count()),
+            (DHCD_METHOD_DH, 4, p.as_ptr(), 0),
+        ] {
+            let mut h = garbage();
+            let rc = dhcd_hierarchy_new(
+                method,
+                levels,
+                positions,
+                vertices,
+                t.as_ptr(),
+                m.triangle_count(),
+                &mut h,
+            );
+            assert_ne!(rc, DHCD_OK);
+            assert!(h.is_null(), "dhcd_hierarchy_new: {}", last_error());
+        }
+        for (method, levels) in [(99, 4), (DHCD_METHOD_DH, 99)] {
+            let mut s = garbage();
+            assert_ne!(dhcd_scene_new(method, levels, &mut s), DHCD_OK);
+            assert!(s.is_null(), "dhcd_scene_new: {}", last_error());
+        }
+        let bad_collides: [(*mut DhcdHierarchy, *mut DhcdHierarchy, u32); 5] = [
+            (ha, ha, 1),
+            (ha, null_mut(), 1),
+            (ha, hs, 1),
+            (ha, hb, u32::MAX),
+            (ha, hb, 16_384),
+        ];
+        for (a, b, threads) in bad_collides {
+            let mut c = garbage_contacts();
+            assert_ne!(dhcd_collide(a, b, threads, &mut c), DHCD_OK);
+            assert!(
+                c.pairs.is_null() && c.count == 0,
+                "dhcd_collide: {}",
+                last_error()
+            );
+            assert_eq!(c.counters, DhcdCounters::default());
+        }
+        for (h, threads) in [(null_mut(), 1), (ha, u32::MAX)] {
+            let mut c = garbage_contacts();
+            assert_ne!(dhcd_self_collide(h, threads, &mut c), DHCD_OK);
+            assert!(c.pairs.is_null() && c.count == 0, "dhcd_self_collide");
+        }
+        for (s, threads) in [(null_mut(), 1), (scene, u32::MAX)] {
+            let mut c = DhcdSceneContacts {
+                pairs: garbage(),
+                count: 99,
+                counters: DhcdCounters::default(),
+            };
+            assert_ne!(dhcd_scene_contacts(s, threads, &mut c), DHCD_OK);
+            assert!(c.pairs.is_null() && c.count == 0, "dhcd_scene_contacts");
+        }
+        dhcd_scene_free(scene);
+        for h in [ha, hb, hs] {
+            dhcd_hierarchy_free(h);
+        }
+    }
+}
+
+/// `threads` above `MAX_THREADS` is an invalid argument (it used to start up to 65,535
+/// rayon workers, or hang); any accepted count runs on at most the machine's threads and
+/// gives the sequential answer.
+#[test]
+fn thread_counts_are_checked() {
+    let a = icosphere(1, 1.0, [0.0; 3]);
+    let b = Mesh::new(
+        translated(a.positions(), [0.5, 0.0, 0.0]),
+        a.triangles().to_vec(),
+    )
+    .unwrap();
+    let (ha, hb) = (new_h(DHCD_METHOD_AABB, &a), new_h(DHCD_METHOD_AABB, &b));
+    // SAFETY: live handles, writable outputs.
+    unsafe {
+        for threads in [u32::MAX, dhcd::par::MAX_THREADS as u32 + 1] {
+            let mut c = empty();
+            assert_eq!(
+                dhcd_collide(ha, hb, threads, &mut c),
+                DHCD_ERR_INVALID_ARGUMENT
+            );
+            let message = last_error();
+            assert!(message.contains(&threads.to_string()), "{message}");
+        }
+        for threads in [0, 1, 2, dhcd::par::MAX_THREADS as u32] {
+            let mut c = empty();
+            assert_eq!(dhcd_collide(ha, hb, threads, &mut c), DHCD_OK);
+            assert_eq!(pairs_of(&c), brute_force_pairs(&a, &b), "{threads}");
+            dhcd_contacts_free(&mut c);
+        }
+        dhcd_hierarchy_free(ha);
+        dhcd_hierarchy_free(hb);
+    }
+}

@@ -130,7 +130,7 @@ fn bad_configs_are_errors() {
             ..small(1, 1)
         },
         Config {
-            threads: 0,
+            threads: dhcd::par::MAX_THREADS + 1,
             ..small(1, 1)
         },
         Config {
@@ -186,7 +186,8 @@ fn cli_bad_flags_fail_cleanly() {
         vec!["experiment", "--frames", "0"],
         vec!["experiment", "--frames", "many"],
         vec!["experiment", "--methods", "dh,octree"],
-        vec!["experiment", "--threads", "0"],
+        vec!["experiment", "--threads", "16384"],
+        vec!["experiment", "--threads", "-1"],
         vec!["experiment", "--levels", "0", "--frames", "1"],
         vec!["experiment", "--mesh", missing.to_str().unwrap()],
         vec!["experiment", "--bogus"],

@@ -4,5 +4,12 @@
 mod cli;
 mod cli_collide;
 mod experiment;
+// The mesh fixtures and the mutation fuzzer are the library's (one copy of each).
+#[path = "../../tests/fixtures.rs"]
+mod fixtures;
+mod fuzz;
+mod hostile;
+#[path = "../../tests/mutation.rs"]
+mod mutation;
 mod sim;
 mod support;

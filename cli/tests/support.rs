@@ -27,3 +27,49 @@ pub fn run_dhcd(args: &[&str]) -> Output {
         .output()
         .unwrap()
 }
+
+/// Runs `dhcd` with `args`, at most `data_kib` KiB of data memory (`ulimit -d`: heap and
+/// private writable mappings, so an unbounded allocation aborts instead of filling the
+/// machine), and fails the test if it has not ended after a generous two minutes (then it is
+/// killed: a hang, not slowness).
+#[cfg(unix)]
+pub fn run_dhcd_bounded(args: &[&str], data_kib: u64) -> Output {
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -d {data_kib} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_dhcd"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let drain = |mut pipe: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            let _ = pipe.read_to_end(&mut bytes);
+            bytes
+        })
+    };
+    let stdout = drain(Box::new(child.stdout.take().unwrap()));
+    let stderr = drain(Box::new(child.stderr.take().unwrap()));
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("dhcd {} did not end within two minutes", args.join(" "));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    };
+    Output {
+        status,
+        stdout: stdout.join().unwrap(),
+        stderr: stderr.join().unwrap(),
+    }
+}

@@ -102,9 +102,11 @@ def contact_segments(
 
 def load_mesh(
     path: Union[str, "os.PathLike[str]"],
+    max_file_bytes: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.int64]]:
     """``(vertices, faces)`` of an OBJ, STL (ASCII or binary) or PLY file: ``(n, 3)`` float32
-    and ``(m, 3)`` int64, faces in file order (polygons split as fans)."""
+    and ``(m, 3)`` int64, faces in file order (polygons split as fans). Only regular files of
+    at most ``max_file_bytes`` (default 1 GiB) are read; anything else raises ``OSError``."""
 
 class Scene:
     """Many deformable objects of one method. Object ids are ints from 0 upwards, never

@@ -19,13 +19,14 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
 /// A library error as a Python exception: `OSError` (`FileNotFoundError` for a missing file)
-/// when a file cannot be read, `ValueError` for everything else (bad input).
+/// when a file cannot be read (or is not a regular file, or is over the size limit),
+/// `ValueError` for everything else (bad input).
 fn to_py(e: Error) -> PyErr {
     match &e {
         Error::Io { path, .. } if !path.exists() => {
             PyFileNotFoundError::new_err((2, e.to_string(), path.display().to_string()))
         }
-        Error::Io { .. } => PyOSError::new_err(e.to_string()),
+        Error::Io { .. } | Error::FileTooLarge { .. } => PyOSError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
 }
@@ -46,24 +47,17 @@ fn int_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<i64> {
     })
 }
 
-/// The largest thread count accepted (larger counts are mistakes, not machines).
-// TODO(issue 9): use the library's one thread-count check (`Par::threads`) once it lands.
-const MAX_THREADS: i64 = 1024;
-
-/// The thread count of a query: `1` (the default, `None` here) the calling thread, `0` all
-/// cores, `n` a pool of `n`.
+/// The thread count of a query, checked where every thread count is (`Par::threads`): `1`
+/// (the default, `None` here) the calling thread, `0` all cores, `n` a pool of at most the
+/// machine's threads; above `dhcd::par::MAX_THREADS`, or negative, a `ValueError`.
 fn par(threads: Option<&Bound<'_, PyAny>>) -> PyResult<Par> {
     let threads = match threads {
         None => 1,
         Some(t) => int_arg(t, "threads")?,
     };
-    match threads {
-        1 => Ok(Par::Seq),
-        n @ 0..=MAX_THREADS => Ok(Par::Rayon(n as usize)),
-        n => Err(value_error(format!(
-            "threads must be between 0 (all cores) and {MAX_THREADS}, got {n}"
-        ))),
-    }
+    let n = usize::try_from(threads)
+        .map_err(|_| value_error(format!("threads must not be negative, got {threads}")))?;
+    Par::threads(n).map_err(to_py)
 }
 
 fn options(levels: Option<&Bound<'_, PyAny>>) -> PyResult<Options> {
@@ -390,9 +384,25 @@ fn contact_segments<'py>(
 type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<i64>>);
 
 /// `(vertices, faces)` of an OBJ, STL or PLY file: float32 `(n, 3)` and int64 `(m, 3)`.
+/// Only regular files of at most `max_file_bytes` (default 1 GiB) are read.
 #[pyfunction]
-fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshArrays<'py>> {
-    let mesh = py.detach(|| dhcd::io::load(&path)).map_err(to_py)?;
+#[pyo3(signature = (path, max_file_bytes = None))]
+fn load_mesh<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    max_file_bytes: Option<&Bound<'py, PyAny>>,
+) -> PyResult<MeshArrays<'py>> {
+    let limits = match max_file_bytes {
+        None => dhcd::io::Limits::default(),
+        Some(m) => dhcd::io::Limits {
+            max_file_bytes: u64::try_from(int_arg(m, "max_file_bytes")?).map_err(|_| {
+                value_error(format!("max_file_bytes must not be negative, got {m}"))
+            })?,
+        },
+    };
+    let mesh = py
+        .detach(|| dhcd::io::load_with(&path, &limits))
+        .map_err(to_py)?;
     let v: Vec<f32> = mesh.positions().iter().flatten().copied().collect();
     let f: Vec<i64> = mesh
         .triangles()

@@ -1,6 +1,8 @@
 """Every kind of bad input raises ValueError (OSError for unreadable files) with the
 library's message, never crashes, and leaves the object unchanged."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -147,6 +149,19 @@ def test_files(tmp_path):
     assert e.value.filename.endswith("missing.obj")
     with pytest.raises(OSError):
         dhcd.load_mesh(tmp_path)  # a directory
+    # Files that never end, and the size limit (issue 9).
+    for endless in ["/dev/zero", "/dev/urandom"]:
+        if os.path.exists(endless):
+            with pytest.raises(OSError, match="not a regular file"):
+                dhcd.load_mesh(endless)
+    small = tmp_path / "small.obj"
+    small.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    with pytest.raises(OSError, match="limit of 10 bytes"):
+        dhcd.load_mesh(small, max_file_bytes=10)
+    assert dhcd.load_mesh(small, max_file_bytes=1000)[1].tolist() == [[0, 1, 2]]
+    for bad in [-1, 2**70]:
+        with pytest.raises(ValueError, match="max_file_bytes"):
+            dhcd.load_mesh(small, max_file_bytes=bad)
     for name, text in [
         ("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n"),
         ("garbage.obj", "v 0 0 zero\n"),

@@ -63,7 +63,7 @@ impl Format {
         if stl::is_binary(bytes) {
             return Some(Format::Stl);
         }
-        let trimmed = trim_ascii_start(bytes);
+        let trimmed = trim_ascii_start(strip_bom(bytes));
         if trimmed.len() >= 5 && trimmed[..5].eq_ignore_ascii_case(b"solid") {
             return Some(Format::Stl);
         }
@@ -83,10 +83,34 @@ impl Format {
     }
 }
 
-/// Loads a mesh, choosing the format from the extension (case-insensitive) or, failing that,
-/// from the contents.
+/// The largest mesh file read by default: 1 GiB (a binary STL of 21 million triangles).
+pub const DEFAULT_MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Bounds on what a loader reads, so that no file (a device that never ends, a sparse file of
+/// many gigabytes) can take unbounded memory or time. See `docs/LIMITS.md`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Limits {
+    /// Files larger than this are refused with [`Error::FileTooLarge`] before being read.
+    pub max_file_bytes: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            max_file_bytes: DEFAULT_MAX_FILE_BYTES,
+        }
+    }
+}
+
+/// Loads a mesh with the default [`Limits`], choosing the format from the extension
+/// (case-insensitive) or, failing that, from the contents.
 pub fn load(path: &Path) -> Result<Mesh> {
-    let bytes = read(path)?;
+    load_with(path, &Limits::default())
+}
+
+/// As [`load`], within `limits`.
+pub fn load_with(path: &Path, limits: &Limits) -> Result<Mesh> {
+    let bytes = read(path, limits)?;
     let format = match Format::from_extension(path).or_else(|| Format::sniff(&bytes)) {
         Some(format) => format,
         None => {
@@ -111,26 +135,98 @@ pub fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<Mesh> {
     }
 }
 
-/// Loads a Wavefront OBJ file.
+/// Loads a Wavefront OBJ file (default [`Limits`]).
 pub fn load_obj(path: &Path) -> Result<Mesh> {
-    parse_obj_bytes(&read(path)?, path)
+    parse_obj_bytes(&read(path, &Limits::default())?, path)
 }
 
-/// Loads an STL file (ASCII or binary, detected from the contents).
+/// Loads an STL file (ASCII or binary, detected from the contents; default [`Limits`]).
 pub fn load_stl(path: &Path) -> Result<Mesh> {
-    parse_stl(&read(path)?, path)
+    parse_stl(&read(path, &Limits::default())?, path)
 }
 
-/// Loads a PLY file (ASCII, binary little- or big-endian).
+/// Loads a PLY file (ASCII, binary little- or big-endian; default [`Limits`]).
 pub fn load_ply(path: &Path) -> Result<Mesh> {
-    parse_ply(&read(path)?, path)
+    parse_ply(&read(path, &Limits::default())?, path)
 }
 
-fn read(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| Error::Io {
+/// Reads a whole mesh file: only regular files (symbolic links followed), at most
+/// `limits.max_file_bytes`.
+pub fn read(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let io = |message: String| Error::Io {
         path: path.to_path_buf(),
-        message: format!("cannot read mesh file: {e}"),
-    })
+        message,
+    };
+    let cannot = |e: std::io::Error| io(format!("cannot read mesh file: {e}"));
+    // Look before opening: opening a FIFO that has no writer blocks forever.
+    let meta = std::fs::metadata(path).map_err(cannot)?;
+    if !meta.is_file() {
+        return Err(io(format!(
+            "not a regular file ({}): mesh files must be regular files",
+            file_kind(&meta.file_type())
+        )));
+    }
+    let too_large = || Error::FileTooLarge {
+        path: path.to_path_buf(),
+        limit: limits.max_file_bytes,
+    };
+    if meta.len() > limits.max_file_bytes {
+        return Err(too_large());
+    }
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    // The file may have grown (or been replaced) since: never read past the limit.
+    let mut bytes = Vec::new();
+    let _ = bytes.try_reserve_exact(meta.len() as usize);
+    file.take(limits.max_file_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > limits.max_file_bytes {
+        return Err(too_large());
+    }
+    Ok(bytes)
+}
+
+fn file_kind(t: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "not a file"
+    }
+}
+
+/// Where the line that starts at `pos` ends, and where the next one starts. A line ends at
+/// `\n`, `\r\n`, a lone `\r` (classic Mac files) or the end of `bytes`.
+pub(crate) fn line_end(bytes: &[u8], pos: usize) -> (usize, usize) {
+    let rest = &bytes[pos.min(bytes.len())..];
+    match rest.iter().position(|&b| b == b'\n' || b == b'\r') {
+        None => (bytes.len(), bytes.len()),
+        Some(i) => {
+            let crlf = rest[i] == b'\r' && rest.get(i + 1) == Some(&b'\n');
+            (pos + i, pos + i + 1 + usize::from(crlf))
+        }
+    }
+}
+
+/// `bytes` without a leading UTF-8 byte order mark.
+pub(crate) fn strip_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
 }
 
 fn trim_ascii_start(bytes: &[u8]) -> &[u8] {

@@ -84,9 +84,8 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<Mesh> {
     let mut continued = String::new();
     let mut continued_from = 0;
 
-    for (number, raw) in text.split('\n').enumerate() {
+    for (number, raw) in lines(text).enumerate() {
         let mut line_no = number + 1;
-        let raw = raw.strip_suffix('\r').unwrap_or(raw);
         // Line continuation: a trailing backslash joins the next line.
         if let Some(head) = raw.strip_suffix('\\') {
             if continued.is_empty() {
@@ -189,6 +188,19 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<Mesh> {
     build(path, positions, triangles)
 }
 
+/// The lines of `text` as [`super::line_end`] ends them (`\n`, `\r\n` or a lone `\r`); like
+/// `split('\n')`, a final line end is followed by an empty last line.
+fn lines(text: &str) -> impl Iterator<Item = &str> {
+    let mut pos = Some(0);
+    std::iter::from_fn(move || {
+        let start = pos?;
+        let (end, next) = super::line_end(text.as_bytes(), start);
+        pos = (end < text.len()).then_some(next);
+        // Line ends are ASCII, so both ends are character boundaries.
+        text.get(start..end)
+    })
+}
+
 fn truncate(token: &str) -> &str {
     match token.char_indices().nth(32) {
         Some((i, _)) => &token[..i],
@@ -261,7 +273,7 @@ pub(crate) fn looks_like_obj(bytes: &[u8]) -> bool {
         Err(e) => std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or(""),
     };
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    for line in text.lines().take(1000) {
+    for line in lines(text).take(1000) {
         let line = match line.find('#') {
             Some(i) => &line[..i],
             None => line,

@@ -1,8 +1,9 @@
 //! PLY reader: ASCII, binary little-endian and binary big-endian.
 
+use std::collections::HashSet;
 use std::path::Path;
 
-use super::{build, fan, parse_error};
+use super::{build, fan, line_end, parse_error};
 use crate::error::Result;
 use crate::mesh::Mesh;
 
@@ -133,6 +134,10 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     let mut line_no = 0;
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
+    // Names seen so far, so that duplicate checks stay linear in the number of header lines
+    // (a header may declare hundreds of thousands of elements).
+    let mut element_names: HashSet<&str> = HashSet::new();
+    let mut property_names: HashSet<&str> = HashSet::new();
     loop {
         if pos >= bytes.len() {
             return Err(parse_error(
@@ -141,12 +146,9 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 "unexpected end of file in the PLY header: missing 'end_header'",
             ));
         }
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |i| pos + i);
+        let (end, next) = line_end(bytes, pos);
         let raw = &bytes[pos..end];
-        pos = (end + 1).min(bytes.len());
+        pos = next;
         line_no += 1;
         let Ok(line) = std::str::from_utf8(raw) else {
             return Err(parse_error(
@@ -201,9 +203,10 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 let count: u64 = count
                     .parse()
                     .map_err(|_| err(format!("invalid element count '{}'", clip(count))))?;
-                if elements.iter().any(|e| e.name == name) {
+                if !element_names.insert(name) {
                     return Err(err(format!("duplicate element '{}'", clip(name))));
                 }
+                property_names.clear();
                 elements.push(Element {
                     name: name.to_string(),
                     count,
@@ -239,7 +242,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                                     <count type> <item type> <name>'"
                         .into()));
                 };
-                if element.properties.iter().any(|p| p.name == name) {
+                if !property_names.insert(name) {
                     return Err(err(format!(
                         "duplicate property '{}' in element '{}'",
                         clip(name),
@@ -324,13 +327,9 @@ impl Source for Ascii<'_> {
                 self.line += 1;
                 return Err("unexpected end of file".into());
             }
-            let end = self
-                .rest
-                .iter()
-                .position(|&b| b == b'\n')
-                .unwrap_or(self.rest.len());
+            let (end, next) = line_end(self.rest, 0);
             let line = &self.rest[..end];
-            self.rest = &self.rest[(end + 1).min(self.rest.len())..];
+            self.rest = &self.rest[next..];
             self.line += 1;
             if line.iter().any(|b| !b.is_ascii_whitespace()) {
                 self.tokens = line.split(is_space as fn(&u8) -> bool);
@@ -565,9 +564,37 @@ fn roles(header: &Header, path: &Path) -> Result<(usize, Vec<Role>, usize, Vec<R
     Ok((v, vertex_roles, f, face_roles))
 }
 
+/// Reserves room for the rows of `element` that the data can hold, never for the declared
+/// count (a header may declare four billion rows over a few bytes). A used row yields at least
+/// one position or triangle, and takes at least [`min_row_bytes`].
+fn reserve<T>(out: &mut Vec<T>, element: &Element, roles: &[Role], header: &Header, data: usize) {
+    let rows = (data / min_row_bytes(element, roles, header.encoding)) as u64;
+    // Only a hint: if even that much memory is not to be had, the rows are pushed one by one.
+    let _ = out.try_reserve(element.count.min(rows) as usize);
+}
+
+/// The fewest bytes a row of `element` can take: every value takes its size in binary, at
+/// least a character and a separator in ASCII; the index list of a face has at least 3 items.
+fn min_row_bytes(element: &Element, roles: &[Role], encoding: Encoding) -> usize {
+    let size = |ty: Ty| match encoding {
+        Encoding::Ascii => 2,
+        Encoding::LittleEndian | Encoding::BigEndian => ty.size(),
+    };
+    let bytes: usize = element
+        .properties
+        .iter()
+        .zip(roles)
+        .map(|(p, role)| match (&p.kind, role) {
+            (Kind::Scalar(ty), _) => size(*ty),
+            (Kind::List { count, item }, Role::Indices) => size(*count) + 3 * size(*item),
+            (Kind::List { count, .. }, _) => size(*count),
+        })
+        .sum();
+    bytes.max(1)
+}
+
 fn read_body(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh> {
-    // Every row of a used element takes at least one byte: never reserve beyond the data.
-    let data_len = (header.data_end - header.data_start) as u64;
+    let data_len = header.data_end - header.data_start;
     let (v_elem, vertex_roles, f_elem, face_roles) = roles(header, path)?;
     let mut positions: Vec<[f32; 3]> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
@@ -582,10 +609,10 @@ fn read_body(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh
         }
         let no_roles = Vec::new();
         let roles = if e == v_elem {
-            positions.reserve(element.count.min(data_len) as usize);
+            reserve(&mut positions, element, &vertex_roles, header, data_len);
             &vertex_roles
         } else if e == f_elem {
-            triangles.reserve(element.count.min(data_len) as usize);
+            reserve(&mut triangles, element, &face_roles, header, data_len);
             &face_roles
         } else {
             &no_roles

@@ -42,10 +42,12 @@ pub fn parse_stl(bytes: &[u8], path: &Path) -> Result<Mesh> {
     if is_binary(bytes) {
         return parse_binary(bytes, path);
     }
-    if starts_with_solid(bytes) {
+    // A text editor may have saved an ASCII file with a byte order mark.
+    let text = super::strip_bom(bytes);
+    if starts_with_solid(text) {
         // Only worth mentioning binary when the contents are not text.
         let binary_hint = bytes.contains(&0).then(|| declared_facets(bytes)).flatten();
-        return parse_ascii(bytes, path).map_err(|e| match (e, binary_hint) {
+        return parse_ascii(text, path).map_err(|e| match (e, binary_hint) {
             (
                 Error::Parse {
                     path,
@@ -189,7 +191,7 @@ impl<'a> Tokens<'a> {
             if !b.is_ascii_whitespace() {
                 break;
             }
-            if b == b'\n' {
+            if ends_line(self.bytes, self.pos) {
                 self.line += 1;
             }
             self.pos += 1;
@@ -207,13 +209,20 @@ impl<'a> Tokens<'a> {
 
     /// Skips the rest of the current line (a solid's name).
     fn skip_line(&mut self) {
-        while let Some(&b) = self.bytes.get(self.pos) {
-            self.pos += 1;
-            if b == b'\n' {
-                self.line += 1;
-                break;
-            }
+        let (_, next) = super::line_end(self.bytes, self.pos);
+        if next > self.pos && matches!(self.bytes[next - 1], b'\n' | b'\r') {
+            self.line += 1;
         }
+        self.pos = next;
+    }
+}
+
+/// Whether the byte at `pos` ends a line: `\n`, or a `\r` not followed by `\n`.
+fn ends_line(bytes: &[u8], pos: usize) -> bool {
+    match bytes[pos] {
+        b'\n' => true,
+        b'\r' => bytes.get(pos + 1) != Some(&b'\n'),
+        _ => false,
     }
 }
 

@@ -1,9 +1,10 @@
-//! `dhcd collide A B [--method dh|sphere|aabb] [--levels N] [--json]`
+//! `dhcd collide A B [--method dh|sphere|aabb] [--levels N] [--json] [--max-file-bytes N]`
 
 use std::path::PathBuf;
 
 use dhcd::{AnyHierarchy, Par, Workspace};
 
+use super::input::InputArgs;
 use super::query::QueryArgs;
 
 #[derive(clap::Args, Debug)]
@@ -14,12 +15,14 @@ pub struct CollideArgs {
     b: PathBuf,
     #[command(flatten)]
     query: QueryArgs,
+    #[command(flatten)]
+    input: InputArgs,
 }
 
 pub fn run(args: CollideArgs) -> dhcd::Result<()> {
     let q = &args.query;
-    let mesh_a = dhcd::io::load(&args.a)?;
-    let mesh_b = dhcd::io::load(&args.b)?;
+    let mesh_a = args.input.load(&args.a)?;
+    let mesh_b = args.input.load(&args.b)?;
     let mut a = AnyHierarchy::new(q.method, &mesh_a, q.options())?;
     let mut b = AnyHierarchy::new(q.method, &mesh_b, q.options())?;
     let contacts = a.collide(&mut b, &mut Workspace::default(), Par::Seq)?;

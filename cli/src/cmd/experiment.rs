@@ -1,12 +1,15 @@
 //! `dhcd experiment [--frames N] [--levels N] [--methods dh,sphere,aabb] [--threads N]
-//! [--seed S] [--out DIR] [--mesh FILE]`: the paper's experiment and the cost-model report.
+//! [--seed S] [--out DIR] [--mesh FILE] [--max-file-bytes N]`: the paper's experiment and the
+//! cost-model report.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use dhcd::Method;
+use dhcd::{Method, Par};
 use dhcd_cli::experiment::{self, output, Config, Phase};
 use indicatif::{ProgressBar, ProgressStyle};
+
+use super::input::InputArgs;
 
 #[derive(clap::Args, Debug)]
 pub struct ExperimentArgs {
@@ -19,9 +22,10 @@ pub struct ExperimentArgs {
     /// Methods to compare, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = Method::ALL, value_parser = super::method_parser(), ignore_case = true)]
     methods: Vec<Method>,
-    /// Threads of each query (1: sequential). Counters and contacts do not depend on it.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1024))]
-    threads: u64,
+    /// Threads of each query (1: sequential; 0: all cores; at most 1024, and never more than
+    /// the machine has). Counters and contacts do not depend on it.
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
     /// Seed of the scene.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -34,19 +38,23 @@ pub struct ExperimentArgs {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    #[command(flatten)]
+    input: InputArgs,
 }
 
 pub fn run(args: ExperimentArgs) -> Result<(), String> {
     let start = Instant::now();
+    // Bad options before any file is read.
+    Par::threads(args.threads).map_err(|e| e.to_string())?;
     let mesh = match &args.mesh {
-        Some(p) => Some(dhcd::io::load(p).map_err(|e| e.to_string())?),
+        Some(p) => Some(args.input.load(p).map_err(|e| e.to_string())?),
         None => None,
     };
     let config = Config {
         frames: args.frames as usize,
         levels: args.levels,
         methods: args.methods.clone(),
-        threads: args.threads as usize,
+        threads: args.threads,
         seed: args.seed,
         mesh,
         ..Config::default()

@@ -2,17 +2,24 @@
 
 mod collide;
 mod experiment;
+mod input;
 mod query;
 mod scene;
 mod self_cmd;
 
+use std::ffi::OsString;
+
 use clap::{Parser, Subcommand};
+use dhcd::error::escaped;
 
 #[derive(Parser, Debug)]
 #[command(
     name = "dhcd",
     version,
-    about = "Collision detection between deformable triangle meshes (Distance Hierarchy, sphere and AABB hierarchies)"
+    about = "Collision detection between deformable triangle meshes (Distance Hierarchy, sphere and AABB hierarchies)",
+    // `dhcd` alone is an error naming the missing subcommand, not the help text.
+    subcommand_required = true,
+    arg_required_else_help = false
 )]
 struct Cli {
     #[command(subcommand)]
@@ -34,13 +41,11 @@ enum Command {
 
 /// Parses the arguments, runs the command, returns the process exit code.
 pub fn run() -> i32 {
-    let cli = match Cli::try_parse() {
+    let args: Vec<OsString> = std::env::args_os().collect();
+    let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
-        // Usage errors: clap's first line only (one line on stderr, like every failure).
         Err(e) if e.use_stderr() => {
-            let text = e.render().to_string();
-            let line = text.lines().next().unwrap_or("error: invalid arguments");
-            warn(&format!("dhcd: {line}"));
+            warn(&format!("dhcd: {}", usage_error(e, &args)));
             return 2;
         }
         Err(e) => {
@@ -71,17 +76,51 @@ pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = dhcd::Met
     PossibleValuesParser::new(values).try_map(|name| name.parse::<dhcd::Method>())
 }
 
-/// Writes `text` to standard output. A reader that went away (broken pipe, as in
-/// `dhcd collide a.obj b.obj | head`) is not an error: there is nobody left to tell.
+/// Writes `text` to standard output (see [`emit_with`]).
 pub fn emit(text: &str) -> dhcd::Result<()> {
+    emit_with(|out| out.write_all(text.as_bytes()))
+}
+
+/// Writes to standard output through a buffer as `write` produces the output, so that a large
+/// report is never held whole in memory. A reader that went away (broken pipe, as in
+/// `dhcd collide a.obj b.obj | head`) is not an error: there is nobody left to tell.
+pub fn emit_with(
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> dhcd::Result<()> {
     use std::io::Write;
-    let mut out = std::io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
+    match write(&mut out).and_then(|()| out.flush()) {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(dhcd::Error::Io {
             path: "<standard output>".into(),
             message: e.to_string(),
         }),
         _ => Ok(()),
+    }
+}
+
+/// A usage error as one printable line that names what is wrong: clap's message without its
+/// usage section, its lines joined (clap lists missing arguments on lines of their own).
+fn usage_error(e: clap::Error, args: &[OsString]) -> String {
+    // clap echoes arguments as given; printable copies of them fail the same way, so their
+    // message is the one to show (a path with a newline must not split the line).
+    let shown: Vec<String> = args
+        .iter()
+        .map(|a| escaped(&a.to_string_lossy()).into_owned())
+        .collect();
+    let e = match Cli::try_parse_from(&shown) {
+        Err(again) if again.kind() == e.kind() => again,
+        _ => e,
+    };
+    let text = e.render().to_string();
+    let message = text.split("\n\n").next().unwrap_or_default();
+    let line: Vec<&str> = message
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    match line.join(" ") {
+        l if l.is_empty() => "error: invalid arguments".to_string(),
+        l => escaped(&l).into_owned(),
     }
 }
 

@@ -1,8 +1,9 @@
 //! What `collide`, `self` and `scene` share: the hierarchy flags and the contact report
 //! (one JSON object with `--json`, otherwise a summary line and one contact per line).
 
+use std::io::Write;
+
 use dhcd::{Counters, Method, Options};
-use serde_json::json;
 
 #[derive(clap::Args, Debug)]
 pub struct QueryArgs {
@@ -33,6 +34,9 @@ impl QueryArgs {
     /// Prints the contacts (`rows`, each a contact's indices) and counters. `what` names
     /// the contacts in the text summary, e.g. "contacts" or "self-contacts".
     /// `levels` is the depth of the built trees (the deepest, for several objects).
+    ///
+    /// The report is streamed row by row: a query with millions of contacts needs no memory
+    /// beyond the library's own contact array.
     pub fn report<const N: usize, T: Copy + Into<u64>>(
         &self,
         what: &str,
@@ -40,14 +44,26 @@ impl QueryArgs {
         rows: &[[T; N]],
         counters: Counters,
     ) -> dhcd::Result<()> {
-        use std::fmt::Write;
-        let rows: Vec<[u64; N]> = rows.iter().map(|r| r.map(Into::into)).collect();
-        if self.json {
-            return super::emit(&format!("{}\n", self.json_value(levels, &rows, counters)));
-        }
-        let mut text = String::new();
-        let _ = writeln!(
-            text,
+        super::emit_with(|out| {
+            if self.json {
+                self.write_json(out, levels, rows, counters)
+            } else {
+                self.write_text(out, what, levels, rows, counters)
+            }
+        })
+    }
+
+    /// A summary line, then one line per contact.
+    fn write_text<const N: usize, T: Copy + Into<u64>>(
+        &self,
+        out: &mut dyn Write,
+        what: &str,
+        levels: usize,
+        rows: &[[T; N]],
+        counters: Counters,
+    ) -> std::io::Result<()> {
+        writeln!(
+            out,
             "{} {what} ({} levels, {} bytes per node): {} BV pairs tested, {} triangle pairs tested, {} BV updates",
             rows.len(),
             levels,
@@ -55,32 +71,53 @@ impl QueryArgs {
             counters.bv_tests,
             counters.prim_tests,
             counters.bv_updates
-        );
-        for row in &rows {
-            let line: Vec<String> = row.iter().map(u64::to_string).collect();
-            let _ = writeln!(text, "{}", line.join(" "));
+        )?;
+        for row in rows {
+            for (i, &x) in row.iter().enumerate() {
+                let x: u64 = x.into();
+                if i == 0 {
+                    write!(out, "{x}")?;
+                } else {
+                    write!(out, " {x}")?;
+                }
+            }
+            writeln!(out)?;
         }
-        super::emit(&text)
+        Ok(())
     }
 
-    /// `{"method", "levels", "bytes_per_node", "pairs", "counters"}`, keys in this order.
-    fn json_value<const N: usize>(
+    /// One compact JSON object and a newline: `{"method", "levels", "bytes_per_node",
+    /// "pairs", "counters"}`, keys in this order, the bytes `serde_json` prints for it.
+    fn write_json<const N: usize, T: Copy + Into<u64>>(
         &self,
+        out: &mut dyn Write,
         levels: usize,
-        rows: &[[u64; N]],
+        rows: &[[T; N]],
         counters: Counters,
-    ) -> serde_json::Value {
-        json!({
-            "method": self.method.name(),
-            "levels": levels,
-            "bytes_per_node": self.method.bytes_per_node(),
-            "pairs": rows.iter().map(|r| r.to_vec()).collect::<Vec<_>>(),
-            "counters": {
-                "bv_tests": counters.bv_tests,
-                "prim_tests": counters.prim_tests,
-                "bv_updates": counters.bv_updates,
-                "contacts": counters.contacts,
-            },
-        })
+    ) -> std::io::Result<()> {
+        out.write_all(b"{\"method\":")?;
+        serde_json::to_writer(&mut *out, self.method.name())?;
+        write!(
+            out,
+            ",\"levels\":{levels},\"bytes_per_node\":{},\"pairs\":[",
+            self.method.bytes_per_node()
+        )?;
+        for (k, row) in rows.iter().enumerate() {
+            out.write_all(if k == 0 { b"[" } else { b",[" })?;
+            for (i, &x) in row.iter().enumerate() {
+                let x: u64 = x.into();
+                if i == 0 {
+                    write!(out, "{x}")?;
+                } else {
+                    write!(out, ",{x}")?;
+                }
+            }
+            out.write_all(b"]")?;
+        }
+        writeln!(
+            out,
+            "],\"counters\":{{\"bv_tests\":{},\"prim_tests\":{},\"bv_updates\":{},\"contacts\":{}}}}}",
+            counters.bv_tests, counters.prim_tests, counters.bv_updates, counters.contacts
+        )
     }
 }

@@ -1,10 +1,12 @@
-//! `dhcd scene MESH... [--method dh|sphere|aabb] [--levels N] [--self-collision] [--json]`
+//! `dhcd scene MESH... [--method dh|sphere|aabb] [--levels N] [--self-collision] [--threads N]
+//! [--json] [--max-file-bytes N]`
 
 use std::path::PathBuf;
 
 use dhcd::scene::Scene;
 use dhcd::Par;
 
+use super::input::InputArgs;
 use super::query::QueryArgs;
 
 #[derive(clap::Args, Debug)]
@@ -17,23 +19,23 @@ pub struct SceneArgs {
     /// Also report each object's self-contacts (as `[k, ti, k, tj]`).
     #[arg(long)]
     self_collision: bool,
-    /// Threads (1: the calling thread; 0: all cores). The output does not depend on it.
+    /// Threads (1: the calling thread; 0: all cores; at most 1024, and never more than the
+    /// machine has). The output does not depend on it.
     #[arg(long, default_value_t = 1)]
     threads: usize,
+    #[command(flatten)]
+    input: InputArgs,
 }
 
 pub fn run(args: SceneArgs) -> dhcd::Result<()> {
     let q = &args.query;
+    let par = Par::threads(args.threads)?;
     let mut scene = Scene::new(q.method, q.options());
     for path in &args.meshes {
-        let mesh = dhcd::io::load(path)?;
+        let mesh = args.input.load(path)?;
         let id = scene.add(&mesh)?;
         scene.set_self_collision(id, args.self_collision)?;
     }
-    let par = match args.threads {
-        1 => Par::Seq,
-        n => Par::Rayon(n),
-    };
     let contacts = scene.contacts(par);
     let what = format!(
         "contacts between {} objects ({} object pairs past the broad phase)",

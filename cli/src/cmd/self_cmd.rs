@@ -1,9 +1,10 @@
-//! `dhcd self MESH [--method dh|sphere|aabb] [--levels N] [--json]`
+//! `dhcd self MESH [--method dh|sphere|aabb] [--levels N] [--json] [--max-file-bytes N]`
 
 use std::path::PathBuf;
 
 use dhcd::{AnyHierarchy, Par, Workspace};
 
+use super::input::InputArgs;
 use super::query::QueryArgs;
 
 #[derive(clap::Args, Debug)]
@@ -12,11 +13,13 @@ pub struct SelfArgs {
     mesh: PathBuf,
     #[command(flatten)]
     query: QueryArgs,
+    #[command(flatten)]
+    input: InputArgs,
 }
 
 pub fn run(args: SelfArgs) -> dhcd::Result<()> {
     let q = &args.query;
-    let mesh = dhcd::io::load(&args.mesh)?;
+    let mesh = args.input.load(&args.mesh)?;
     let mut h = AnyHierarchy::new(q.method, &mesh, q.options())?;
     let contacts = h.self_collide(&mut Workspace::default(), Par::Seq);
     q.report(

@@ -79,7 +79,8 @@ pub struct Config {
     pub levels: usize,
     /// Methods to measure, in report order (no duplicates).
     pub methods: Vec<Method>,
-    /// 1: sequential ([`Par::Seq`]); n > 1: [`Par::Rayon`]`(n)`.
+    /// Threads of each query, as [`Par::threads`] takes them: 1 sequential, 0 all cores,
+    /// `n` at most the machine's threads; above [`dhcd::par::MAX_THREADS`] an error.
     pub threads: usize,
     /// Seed of the scene (object turns, wobble phases).
     pub seed: u64,
@@ -113,19 +114,15 @@ impl Default for Config {
 }
 
 impl Config {
-    /// The parallelism of the queries.
-    pub fn par(&self) -> Par {
-        if self.threads <= 1 {
-            Par::Seq
-        } else {
-            Par::Rayon(self.threads)
-        }
+    /// The parallelism of the queries (checked by [`Par::threads`]).
+    pub fn par(&self) -> Result<Par, Error> {
+        Par::threads(self.threads)
     }
 
     fn check(&self) -> Result<(), ExperimentError> {
+        // Threads: 0 is all cores; `Par::threads` checks the range.
         let counts = [
             ("frames", self.frames),
-            ("threads", self.threads),
             ("timing_reps", self.timing_reps),
             ("calibration_reps", self.calibration_reps),
             ("calibration_frames", self.calibration_frames),
@@ -133,6 +130,7 @@ impl Config {
         if let Some((name, _)) = counts.into_iter().find(|&(_, n)| n == 0) {
             return Err(ExperimentError::ZeroCount(name));
         }
+        self.par()?;
         if self.methods.is_empty() {
             return Err(ExperimentError::NoMethods);
         }
@@ -179,6 +177,7 @@ pub struct SceneInfo {
     pub nodes_per_hierarchy: usize,
     pub frames: usize,
     pub levels: usize,
+    /// Threads the queries actually ran on.
     pub threads: usize,
     pub seed: u64,
     /// Object pairs queried per step.
@@ -403,7 +402,7 @@ pub fn run(
         nodes_per_hierarchy: trees[0].node_count(),
         frames: config.frames,
         levels: config.levels,
-        threads: config.threads,
+        threads: config.par()?.thread_count(),
         seed: config.seed,
         object_pairs: pairs.len(),
     };
@@ -426,7 +425,7 @@ fn simulate(
     config: &Config,
     progress: &mut dyn FnMut(Phase, usize, usize),
 ) -> Result<Frames, ExperimentError> {
-    let par = config.par();
+    let par = config.par()?;
     let mut dh: Vec<AnyHierarchy> = meshes
         .iter()
         .zip(trees)
@@ -480,7 +479,7 @@ fn measure(
     config: &Config,
     progress: &mut dyn FnMut(Phase, usize, usize),
 ) -> Result<Measured, ExperimentError> {
-    let par = config.par();
+    let par = config.par()?;
     let methods = &config.methods;
     let mut ws = Workspace::default();
     let mut steps: Vec<Vec<Step>> = vec![Vec::with_capacity(config.frames); methods.len()];

@@ -38,6 +38,20 @@ pub enum SimError {
     Unstable { stiffness: f64, substep: f64 },
     #[error("a simulation needs at least one object")]
     NoObjects,
+    /// The copies of a mesh laid out side by side leave the f32 range: the file's
+    /// coordinates are finite, the scene's are not.
+    #[error(
+        "the mesh is too large for the experiment's scene: placed as copy {copy} \
+         (spacing {spacing:.3e}), its vertex {vertex} lands at ({:.3e} {:.3e} {:.3e}), beyond \
+         the f32 range; the file's coordinates are finite: scale the mesh down",
+        at[0], at[1], at[2]
+    )]
+    SceneTooLarge {
+        copy: usize,
+        vertex: usize,
+        spacing: f64,
+        at: [f64; 3],
+    },
     #[error("too many objects ({0})")]
     TooManyObjects(usize),
     #[error(transparent)]

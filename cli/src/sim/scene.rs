@@ -46,16 +46,24 @@ pub fn scene_with_mesh(mesh: Mesh, config: &SimConfig) -> Result<Simulation, Sim
         let angle =
             (splitmix64(&mut state) >> 11) as f64 / (1u64 << 53) as f64 * std::f64::consts::TAU;
         let (s, c) = angle.sin_cos();
-        let positions = mesh
-            .positions()
-            .iter()
-            .map(|p| {
-                let q = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - centre;
-                let turned = DVec3::new(c * q.x + s * q.z, q.y, -s * q.x + c * q.z);
-                let r = turned + offset;
-                [r.x as f32, r.y as f32, r.z as f32]
-            })
-            .collect();
+        let mut positions = Vec::with_capacity(mesh.vertex_count());
+        for (v, p) in mesh.positions().iter().enumerate() {
+            let q = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) - centre;
+            let turned = DVec3::new(c * q.x + s * q.z, q.y, -s * q.x + c * q.z);
+            let r = turned + offset;
+            let placed = [r.x as f32, r.y as f32, r.z as f32];
+            // The file's coordinates are finite (a `Mesh`); only the layout can overflow, and
+            // then the message must not blame the file.
+            if !placed.iter().all(|x| x.is_finite()) {
+                return Err(SimError::SceneTooLarge {
+                    copy: k,
+                    vertex: v,
+                    spacing,
+                    at: r.to_array(),
+                });
+            }
+            positions.push(placed);
+        }
         objects.push(Mesh::new(positions, mesh.triangles().to_vec())?);
     }
     Simulation::new(objects, config.clone())
