@@ -16,7 +16,7 @@
 //! Memory does not grow with the work: the stack holds at most
 //! `depth * (MAX_CHILDREN + MAX_CHILDREN^2 / 2)` pairs, and the only output is the contact
 //! list. Lazy refit happens in the same walk: a sibling group is fitted right before its
-//! first test in a step (see [`LazySoa`](crate::lazy)), whichever thread gets there first.
+//! first test in a step (see [`LazyTiles`](dhcd_kernels::lazy::LazyTiles)), whichever thread gets there first.
 //!
 //! Parallelism: the walk is expanded breadth-first on the calling thread until there are
 //! enough pairs to share, then each pair is walked depth-first as a rayon task. Every pair

@@ -54,7 +54,7 @@ mod sealed {
 /// [`crate::kinds`], the set the library compares; everything generic over them is
 /// monomorphised (no per-node dispatch).
 ///
-/// Node bounds live in [`LazySoa`] buffers grouped by *sibling group* (the children of one
+/// Node bounds live in [`LazyTiles`] buffers grouped by *sibling group* (the children of one
 /// node, [`RegionTree::group_nodes`]): a group is fitted as a whole, just before its first
 /// test in a step, by whichever thread needs it first. A wide test reads one node of a
 /// fitted group against a block of another fitted group.
