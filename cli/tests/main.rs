@@ -1,6 +1,7 @@
 //! One integration-test binary for the command line, the experiment and the simulator; each
 //! module is a suite.
 
+mod bench;
 mod cli;
 mod cli_collide;
 mod experiment;

@@ -1,5 +1,6 @@
 //! Command-line front end. Every failure is one line on stderr and a non-zero exit code.
 
+mod bench;
 mod collide;
 mod experiment;
 mod input;
@@ -37,6 +38,9 @@ enum Command {
     Scene(scene::SceneArgs),
     /// The paper's experiment (eight deforming pawns) and the cost-model report.
     Experiment(experiment::ExperimentArgs),
+    /// Time the steps of a deforming mesh (or pair) given as frames: build once, then
+    /// update + query per frame.
+    Bench(bench::BenchArgs),
 }
 
 /// Parses the arguments, runs the command, returns the process exit code.
@@ -58,6 +62,7 @@ pub fn run() -> i32 {
         Command::SelfCollide(args) => self_cmd::run(args).map_err(|e| e.to_string()),
         Command::Scene(args) => scene::run(args).map_err(|e| e.to_string()),
         Command::Experiment(args) => experiment::run(args),
+        Command::Bench(args) => bench::run(args),
     };
     match result {
         Ok(()) => 0,

@@ -1,0 +1,250 @@
+//! `dhcd bench self FRAME...` and `dhcd bench collide --a FRAME... --b FRAME...`: the
+//! microbenchmark users run on their own meshes. Builds once on the first frame, then
+//! cycles `update_positions` through the frames, timing each step (update + query); reports
+//! the build time, the median and least step time, and each frame's contacts and counters.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use dhcd::{AnyHierarchy, Counters, Mesh, Method, Options, Par, Workspace};
+use serde_json::json;
+
+use super::input::InputArgs;
+
+/// Most passes over the frames (`--repeat`): a typo must not start a day-long run.
+const MAX_REPEAT: usize = 10_000;
+
+#[derive(clap::Args, Debug)]
+#[command(subcommand_required = true, arg_required_else_help = false)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    what: What,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum What {
+    /// Self-collision of one deforming mesh; FRAME... are its poses (the same triangles,
+    /// new vertex positions).
+    #[command(name = "self")]
+    SelfCollide {
+        /// The poses (OBJ, STL or PLY), in order.
+        #[arg(required = true)]
+        frames: Vec<PathBuf>,
+        #[command(flatten)]
+        opts: Opts,
+    },
+    /// Contacts between two deforming meshes: the i-th step uses `--a` frame i and `--b`
+    /// frame i (each list cycles).
+    Collide {
+        /// Poses of the first mesh.
+        #[arg(long, num_args = 1.., required = true)]
+        a: Vec<PathBuf>,
+        /// Poses of the second mesh.
+        #[arg(long, num_args = 1.., required = true)]
+        b: Vec<PathBuf>,
+        #[command(flatten)]
+        opts: Opts,
+    },
+}
+
+#[derive(clap::Args, Debug)]
+struct Opts {
+    /// Bounding-volume hierarchy: dh, sphere, aabb, or all (one result each).
+    #[arg(long, default_value = "dh")]
+    method: String,
+    /// A fixed depth for the region tree (the paper uses 5). Default: an adaptive tree.
+    #[arg(long)]
+    levels: Option<usize>,
+    /// Largest number of triangles per leaf of the adaptive tree.
+    #[arg(long, default_value_t = dhcd::tree::DEFAULT_LEAF_SIZE)]
+    leaf_size: usize,
+    /// Threads of each query (1: the calling thread). Results do not depend on it.
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+    /// Passes over the frames (each pass times one step per frame).
+    #[arg(long, default_value_t = 5)]
+    repeat: usize,
+    /// Print JSON (an object, or an array of objects with `--method all`).
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    input: InputArgs,
+}
+
+/// One method's measurement.
+struct Run {
+    method: Method,
+    build_ms: f64,
+    steps_ms: Vec<f64>,
+    /// Per frame: contacts and counters (of the last pass; every pass gives the same).
+    frames: Vec<Counters>,
+}
+
+pub fn run(args: BenchArgs) -> Result<(), String> {
+    let (opts, a, b) = match &args.what {
+        What::SelfCollide { frames, opts } => (opts, load_frames(&opts.input, frames)?, None),
+        What::Collide { a, b, opts } => (
+            opts,
+            load_frames(&opts.input, a)?,
+            Some(load_frames(&opts.input, b)?),
+        ),
+    };
+    let methods: Vec<Method> = if opts.method.eq_ignore_ascii_case("all") {
+        Method::ALL.to_vec()
+    } else {
+        vec![opts.method.parse::<Method>().map_err(|e| e.to_string())?]
+    };
+    if opts.repeat == 0 || opts.repeat > MAX_REPEAT {
+        return Err(format!(
+            "--repeat must be between 1 and {MAX_REPEAT}, got {}",
+            opts.repeat
+        ));
+    }
+    let par = Par::threads(opts.threads).map_err(|e| e.to_string())?;
+    let threads = par.thread_count();
+    let options = Options {
+        levels: opts.levels,
+        leaf_size: opts.leaf_size,
+        ..Options::default()
+    };
+    let steps = a.len().max(b.as_ref().map_or(0, Vec::len));
+    let mut runs = Vec::new();
+    for &method in &methods {
+        let t = Instant::now();
+        let mut ha = AnyHierarchy::new(method, &a[0], options).map_err(|e| e.to_string())?;
+        let mut hb = match &b {
+            Some(b) => Some(AnyHierarchy::new(method, &b[0], options).map_err(|e| e.to_string())?),
+            None => None,
+        };
+        let build_ms = t.elapsed().as_secs_f64() * 1e3;
+        let mut ws = Workspace::default();
+        let mut steps_ms = Vec::with_capacity(opts.repeat * steps);
+        let mut frames = vec![Counters::default(); steps];
+        for _ in 0..opts.repeat {
+            for (k, counters) in frames.iter_mut().enumerate() {
+                let t = Instant::now();
+                ha.update_positions(a[k % a.len()].positions())
+                    .map_err(|e| e.to_string())?;
+                let c = match (&mut hb, &b) {
+                    (Some(hb), Some(b)) => {
+                        hb.update_positions(b[k % b.len()].positions())
+                            .map_err(|e| e.to_string())?;
+                        ha.collide(hb, &mut ws, par).map_err(|e| e.to_string())?
+                    }
+                    _ => ha.self_collide(&mut ws, par),
+                };
+                steps_ms.push(t.elapsed().as_secs_f64() * 1e3);
+                *counters = c.counters;
+            }
+        }
+        runs.push(Run {
+            method,
+            build_ms,
+            steps_ms,
+            frames,
+        });
+    }
+    let out = if opts.json {
+        let values: Vec<serde_json::Value> = runs.iter().map(|r| to_json(r, threads)).collect();
+        let v = if methods.len() == 1 {
+            values.into_iter().next().unwrap_or_default()
+        } else {
+            serde_json::Value::Array(values)
+        };
+        format!("{v}\n")
+    } else {
+        text(&runs, opts.repeat, threads, &a, b.as_deref())
+    };
+    super::emit(&out).map_err(|e| e.to_string())
+}
+
+/// Loads the poses; every one must have the first one's triangles.
+fn load_frames(input: &InputArgs, paths: &[PathBuf]) -> Result<Vec<Mesh>, String> {
+    let mut frames: Vec<Mesh> = Vec::new();
+    for path in paths {
+        let m = input.load(path).map_err(|e| e.to_string())?;
+        if let Some(first) = frames.first() {
+            if m.vertex_count() != first.vertex_count() || m.triangles() != first.triangles() {
+                return Err(format!(
+                    "{}: not a pose of {} (a frame must have the first frame's vertices and triangles)",
+                    shown(path),
+                    shown(&paths[0])
+                ));
+            }
+        }
+        frames.push(m);
+    }
+    Ok(frames)
+}
+
+fn shown(p: &Path) -> String {
+    dhcd::error::escaped_path(p)
+}
+
+/// Median and least of `xs` (non-empty).
+fn median_min(xs: &[f64]) -> (f64, f64) {
+    let mut s = xs.to_vec();
+    s.sort_by(f64::total_cmp);
+    (s[s.len() / 2], s[0])
+}
+
+fn counters_json(c: &Counters) -> serde_json::Value {
+    json!({
+        "bv_tests": c.bv_tests,
+        "prim_tests": c.prim_tests,
+        "bv_updates": c.bv_updates,
+        "contacts": c.contacts,
+    })
+}
+
+/// `{"method", "threads", "build_ms", "step_ms": {"median", "min"}, "frames": [{"contacts",
+/// "counters"}...]}`.
+fn to_json(r: &Run, threads: usize) -> serde_json::Value {
+    let (median, min) = median_min(&r.steps_ms);
+    json!({
+        "method": r.method.name(),
+        "threads": threads,
+        "build_ms": r.build_ms,
+        "step_ms": { "median": median, "min": min },
+        "frames": r.frames.iter().map(|c| json!({
+            "contacts": c.contacts,
+            "counters": counters_json(c),
+        })).collect::<Vec<_>>(),
+    })
+}
+
+fn text(runs: &[Run], repeat: usize, threads: usize, a: &[Mesh], b: Option<&[Mesh]>) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let what = match b {
+        None => format!("self-collision of {} triangles", a[0].triangle_count()),
+        Some(b) => format!(
+            "{} against {} triangles",
+            a[0].triangle_count(),
+            b[0].triangle_count()
+        ),
+    };
+    let _ = writeln!(
+        s,
+        "{what}, {} steps per pass, {} passes, {} thread(s)",
+        runs.first().map_or(0, |r| r.frames.len()),
+        repeat,
+        threads
+    );
+    for r in runs {
+        let (median, min) = median_min(&r.steps_ms);
+        let _ = writeln!(
+            s,
+            "{}: build {:.2} ms; step median {:.3} ms, min {:.3} ms",
+            r.method, r.build_ms, median, min
+        );
+        for (k, c) in r.frames.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "  step {k}: {} contacts; {} BV tests, {} triangle pairs, {} BV updates",
+                c.contacts, c.bv_tests, c.prim_tests, c.bv_updates
+            );
+        }
+    }
+    s
+}

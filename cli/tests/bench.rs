@@ -1,0 +1,202 @@
+//! `dhcd bench`: the microbenchmark users run on their own frames. Its contacts per frame
+//! are the ones `dhcd self` / `dhcd collide` find on each frame alone (the tree is built on
+//! the first frame and refitted, never rebuilt), for every method and thread count; bad
+//! input is one error line.
+
+use std::path::{Path, PathBuf};
+
+use dhcd::shapes::{grid, icosphere, wave};
+use dhcd::Mesh;
+use serde_json::Value;
+
+use crate::support::{run_dhcd as dhcd, temp_dir, write_obj};
+
+/// Frames of one mesh of two sheets, a waving one and a vertical one sliding through it: the
+/// sheets cross in some frames and not in others.
+fn crossing_sheets(dir: &Path, frames: usize) -> Vec<PathBuf> {
+    let flat = grid(16, 16, 0.1, [0.0; 3]);
+    let n = flat.vertex_count() as u32;
+    let mut triangles = flat.triangles().to_vec();
+    triangles.extend(flat.triangles().iter().map(|t| t.map(|v| v + n)));
+    (0..frames)
+        .map(|k| {
+            let mut positions = wave(flat.positions(), k as f32, 0.05, [0.0; 3]);
+            // The second sheet stands in the plane x = const, moving along x.
+            let x = 0.5 + 0.9 * k as f32;
+            positions.extend(flat.positions().iter().map(|p| [x, p[0] - 0.2, p[1] - 0.8]));
+            let pose = Mesh::new(positions, triangles.clone()).unwrap();
+            let path = dir.join(format!("sheets-{k}.obj"));
+            write_obj(&pose, &path);
+            path
+        })
+        .collect()
+}
+
+/// Frames of a sphere moving through another.
+fn passing_sphere(dir: &Path, frames: usize) -> (Vec<PathBuf>, PathBuf) {
+    let fixed = icosphere(2, 1.0, [0.0; 3]);
+    let fixed_path = dir.join("fixed.obj");
+    write_obj(&fixed, &fixed_path);
+    let moving = (0..frames)
+        .map(|k| {
+            let m = icosphere(2, 0.6, [2.0 - 0.8 * k as f32, 0.1, 0.0]);
+            let path = dir.join(format!("moving-{k}.obj"));
+            write_obj(&m, &path);
+            path
+        })
+        .collect();
+    (moving, fixed_path)
+}
+
+fn strs(paths: &[PathBuf]) -> Vec<&str> {
+    paths.iter().map(|p| p.to_str().unwrap()).collect()
+}
+
+fn json_of(args: &[&str]) -> Value {
+    let out = dhcd(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Contacts of `dhcd self|collide ... --json` on one frame.
+fn contacts_alone(args: &[&str]) -> u64 {
+    json_of(args)["counters"]["contacts"].as_u64().unwrap()
+}
+
+/// Checks one bench result's shape and returns its contacts per frame.
+fn frame_contacts(run: &Value, method: &str, threads: u64, frames: usize) -> Vec<u64> {
+    assert_eq!(run["method"], method, "{run}");
+    assert_eq!(run["threads"], threads, "{run}");
+    assert!(run["build_ms"].as_f64().unwrap() >= 0.0, "{run}");
+    let (median, min) = (
+        run["step_ms"]["median"].as_f64().unwrap(),
+        run["step_ms"]["min"].as_f64().unwrap(),
+    );
+    assert!(0.0 <= min && min <= median, "{run}");
+    let list = run["frames"].as_array().unwrap();
+    assert_eq!(list.len(), frames, "{run}");
+    list.iter()
+        .map(|f| {
+            let contacts = f["contacts"].as_u64().unwrap();
+            assert_eq!(f["counters"]["contacts"].as_u64(), Some(contacts), "{run}");
+            assert!(f["counters"]["bv_tests"].as_u64().unwrap() > 0, "{run}");
+            contacts
+        })
+        .collect()
+}
+
+#[test]
+fn self_bench_finds_each_frames_contacts_with_every_method_and_thread_count() {
+    let dir = temp_dir("bench-self");
+    let frames = crossing_sheets(&dir, 3);
+    let expected: Vec<u64> = frames
+        .iter()
+        .map(|f| contacts_alone(&["self", f.to_str().unwrap(), "--json"]))
+        .collect();
+    assert!(
+        expected.iter().any(|&c| c > 0) && expected.contains(&0),
+        "the sheets must cross in some frames only: {expected:?}"
+    );
+    for threads in ["1", "2"] {
+        let mut args = vec!["bench", "self"];
+        args.extend(strs(&frames));
+        args.extend([
+            "--method",
+            "all",
+            "--repeat",
+            "2",
+            "--json",
+            "--threads",
+            threads,
+        ]);
+        let runs = json_of(&args);
+        let runs = runs.as_array().unwrap();
+        let used = dhcd::Par::threads(threads.parse().unwrap())
+            .unwrap()
+            .thread_count() as u64;
+        for (run, method) in runs.iter().zip(["dh", "sphere", "aabb"]) {
+            assert_eq!(frame_contacts(run, method, used, 3), expected, "{method}");
+        }
+        assert_eq!(runs.len(), 3);
+    }
+}
+
+#[test]
+fn collide_bench_finds_each_frames_contacts_and_cycles_the_shorter_list() {
+    let dir = temp_dir("bench-collide");
+    let (moving, fixed) = passing_sphere(&dir, 4);
+    let fixed = fixed.to_str().unwrap();
+    let expected: Vec<u64> = moving
+        .iter()
+        .map(|m| contacts_alone(&["collide", m.to_str().unwrap(), fixed, "--json"]))
+        .collect();
+    assert!(
+        expected.iter().any(|&c| c > 0) && expected.contains(&0),
+        "{expected:?}"
+    );
+    let mut args = vec!["bench", "collide", "--a"];
+    args.extend(strs(&moving));
+    args.extend(["--b", fixed, "--method", "aabb", "--json", "--repeat", "1"]);
+    let run = json_of(&args);
+    assert_eq!(frame_contacts(&run, "aabb", 1, 4), expected);
+}
+
+#[test]
+fn text_output_names_the_build_and_step_times_and_every_frame() {
+    let dir = temp_dir("bench-text");
+    let frames = crossing_sheets(&dir, 2);
+    let mut args = vec!["bench", "self"];
+    args.extend(strs(&frames));
+    let out = dhcd(&args);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("dh: build "), "{text}");
+    assert!(text.contains("step median "), "{text}");
+    assert!(
+        text.contains("  step 0: ") && text.contains("  step 1: "),
+        "{text}"
+    );
+}
+
+#[test]
+fn bad_input_is_one_error_line() {
+    let dir = temp_dir("bench-bad");
+    let frames = crossing_sheets(&dir, 1);
+    let frame = frames[0].to_str().unwrap();
+    let other = dir.join("other.obj");
+    write_obj(&icosphere(1, 1.0, [0.0; 3]), &other);
+    let other = other.to_str().unwrap();
+    let missing = dir.join("missing.obj");
+    let missing = missing.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["bench", "self", frame, other], "not a pose of"),
+        (vec!["bench", "self", frame, "--repeat", "0"], "--repeat"),
+        (
+            vec!["bench", "self", frame, "--repeat", "99999999"],
+            "--repeat",
+        ),
+        (vec!["bench", "self", frame, "--threads", "5000"], "threads"),
+        (vec!["bench", "self", frame, "--method", "obb"], "obb"),
+        (vec!["bench", "self", frame, "--leaf-size", "0"], "leaf"),
+        (vec!["bench", "self", missing], "missing.obj"),
+        (vec!["bench", "collide", "--a", frame], "--b"),
+        (vec!["bench", "self"], "FRAMES"),
+        (vec!["bench"], "subcommand"),
+    ];
+    for (args, needle) in cases {
+        let out = dhcd(&args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(out.stdout.is_empty(), "{args:?} printed a report");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err:?}");
+        assert!(err.starts_with("dhcd: "), "{args:?}: {err:?}");
+        assert!(
+            err.to_lowercase().contains(&needle.to_lowercase()),
+            "{args:?}: {err:?} should name {needle}"
+        );
+    }
+}
