@@ -8,6 +8,7 @@ mod io;
 mod kinds;
 mod mutation;
 mod narrow;
+mod real_frames;
 mod scene;
 mod self_collision;
 mod support;
