@@ -16,15 +16,25 @@
 //! 1M-triangle grids at 8 levels.
 
 use dhcd::shapes::{fold_x, grid, jitter, translated};
-use dhcd::{AnyHierarchy, Method, Options, Par, Workspace};
+use dhcd::{AnyHierarchy, Contacts, Method, Options, Par, Workspace};
 
 use crate::support::peak_bytes;
 
 /// The fixed part of the bound (see the module docs).
 const QUERY_SCRATCH_BOUND: usize = 1 << 20;
 
-fn bound(contacts: usize) -> usize {
-    2 * contacts * std::mem::size_of::<[u32; 2]>() + QUERY_SCRATCH_BOUND
+/// Asserts the bound on one query's peak, and that the query did millions of node tests and
+/// found many contacts (so the bound is tested where the old frontier was large).
+fn assert_bounded(what: &str, c: &Contacts, peak: usize) {
+    let contacts = c.pairs.len();
+    let bound = 2 * contacts * std::mem::size_of::<[u32; 2]>() + QUERY_SCRATCH_BOUND;
+    eprintln!(
+        "{what}: N_V {} N_P {} contacts {contacts}: peak {peak} bytes, bound {bound}",
+        c.counters.bv_tests, c.counters.prim_tests
+    );
+    assert!(c.counters.bv_tests >= 1_000_000, "{what}: too little work");
+    assert!(contacts >= 10_000, "{what}: the layers cross everywhere");
+    assert!(peak <= bound, "{what}: {peak} bytes, bound {bound}");
 }
 
 /// A `2 cells x cells` grid over `[0, 2] x [0, 1]` and z-noise of half a cell.
@@ -53,19 +63,7 @@ fn collide_scratch_does_not_grow_with_the_work() {
             ha.collide(&mut hb, &mut Workspace::default(), Par::Seq)
                 .unwrap()
         });
-        let contacts = c.pairs.len();
-        eprintln!(
-            "collide {method}: N_V {} N_P {} contacts {contacts}: peak {peak} bytes, bound {}",
-            c.counters.bv_tests,
-            c.counters.prim_tests,
-            bound(contacts)
-        );
-        assert!(
-            c.counters.bv_tests >= 1_000_000,
-            "{method}: too little work"
-        );
-        assert!(contacts >= 10_000, "{method}: the grids cross everywhere");
-        assert!(peak <= bound(contacts), "{method}: {peak} bytes");
+        assert_bounded(&format!("collide {method}"), &c, peak);
     }
 }
 
@@ -83,18 +81,6 @@ fn self_collide_scratch_does_not_grow_with_the_work() {
         let mut h = AnyHierarchy::new(method, &rest, Options::default()).unwrap();
         h.update_positions(&folded).unwrap();
         let (c, peak) = peak_bytes(|| h.self_collide(&mut Workspace::default(), Par::Seq));
-        let contacts = c.pairs.len();
-        eprintln!(
-            "self {method}: N_V {} N_P {} contacts {contacts}: peak {peak} bytes, bound {}",
-            c.counters.bv_tests,
-            c.counters.prim_tests,
-            bound(contacts)
-        );
-        assert!(
-            c.counters.bv_tests >= 1_000_000,
-            "{method}: too little work"
-        );
-        assert!(contacts >= 10_000, "{method}: the layers cross everywhere");
-        assert!(peak <= bound(contacts), "{method}: {peak} bytes");
+        assert_bounded(&format!("self {method}"), &c, peak);
     }
 }
