@@ -119,3 +119,49 @@ pub fn wave(rest: &[[f32; 3]], t: f32, amplitude: f32, offset: [f32; 3]) -> Vec<
         })
         .collect()
 }
+
+/// `positions` each moved by deterministic noise, uniform in `[-amplitude[k], amplitude[k]]`
+/// along axis `k` (independent per vertex and axis, from a hash of `seed` and the vertex
+/// index, so the same arguments always give the same positions). For noisy test and bench
+/// scenes: a near-flat grid is `jitter(grid.positions(), [0.0, 0.0, 1e-4], seed)`.
+pub fn jitter(positions: &[[f32; 3]], amplitude: [f32; 3], seed: u64) -> Vec<[f32; 3]> {
+    positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let mut state = seed ^ (i as u64).wrapping_mul(0xD1B5_4A32_D192_ED03);
+            std::array::from_fn(|k| {
+                // A uniform number in [-1, 1) from a splitmix64 draw.
+                let u = (splitmix64(&mut state) >> 40) as f32 / (1u32 << 23) as f32 - 1.0;
+                p[k] + amplitude[k] * u
+            })
+        })
+        .collect()
+}
+
+/// `positions` folded across the plane `x = at`: every vertex beyond it (`x > at`) is
+/// mirrored back (`x -> 2 at - x`), so a flat sheet's far part lies on its near part. With a
+/// [`grid`] whose cells divide `at`, the layers' vertices coincide in `x` and `y`;
+/// [`jitter`] in `z` then makes them cross everywhere (contacts grow with the area).
+pub fn fold_x(positions: &[[f32; 3]], at: f32) -> Vec<[f32; 3]> {
+    positions
+        .iter()
+        .map(|&[x, y, z]| {
+            if x > at {
+                [2.0 * at - x, y, z]
+            } else {
+                [x, y, z]
+            }
+        })
+        .collect()
+}
+
+/// SplitMix64 (Steele, Lea, Flood 2014): advances `state` and returns its next 64-bit
+/// output. The seeded generator behind [`jitter`] and the simulator's scenes.
+pub fn splitmix64(state: &mut u64) -> u64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}

@@ -683,10 +683,4 @@ fn unit(x: u64) -> f64 {
 
 /// SplitMix64: a tiny, well-mixed, dependency-free generator; all we need for seeded
 /// phases and turns.
-pub(crate) fn splitmix64(state: &mut u64) -> u64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
+pub(crate) use dhcd::shapes::splitmix64;
