@@ -109,6 +109,33 @@ fn every_region_gets_the_brute_force_argmin() {
     }
 }
 
+/// Every region of a real simulation frame (the whole 12K-vertex mesh at the root), when the
+/// shared data folder is there.
+#[test]
+fn real_frame_regions_get_the_brute_force_argmin() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/real-frames/armadillo-rollers-326.ply");
+    if !path.exists() {
+        eprintln!("skipped: {} is absent", path.display());
+        return;
+    }
+    let mesh = dhcd::io::load(&path).unwrap();
+    let options = Options {
+        central: CentralVertex::MinRadius,
+        ..Options::default()
+    };
+    let h = Hierarchy::<Dh>::new(&mesh, options).unwrap();
+    let tree = h.tree();
+    for n in 0..tree.node_count() {
+        let ids: Vec<u32> = tree.region_vertices(n).collect();
+        assert_eq!(
+            h.nodes().vertex[n],
+            brute_min_radius(&ids, h.points()),
+            "node {n}"
+        );
+    }
+}
+
 #[test]
 fn names_parse_and_default_is_the_papers() {
     assert_eq!(CentralVertex::default(), CentralVertex::RestCentroid);

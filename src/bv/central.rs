@@ -125,6 +125,9 @@ struct MinRadius {
     /// `(initial lower bound, position in pts)` per candidate.
     order: Vec<(f64, u32)>,
     witnesses: Vec<[f32; 3]>,
+    /// The points' coordinates as three arrays, and their initial lower bounds.
+    xyz: [Vec<f32>; 3],
+    bound: Vec<f64>,
 }
 
 /// The state of one farthest-point query: the partial maximum, its vertex, and the best
@@ -155,29 +158,25 @@ impl MinRadius {
         build_kd(&mut self.pts, &mut self.kd);
 
         self.witnesses.clear();
-        for d in DIRECTIONS {
-            let proj = |p: &[f32; 3]| d[0] * p[0] as f64 + d[1] * p[1] as f64 + d[2] * p[2] as f64;
-            let by = |a: &&([f32; 3], u32), b: &&([f32; 3], u32)| {
-                proj(&a.0).total_cmp(&proj(&b.0)).then(a.1.cmp(&b.1))
-            };
-            let lo = self.pts.iter().min_by(by).map(|p| p.0);
-            let hi = self.pts.iter().max_by(by).map(|p| p.0);
-            for w in [lo, hi].into_iter().flatten() {
-                if !self.witnesses.contains(&w) {
-                    self.witnesses.push(w);
-                }
+        extremes(&self.pts, &mut self.witnesses);
+        let initial = self.witnesses.len();
+        // Initial bounds, one witness at a time over the coordinate arrays (vectorises).
+        self.xyz.iter_mut().for_each(Vec::clear);
+        for k in 0..3 {
+            self.xyz[k].extend(self.pts.iter().map(|p| p.0[k]));
+        }
+        self.bound.clear();
+        self.bound.resize(self.pts.len(), 0.0);
+        for w in &self.witnesses {
+            let [xs, ys, zs] = &self.xyz;
+            for (((b, &x), &y), &z) in self.bound.iter_mut().zip(xs).zip(ys).zip(zs) {
+                let d = dist2_f64([x, y, z], *w);
+                *b = if d > *b { d } else { *b };
             }
         }
-        let initial = self.witnesses.len();
-        let bound =
-            |p: [f32; 3], ws: &[[f32; 3]]| ws.iter().fold(0.0f64, |m, &w| m.max(dist2_f64(p, w)));
         self.order.clear();
-        self.order.extend(
-            self.pts
-                .iter()
-                .enumerate()
-                .map(|(i, &(p, _))| (bound(p, &self.witnesses), i as u32)),
-        );
+        self.order
+            .extend(self.bound.iter().enumerate().map(|(i, &b)| (b, i as u32)));
         let pts = &self.pts;
         self.order.sort_unstable_by(|a, b| {
             a.0.total_cmp(&b.0)
@@ -214,6 +213,34 @@ impl MinRadius {
             }
         }
         best.1
+    }
+}
+
+/// Appends to `out` the points of least and greatest projection on each of [`DIRECTIONS`]
+/// (the first such point; no duplicates).
+fn extremes(pts: &[([f32; 3], u32)], out: &mut Vec<[f32; 3]>) {
+    let proj = |p: [f32; 3]| {
+        DIRECTIONS.map(|d| d[0] * p[0] as f64 + d[1] * p[1] as f64 + d[2] * p[2] as f64)
+    };
+    let Some(&(first, _)) = pts.first() else {
+        return;
+    };
+    let mut lo = proj(first).map(|v| (v, first));
+    let mut hi = lo;
+    for &(p, _) in &pts[1..] {
+        for (j, v) in proj(p).into_iter().enumerate() {
+            if v < lo[j].0 {
+                lo[j] = (v, p);
+            }
+            if v > hi[j].0 {
+                hi[j] = (v, p);
+            }
+        }
+    }
+    for (_, p) in lo.into_iter().chain(hi) {
+        if !out.contains(&p) {
+            out.push(p);
+        }
     }
 }
 
