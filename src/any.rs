@@ -6,7 +6,7 @@ use std::sync::Arc;
 use crate::bv::Method;
 use crate::counters::Counters;
 use crate::error::Result;
-use crate::hierarchy::{Hierarchy, InvariantError, Options, Refit};
+use crate::hierarchy::{Hierarchy, InvariantError, Options};
 use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
 use crate::mesh::Mesh;
 use crate::par::Par;
@@ -40,16 +40,17 @@ macro_rules! pairwise {
 impl AnyHierarchy {
     pub fn new(method: Method, mesh: &Mesh, options: Options) -> Result<Self> {
         let tree = Arc::new(RegionTree::build(mesh, options.shape())?);
-        Self::with_tree(method, tree, mesh, options.refit)
+        Self::with_tree(method, tree, mesh, options)
     }
 
+    /// A hierarchy over an existing region tree of `mesh` (see [`Hierarchy::with_tree`]).
     pub fn with_tree(
         method: Method,
         tree: Arc<RegionTree>,
         mesh: &Mesh,
-        refit: Refit,
+        options: Options,
     ) -> Result<Self> {
-        Ok(with_kind!(method, K => Hierarchy::<K>::with_tree(tree, mesh, refit)?.into()))
+        Ok(with_kind!(method, K => Hierarchy::<K>::with_tree(tree, mesh, options)?.into()))
     }
 
     pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {
@@ -110,6 +111,16 @@ impl AnyHierarchy {
     /// Refits the stale nodes among `ids` (see [`Hierarchy::refit_nodes`]).
     pub fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<()> {
         each!(self, h => h.refit_nodes(ids, par))
+    }
+
+    /// Refits every stale node exactly now (see [`Hierarchy::refit_all`]).
+    pub fn refit_all(&mut self) {
+        each!(self, h => h.refit_all())
+    }
+
+    /// Refits every stale node bottom-up now (see [`Hierarchy::refit_bottom_up`]).
+    pub fn refit_bottom_up(&mut self) {
+        each!(self, h => h.refit_bottom_up())
     }
 
     /// The nodes fitted to the current positions (see [`Hierarchy::fitted_nodes`]).

@@ -51,6 +51,8 @@ pub enum Error {
     UnknownMethod(String),
     #[error("unknown refit mode {0:?} (expected lazy, eager or bottom-up)")]
     UnknownRefit(String),
+    #[error("unknown central vertex {0:?} (expected rest-centroid or min-radius)")]
+    UnknownCentral(String),
     /// A node id (e.g. given to `refit_nodes`) beyond the hierarchy's nodes.
     #[error("node {node} out of range (the hierarchy has {node_count} nodes)")]
     NodeOutOfRange { node: u32, node_count: usize },

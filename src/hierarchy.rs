@@ -27,6 +27,24 @@ pub enum Refit {
     EagerBottomUp,
 }
 
+impl Refit {
+    /// The name in reports (and [`FromStr`](std::str::FromStr)): `lazy`, `eager`,
+    /// `bottom-up`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Refit::Lazy => "lazy",
+            Refit::Eager => "eager",
+            Refit::EagerBottomUp => "bottom-up",
+        }
+    }
+}
+
+impl std::fmt::Display for Refit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 impl std::str::FromStr for Refit {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
@@ -39,6 +57,49 @@ impl std::str::FromStr for Refit {
     }
 }
 
+/// Which vertex of its region a DH node is centred on (chosen at build, fixed for life). The
+/// other kinds ignore it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum CentralVertex {
+    /// The paper's choice: the region vertex closest to the centroid (mean) of the region's
+    /// vertices at rest.
+    #[default]
+    RestCentroid,
+    /// The region vertex whose rest radius (largest distance to the region's vertices at
+    /// rest) is least: the tightest DH sphere at rest. Costlier to build (exact, pruned).
+    MinRadius,
+}
+
+impl CentralVertex {
+    /// Every choice, the default first.
+    pub const ALL: [CentralVertex; 2] = [CentralVertex::RestCentroid, CentralVertex::MinRadius];
+
+    /// The name on the command line and in reports: `rest-centroid`, `min-radius`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            CentralVertex::RestCentroid => "rest-centroid",
+            CentralVertex::MinRadius => "min-radius",
+        }
+    }
+}
+
+impl std::fmt::Display for CentralVertex {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for CentralVertex {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        CentralVertex::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| Error::UnknownCentral(s.to_owned()))
+    }
+}
+
 /// Build options of a hierarchy.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Options {
@@ -48,6 +109,8 @@ pub struct Options {
     /// Largest number of triangles in a leaf of an adaptive tree (ignored with `levels`).
     pub leaf_size: usize,
     pub refit: Refit,
+    /// The DH central vertex of every node (ignored by the other kinds).
+    pub central: CentralVertex,
 }
 
 impl Default for Options {
@@ -56,12 +119,14 @@ impl Default for Options {
             levels: None,
             leaf_size: DEFAULT_LEAF_SIZE,
             refit: Refit::Lazy,
+            central: CentralVertex::RestCentroid,
         }
     }
 }
 
 impl Options {
-    /// The paper's setting: a fixed depth of 5 levels, lazy refit.
+    /// The paper's setting: a fixed depth of 5 levels, lazy refit, central vertices closest to
+    /// the rest centroid.
     pub fn paper() -> Self {
         Self {
             levels: Some(PAPER_LEVELS),
@@ -176,12 +241,13 @@ impl<K: BvKind> Hierarchy<K> {
     /// volumes to it.
     pub fn new(mesh: &Mesh, options: Options) -> Result<Self> {
         let tree = Arc::new(RegionTree::build(mesh, options.shape())?);
-        Self::with_tree(tree, mesh, options.refit)
+        Self::with_tree(tree, mesh, options)
     }
 
     /// Fits `K`'s volumes over an existing region tree of `mesh`, so several kinds can
-    /// share one tree (identical regions).
-    pub fn with_tree(tree: Arc<RegionTree>, mesh: &Mesh, refit: Refit) -> Result<Self> {
+    /// share one tree (identical regions). The tree's shape is the given tree's: `options`'
+    /// `levels` and `leaf_size` are not read.
+    pub fn with_tree(tree: Arc<RegionTree>, mesh: &Mesh, options: Options) -> Result<Self> {
         if tree.vertex_total() != mesh.vertex_count()
             || tree.triangle_total() != mesh.triangle_count()
         {
@@ -193,13 +259,13 @@ impl<K: BvKind> Hierarchy<K> {
             });
         }
         let points = Points::gather(mesh.positions(), tree.vert_order());
-        let nodes = K::build(&tree, &points);
+        let nodes = K::build(&tree, &points, &options);
         Ok(Self {
             tris: TriCache::new(&tree),
             tree,
             points,
             nodes,
-            refit,
+            refit: options.refit,
             updates: 0,
         })
     }

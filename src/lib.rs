@@ -47,7 +47,7 @@ pub use any::AnyHierarchy;
 pub use bv::Method;
 pub use counters::Counters;
 pub use error::{Error, Result};
-pub use hierarchy::{Hierarchy, InvariantError, Options, Refit};
+pub use hierarchy::{CentralVertex, Hierarchy, InvariantError, Options, Refit};
 pub use mesh::Mesh;
 pub use par::Par;
 pub use scene::{ObjectId, Scene, SceneContacts};

@@ -4,7 +4,10 @@
 use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
 use dhcd::narrow::brute_force_pairs;
 use dhcd::shapes::{grid, icosphere, translated, wave};
-use dhcd::{collide, for_each_kind, Error, Hierarchy, Mesh, Method, Options, Refit, RegionTree};
+use dhcd::{
+    collide, for_each_kind, CentralVertex, Error, Hierarchy, Mesh, Method, Options, Refit,
+    RegionTree,
+};
 use proptest::prelude::*;
 
 const MODES: [Refit; 3] = [Refit::Lazy, Refit::Eager, Refit::EagerBottomUp];
@@ -124,12 +127,17 @@ fn degenerate_triangles_at_build() {
 
 /// A deforming sequence: two spheres wobble through each other for `steps` steps; every step
 /// compares every kind and refit mode with brute force and checks invariants after refit.
-fn deforming_sequence<K: BvKind>(refit: Refit, steps: usize) -> Vec<Vec<[u32; 2]>> {
+fn deforming_sequence<K: BvKind>(
+    refit: Refit,
+    central: CentralVertex,
+    steps: usize,
+) -> Vec<Vec<[u32; 2]>> {
     let a = icosphere(2, 1.0, [0.0, 0.0, 0.0]);
     let b = icosphere(2, 0.8, [0.0, 0.0, 0.0]);
     let options = Options {
         levels: Some(5),
         refit,
+        central,
         ..Options::default()
     };
     let mut ha = Hierarchy::<K>::new(&a, options).unwrap();
@@ -166,14 +174,16 @@ fn deforming_sequence<K: BvKind>(refit: Refit, steps: usize) -> Vec<Vec<[u32; 2]
 #[test]
 fn deforming_sequences_all_kinds_all_refit_modes() {
     for refit in MODES {
-        let dh = deforming_sequence::<Dh>(refit, 24);
+        let dh = deforming_sequence::<Dh>(refit, CentralVertex::default(), 24);
         assert!(
             dh.iter().filter(|p| !p.is_empty()).count() > 10,
             "the spheres must meet"
         );
-        for_each_kind!(K => if K::METHOD != Method::Dh {
-            assert_eq!(dh, deforming_sequence::<K>(refit, 24));
-        });
+        for central in CentralVertex::ALL {
+            for_each_kind!(K => if K::METHOD != Method::Dh || central != CentralVertex::default() {
+                assert_eq!(dh, deforming_sequence::<K>(refit, central, 24));
+            });
+        }
     }
 }
 
@@ -217,12 +227,12 @@ fn shared_tree_gives_identical_regions() {
     let m = icosphere(2, 1.0, [0.0; 3]);
     let tree =
         std::sync::Arc::new(RegionTree::build(&m, dhcd::tree::TreeShape::Levels(4)).unwrap());
-    let dh = Hierarchy::<Dh>::with_tree(tree.clone(), &m, Refit::Lazy).unwrap();
-    let bx = Hierarchy::<Aabb>::with_tree(tree.clone(), &m, Refit::Lazy).unwrap();
+    let dh = Hierarchy::<Dh>::with_tree(tree.clone(), &m, Options::default()).unwrap();
+    let bx = Hierarchy::<Aabb>::with_tree(tree.clone(), &m, Options::default()).unwrap();
     assert!(std::sync::Arc::ptr_eq(dh.tree(), bx.tree()));
     let other = icosphere(1, 1.0, [0.0; 3]);
     assert!(matches!(
-        Hierarchy::<Dh>::with_tree(tree, &other, Refit::Lazy),
+        Hierarchy::<Dh>::with_tree(tree, &other, Options::default()),
         Err(Error::TreeMismatch { .. })
     ));
 }

@@ -5,7 +5,8 @@ use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
 use dhcd::narrow::brute_force_self_pairs;
 use dhcd::shapes::{grid, icosphere, wave};
 use dhcd::{
-    for_each_kind, self_collide, self_collide_with, Hierarchy, Mesh, Options, Par, Refit, Workspace,
+    for_each_kind, self_collide, self_collide_with, CentralVertex, Hierarchy, Mesh, Options, Par,
+    Refit, Workspace,
 };
 
 fn with_positions(mesh: &Mesh, positions: Vec<[f32; 3]>) -> Mesh {
@@ -59,12 +60,15 @@ fn check<K: BvKind>(rest: &Mesh, posed: &[[f32; 3]], options: Options) -> Vec<[u
 fn check_all(rest: &Mesh, posed: &[[f32; 3]], levels: usize) -> usize {
     let mut found = 0;
     for refit in [Refit::Lazy, Refit::Eager, Refit::EagerBottomUp] {
-        let options = Options {
-            levels: Some(levels),
-            refit,
-            ..Options::default()
-        };
-        for_each_kind!(K => found = check::<K>(rest, posed, options).len());
+        for central in CentralVertex::ALL {
+            let options = Options {
+                levels: Some(levels),
+                refit,
+                central,
+                ..Options::default()
+            };
+            for_each_kind!(K => found = check::<K>(rest, posed, options).len());
+        }
     }
     found
 }

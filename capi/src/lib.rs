@@ -136,6 +136,7 @@ impl From<Error> for Fail {
             Error::InvalidLevels { .. }
             | Error::UnknownMethod(_)
             | Error::UnknownRefit(_)
+            | Error::UnknownCentral(_)
             | Error::NodeOutOfRange { .. }
             | Error::NotALeaf { .. }
             | Error::TreeMismatch { .. }

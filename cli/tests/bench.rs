@@ -123,6 +123,11 @@ fn self_bench_finds_each_frames_contacts_with_every_method_and_thread_count() {
         }
         assert_eq!(runs.len(), 3);
     }
+    // The DH central vertex changes the work, never the contacts.
+    let mut args = vec!["bench", "self"];
+    args.extend(strs(&frames));
+    args.extend(["--central", "min-radius", "--repeat", "1", "--json"]);
+    assert_eq!(frame_contacts(&json_of(&args), "dh", 1, 3), expected);
 }
 
 #[test]
@@ -182,6 +187,7 @@ fn bad_input_is_one_error_line() {
         (vec!["bench", "self", frame, "--threads", "5000"], "threads"),
         (vec!["bench", "self", frame, "--method", "obb"], "obb"),
         (vec!["bench", "self", frame, "--leaf-size", "0"], "leaf"),
+        (vec!["bench", "self", frame, "--central", "mean"], "mean"),
         (vec!["bench", "self", missing], "missing.obj"),
         (vec!["bench", "collide", "--a", frame], "--b"),
         (vec!["bench", "self"], "FRAMES"),

@@ -72,6 +72,50 @@ fn self_json_equals_brute_force() {
 }
 
 #[test]
+fn central_vertex_choices_find_the_same_contacts() {
+    let s = icosphere(2, 1.0, [0.0; 3]);
+    let crumpled = Mesh::new(
+        wave(s.positions(), 1.0, 0.6, [0.0; 3]),
+        s.triangles().to_vec(),
+    )
+    .unwrap();
+    let other = Mesh::new(
+        wave(s.positions(), 0.3, 0.2, [1.1, 0.2, 0.0]),
+        s.triangles().to_vec(),
+    )
+    .unwrap();
+    let (pa, pb) = (
+        write_obj("central-a.obj", &crumpled),
+        write_obj("central-b.obj", &other),
+    );
+    let (pa, pb) = (pa.to_str().unwrap(), pb.to_str().unwrap());
+    let own = brute_force_self_pairs(&crumpled);
+    let cross = brute_force_pairs(&crumpled, &other);
+    assert!(!own.is_empty() && !cross.is_empty());
+    for central in ["rest-centroid", "min-radius"] {
+        for method in ["dh", "aabb"] {
+            for (args, expected) in [(vec!["self", pa], &own), (vec!["collide", pa, pb], &cross)] {
+                let mut args = args.clone();
+                args.extend(["--method", method, "--central", central, "--json"]);
+                let (code, out, err) = dhcd(&args);
+                assert_eq!(code, 0, "{args:?}: {err}");
+                let pairs: Vec<[u32; 2]> =
+                    serde_json::from_value(json(&out)["pairs"].clone()).unwrap();
+                assert_eq!(&pairs, expected, "{args:?}");
+            }
+        }
+    }
+    let (code, out, err) = dhcd(&["self", pa, "--central", "middle"]);
+    assert_ne!(code, 0);
+    assert!(out.is_empty());
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("middle") && err.contains("min-radius"),
+        "{err}"
+    );
+}
+
+#[test]
 fn scene_json_equals_brute_force() {
     let a = icosphere(2, 1.0, [0.0; 3]);
     let b = Mesh::new(

@@ -1,7 +1,7 @@
 //! `dhcd_cli::experiment` and `dhcd experiment`: schema of the report, determinism (seed and
 //! thread count), the command line and its files, bad flags.
 
-use dhcd::Counters;
+use dhcd::{CentralVertex, Counters, Refit};
 use dhcd_cli::experiment::{output, run, Config, Report};
 use dhcd_cli::sim::{pawn_mesh_with, PAWN_HEIGHT};
 
@@ -108,12 +108,108 @@ fn report_schema_and_contacts_agree() {
 }
 
 #[test]
+fn refit_study_compares_exact_and_bottom_up_radii() {
+    let frames = 20;
+    let report = quiet(&small(frames, 1));
+    let study = report.refit_study.as_ref().expect("DH is measured");
+    let dh = report.method(dhcd::Method::Dh).unwrap();
+    let refits: Vec<Refit> = study.rows.iter().map(|r| r.refit).collect();
+    assert_eq!(refits, [Refit::Eager, Refit::EagerBottomUp]);
+    let (exact, bound) = (&study.rows[0], &study.rows[1]);
+    for (s, (e, b)) in dh.steps.iter().zip(exact.steps.iter().zip(&bound.steps)) {
+        // Eager exact radii are the lazy ones: the same tests, every node updated.
+        assert_eq!(
+            (
+                e.counters.bv_tests,
+                e.counters.prim_tests,
+                e.counters.contacts
+            ),
+            (
+                s.counters.bv_tests,
+                s.counters.prim_tests,
+                s.counters.contacts
+            )
+        );
+        assert_eq!(
+            e.counters.bv_updates,
+            8 * report.scene.nodes_per_hierarchy as u64
+        );
+        // The bottom-up bound encloses the exact sphere: never fewer tests, same contacts.
+        assert!(b.counters.bv_tests >= e.counters.bv_tests);
+        assert!(b.counters.prim_tests >= e.counters.prim_tests);
+        assert_eq!(b.counters.contacts, e.counters.contacts);
+        assert_eq!(b.counters.bv_updates, e.counters.bv_updates);
+        assert!(e.refit_ns > 0.0 && b.refit_ns > 0.0 && s.refit_ns == 0.0);
+    }
+    assert_eq!(exact.steps.len(), frames);
+    let l = study.looseness;
+    assert!(
+        l.nodes > 0 && l.mean >= 1.0 && l.max >= l.mean && l.root_mean >= 1.0,
+        "{l:?}"
+    );
+    // Reports: the JSON section, the Markdown table and the summary lines.
+    let json = output::to_json(&report);
+    let rows = json["refit_study"]["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[1]["refit"], "bottom-up");
+    assert_eq!(rows[1]["steps"].as_array().unwrap().len(), frames);
+    assert!(rows[1]["totals"]["refit_ns"].as_f64().unwrap() > 0.0);
+    let md = output::markdown(&report);
+    assert!(
+        md.contains("## DH radius: exact against the bottom-up bound"),
+        "{md}"
+    );
+    assert!(md.contains("| bottom-up bound | eager |"), "{md}");
+    assert!(md.contains("| exact | lazy (default) |"), "{md}");
+    assert!(output::summary_table(&report).contains("bottom-up bound, eager"));
+    // No DH, no study.
+    let no_dh = quiet(&Config {
+        methods: vec![dhcd::Method::Aabb],
+        ..small(3, 1)
+    });
+    assert!(no_dh.refit_study.is_none());
+    assert!(output::to_json(&no_dh)["refit_study"].is_null());
+}
+
+#[test]
+fn central_vertex_changes_dh_work_not_contacts() {
+    let paper = quiet(&small(16, 1));
+    let tight = quiet(&Config {
+        central: CentralVertex::MinRadius,
+        ..small(16, 1)
+    });
+    assert_eq!(tight.scene.central, CentralVertex::MinRadius);
+    assert_eq!(output::to_json(&tight)["scene"]["central"], "min-radius");
+    let contacts = |r: &Report| -> Vec<Vec<u64>> {
+        r.methods
+            .iter()
+            .map(|m| m.steps.iter().map(|s| s.counters.contacts).collect())
+            .collect()
+    };
+    assert_eq!(contacts(&paper), contacts(&tight));
+    // The other kinds ignore it.
+    let (p, t) = (counters(&paper), counters(&tight));
+    assert_eq!(p[1..], t[1..]);
+}
+
+#[test]
 fn deterministic_for_seed_and_thread_count() {
     let a = quiet(&small(16, 1));
     let b = quiet(&small(16, 1));
     let c = quiet(&small(16, 2));
     assert_eq!(counters(&a), counters(&b));
     assert_eq!(counters(&a), counters(&c));
+    let study = |r: &Report| -> Vec<Vec<Counters>> {
+        let rows = &r.refit_study.as_ref().unwrap().rows;
+        rows.iter()
+            .map(|row| row.steps.iter().map(|s| s.counters).collect())
+            .collect()
+    };
+    assert_eq!(study(&a), study(&c));
+    assert_eq!(
+        a.refit_study.as_ref().unwrap().looseness,
+        c.refit_study.as_ref().unwrap().looseness
+    );
     assert_eq!(a.snapshot, c.snapshot);
     let other_seed = quiet(&Config {
         seed: 7,
@@ -175,6 +271,34 @@ fn cli_writes_every_file() {
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
     assert_eq!(json["methods"]["dh"]["steps"].as_array().unwrap().len(), 3);
+    assert_eq!(json["scene"]["central"], "rest-centroid");
+    assert!(
+        stdout.contains("DH central vertex rest-centroid"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("bottom-up bound, eager"), "{stdout}");
+    // The least-radius central vertex, asked for on the command line.
+    let out = dhcd(&[
+        "experiment",
+        "--frames",
+        "2",
+        "--methods",
+        "dh",
+        "--central",
+        "min-radius",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["scene"]["central"], "min-radius");
+    assert_eq!(json["refit_study"]["rows"].as_array().unwrap().len(), 2);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -189,6 +313,7 @@ fn cli_bad_flags_fail_cleanly() {
         vec!["experiment", "--threads", "16384"],
         vec!["experiment", "--threads", "-1"],
         vec!["experiment", "--levels", "0", "--frames", "1"],
+        vec!["experiment", "--central", "middle"],
         vec!["experiment", "--mesh", missing.to_str().unwrap()],
         vec!["experiment", "--bogus"],
     ] {

@@ -1,6 +1,7 @@
 //! Axis-aligned bounding boxes: min/max over the region's vertices (exact in f32).
 
 use super::{sealed, Bounds, BvKind, Method};
+use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};
@@ -44,7 +45,7 @@ impl BvKind for Aabb {
     type Nodes = AabbNodes;
     type Block<'a> = overlap::AabbSoa<'a>;
 
-    fn build(tree: &RegionTree, rest: &Points) -> AabbNodes {
+    fn build(tree: &RegionTree, rest: &Points, _: &Options) -> AabbNodes {
         let mut nodes = AabbNodes {
             fitted: Bounds::new(tree),
         };

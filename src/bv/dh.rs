@@ -1,9 +1,11 @@
 //! The Distance Hierarchy: a region is bounded by the sphere around one of its own vertices
-//! (the central vertex, fixed at build) whose radius is refitted after deformation. The
+//! (the central vertex, fixed at build: [`crate::CentralVertex`], chosen in `central.rs`)
+//! whose radius is refitted after deformation. The
 //! centre moves with the mesh for free; only the radius is ever recomputed.
 
+use super::{central, sealed, BvKind, Method};
 use super::{conservative_radius, conservative_sum, dist2_f64, Bounds};
-use super::{sealed, BvKind, Method};
+use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};
@@ -49,10 +51,8 @@ impl BvKind for Dh {
     type Nodes = DhNodes;
     type Block<'a> = overlap::SphereSoa<'a>;
 
-    fn build(tree: &RegionTree, rest: &Points) -> DhNodes {
-        let vertex = (0..tree.node_count())
-            .map(|n| central_vertex(tree, rest, n))
-            .collect();
+    fn build(tree: &RegionTree, rest: &Points, options: &Options) -> DhNodes {
+        let vertex = central::central_vertices(tree, rest, options.central);
         let mut nodes = DhNodes {
             vertex,
             fitted: Bounds::new(tree),
@@ -142,27 +142,4 @@ impl BvKind for Dh {
         let rad = r.radius as f64;
         dist2_f64(p.get(r.vertex as usize), p.get(v)) <= rad * rad
     }
-}
-
-/// The region vertex closest to the centroid (mean) of the region's vertices at rest; ties
-/// go to the smallest internal index.
-fn central_vertex(tree: &RegionTree, rest: &Points, n: usize) -> u32 {
-    let count = tree.vertex_count(n) as f64;
-    let mut mean = [0.0f64; 3];
-    for v in tree.region_vertices(n) {
-        let q = rest.get(v as usize);
-        for k in 0..3 {
-            mean[k] += q[k] as f64;
-        }
-    }
-    let mean = mean.map(|s| s / count);
-    let mut best = (f64::INFINITY, u32::MAX);
-    for v in tree.region_vertices(n) {
-        let q = rest.get(v as usize);
-        let d: f64 = (0..3).map(|k| (q[k] as f64 - mean[k]).powi(2)).sum();
-        if (d, v) < best {
-            best = (d, v);
-        }
-    }
-    best.1
 }

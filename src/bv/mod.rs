@@ -7,6 +7,7 @@
 //! time; every kind is a row of the table in [`crate::kinds`].
 
 mod aabb;
+mod central;
 mod dh;
 mod sphere;
 
@@ -16,6 +17,7 @@ pub use sphere::{Sphere, SphereNode, SphereNodes};
 
 pub use crate::kinds::Method;
 
+use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::lazy::LazyTiles;
@@ -69,8 +71,9 @@ pub trait BvKind:
     /// The fitted bounds of one sibling group, as the overlap kernels read them.
     type Block<'a>: Copy;
 
-    /// Allocates the buffers and fits every node to the rest pose `rest` (all current).
-    fn build(tree: &RegionTree, rest: &Points) -> Self::Nodes;
+    /// Allocates the buffers and fits every node to the rest pose `rest` (all current);
+    /// `options` say how (e.g. [`Options::central`] for DH).
+    fn build(tree: &RegionTree, rest: &Points, options: &Options) -> Self::Nodes;
     /// The bounds of sibling group `g`, fitting the group exactly to the current pose `p`
     /// first if it is stale (once per step, whichever thread asks first). Returns the block
     /// and whether this call fitted it.

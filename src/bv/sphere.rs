@@ -3,6 +3,7 @@
 
 use super::{conservative_radius, conservative_sum, dist2_f64, Bounds};
 use super::{sealed, BvKind, Method};
+use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};
@@ -61,7 +62,7 @@ impl BvKind for Sphere {
     type Nodes = SphereNodes;
     type Block<'a> = overlap::SphereSoa<'a>;
 
-    fn build(tree: &RegionTree, rest: &Points) -> SphereNodes {
+    fn build(tree: &RegionTree, rest: &Points, _: &Options) -> SphereNodes {
         let mut nodes = SphereNodes {
             fitted: Bounds::new(tree),
         };

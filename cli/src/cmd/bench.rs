@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use dhcd::{AnyHierarchy, Counters, Mesh, Method, Options, Par, Workspace};
+use dhcd::{AnyHierarchy, CentralVertex, Counters, Mesh, Method, Options, Par, Workspace};
 use serde_json::json;
 
 use super::input::InputArgs;
@@ -58,6 +58,10 @@ struct Opts {
     /// Largest number of triangles per leaf of the adaptive tree.
     #[arg(long, default_value_t = dhcd::tree::DEFAULT_LEAF_SIZE)]
     leaf_size: usize,
+    /// The DH central vertex: rest-centroid (the paper's) or min-radius. Other methods
+    /// ignore it.
+    #[arg(long, default_value_t = CentralVertex::RestCentroid, value_parser = super::central_parser())]
+    central: CentralVertex,
     /// Threads of each query (1: the calling thread). Results do not depend on it.
     #[arg(long, default_value_t = 1)]
     threads: usize,
@@ -105,6 +109,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     let options = Options {
         levels: opts.levels,
         leaf_size: opts.leaf_size,
+        central: opts.central,
         ..Options::default()
     };
     let steps = a.len().max(b.as_ref().map_or(0, Vec::len));

@@ -1,11 +1,11 @@
-//! `dhcd experiment [--frames N] [--levels N] [--methods dh,sphere,aabb] [--threads N]
-//! [--seed S] [--out DIR] [--mesh FILE] [--max-file-bytes N]`: the paper's experiment and the
-//! cost-model report.
+//! `dhcd experiment [--frames N] [--levels N] [--methods dh,sphere,aabb] [--central C]
+//! [--threads N] [--seed S] [--out DIR] [--mesh FILE] [--max-file-bytes N]`: the paper's
+//! experiment and the cost-model report.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use dhcd::{Method, Par};
+use dhcd::{CentralVertex, Method, Par};
 use dhcd_cli::experiment::{self, output, Config, Phase};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -22,6 +22,9 @@ pub struct ExperimentArgs {
     /// Methods to compare, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = Method::ALL, value_parser = super::method_parser(), ignore_case = true)]
     methods: Vec<Method>,
+    /// The DH central vertex: rest-centroid (the paper's) or min-radius.
+    #[arg(long, default_value_t = CentralVertex::RestCentroid, value_parser = super::central_parser())]
+    central: CentralVertex,
     /// Threads of each query (1: sequential; 0: all cores; at most 1024, and never more than
     /// the machine has). Counters and contacts do not depend on it.
     #[arg(long, default_value_t = 1)]
@@ -54,6 +57,7 @@ pub fn run(args: ExperimentArgs) -> Result<(), String> {
         frames: args.frames as usize,
         levels: args.levels,
         methods: args.methods.clone(),
+        central: args.central,
         threads: args.threads,
         seed: args.seed,
         mesh,
@@ -84,12 +88,13 @@ pub fn run(args: ExperimentArgs) -> Result<(), String> {
     output::write_all(&report, &args.out).map_err(|e| e.to_string())?;
     let s = &report.scene;
     let text = format!(
-        "{} objects x {} triangles, {} frames, {} levels, {} thread(s), seed {}\n{}\
+        "{} objects x {} triangles, {} frames, {} levels, DH central vertex {}, {} thread(s), seed {}\n{}\
          contacts identical across methods at every step; report in {} ({:.1} s)\n",
         s.objects,
         s.triangles_per_object,
         s.frames,
         s.levels,
+        s.central,
         s.threads,
         s.seed,
         output::summary_table(&report),

@@ -81,6 +81,14 @@ pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = dhcd::Met
     PossibleValuesParser::new(values).try_map(|name| name.parse::<dhcd::Method>())
 }
 
+/// Parses a DH central vertex choice: `rest-centroid` (the paper's, the default) or
+/// `min-radius`, which `--help` lists.
+pub fn central_parser() -> impl clap::builder::TypedValueParser<Value = dhcd::CentralVertex> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(dhcd::CentralVertex::ALL.map(dhcd::CentralVertex::name))
+        .try_map(|name| name.parse::<dhcd::CentralVertex>())
+}
+
 /// Writes `text` to standard output (see [`emit_with`]).
 pub fn emit(text: &str) -> dhcd::Result<()> {
     emit_with(|out| out.write_all(text.as_bytes()))

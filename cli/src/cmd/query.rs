@@ -3,7 +3,7 @@
 
 use std::io::Write;
 
-use dhcd::{Counters, Method, Options};
+use dhcd::{CentralVertex, Counters, Method, Options};
 
 #[derive(clap::Args, Debug)]
 pub struct QueryArgs {
@@ -17,6 +17,10 @@ pub struct QueryArgs {
     /// Largest number of triangles per leaf of the adaptive tree.
     #[arg(long, default_value_t = dhcd::tree::DEFAULT_LEAF_SIZE)]
     pub leaf_size: usize,
+    /// The DH central vertex of each region: the paper's (closest to the rest centroid) or
+    /// the one of least rest radius (tighter, slower to build). Other methods ignore it.
+    #[arg(long, default_value_t = CentralVertex::RestCentroid, value_parser = super::central_parser())]
+    pub central: CentralVertex,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -27,6 +31,7 @@ impl QueryArgs {
         Options {
             levels: self.levels,
             leaf_size: self.leaf_size,
+            central: self.central,
             ..Options::default()
         }
     }

@@ -18,6 +18,11 @@
 //!    per method, from the real kernels on frames spread over the run, each calibrated right
 //!    after it is measured (same machine load).
 //!
+//! When DH is measured, the measure phase also replays the frames for the **refit study**
+//! ([`RefitStudy`]): DH with every radius refitted eagerly, exactly and as the bottom-up
+//! bound `r_p = max_c(|C_p - C_c| + r_c)`, the refit timed apart from the query, so the
+//! report weighs the cheaper refit against the work the looser radii add (`N_V`, `N_P`).
+//!
 //! Results do not depend on the thread count (counters and contacts; times do).
 
 pub mod cost;
@@ -31,7 +36,7 @@ use dhcd::any::AnyHierarchy;
 use dhcd::bv::Method;
 use dhcd::counters::Counters;
 use dhcd::error::Error;
-use dhcd::hierarchy::Refit;
+use dhcd::hierarchy::{CentralVertex, Options, Refit};
 use dhcd::mesh::Mesh;
 use dhcd::par::Par;
 use dhcd::traverse::Workspace;
@@ -86,6 +91,8 @@ pub struct Config {
     pub seed: u64,
     /// The object mesh (eight copies); `None`: the built-in pawn.
     pub mesh: Option<Mesh>,
+    /// The DH central vertex (the paper's: closest to the rest centroid).
+    pub central: CentralVertex,
     /// Simulator parameters (its `seed` is replaced by [`Config::seed`]).
     pub sim: SimConfig,
     /// Replays of every measured step; the least time is kept.
@@ -105,6 +112,7 @@ impl Default for Config {
             threads: 1,
             seed: 1,
             mesh: None,
+            central: CentralVertex::RestCentroid,
             sim: SimConfig::default(),
             timing_reps: 5,
             calibration_frames: 10,
@@ -114,6 +122,26 @@ impl Default for Config {
 }
 
 impl Config {
+    /// The hierarchy options of every measured hierarchy, refitted as `refit` says.
+    fn options(&self, refit: Refit) -> Options {
+        Options {
+            refit,
+            central: self.central,
+            ..Options::paper()
+        }
+    }
+
+    /// What the measure phase replays: every method with lazy refit (calibrated, in the
+    /// report's per-method tables), then, when DH is among them, the refit study's eager
+    /// DH variants.
+    fn variants(&self) -> Vec<(Method, Refit)> {
+        let mut v: Vec<(Method, Refit)> = self.methods.iter().map(|&m| (m, Refit::Lazy)).collect();
+        if self.methods.contains(&Method::Dh) {
+            v.extend(RefitStudy::REFITS.map(|r| (Method::Dh, r)));
+        }
+        v
+    }
+
     /// The parallelism of the queries (checked by [`Par::threads`]).
     pub fn par(&self) -> Result<Par, Error> {
         Par::threads(self.threads)
@@ -177,6 +205,8 @@ pub struct SceneInfo {
     pub nodes_per_hierarchy: usize,
     pub frames: usize,
     pub levels: usize,
+    /// The DH central vertex.
+    pub central: CentralVertex,
     /// Threads the queries actually ran on.
     pub threads: usize,
     pub seed: u64,
@@ -191,6 +221,9 @@ pub struct Step {
     pub counters: Counters,
     /// `update_positions` of every object (least over replays).
     pub update_ns: f64,
+    /// An eager refit of every object between update and query (least over replays; the
+    /// refit study's variants), 0 with lazy refit (which happens inside the query).
+    pub refit_ns: f64,
     /// All object-pair queries, lazy refit included (least over replays).
     pub query_ns: f64,
     /// Cost model `N_V*C_V + N_P*C_P + N_U*C_U` (calibrated constants).
@@ -198,9 +231,9 @@ pub struct Step {
 }
 
 impl Step {
-    /// Measured step time: update + query.
+    /// Measured step time: update + refit + query.
     pub fn time_ns(&self) -> f64 {
-        self.update_ns + self.query_ns
+        self.update_ns + self.refit_ns + self.query_ns
     }
 }
 
@@ -257,6 +290,59 @@ impl MethodReport {
     }
 }
 
+/// The DH refit study: on the frames the methods replay, DH with every radius refitted
+/// eagerly (all nodes, before the query, timed apart), exactly and as the bottom-up bound.
+/// The default (exact, lazy) is the DH row of [`Report::methods`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefitStudy {
+    /// One row per mode of [`RefitStudy::REFITS`], in that order.
+    pub rows: Vec<RefitRow>,
+    /// Bottom-up radius / exact radius over the internal nodes of every object at the last
+    /// step (leaves are fitted exactly by both).
+    pub looseness: Looseness,
+}
+
+impl RefitStudy {
+    /// The eager modes compared with the default lazy exact refit.
+    pub const REFITS: [Refit; 2] = [Refit::Eager, Refit::EagerBottomUp];
+}
+
+/// One eager refit mode of the study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefitRow {
+    pub refit: Refit,
+    pub steps: Vec<Step>,
+}
+
+impl RefitRow {
+    pub fn totals(&self) -> Counters {
+        self.steps.iter().map(|s| s.counters).sum()
+    }
+    pub fn total_refit_ns(&self) -> f64 {
+        self.steps.iter().map(|s| s.refit_ns).sum()
+    }
+    pub fn total_query_ns(&self) -> f64 {
+        self.steps.iter().map(|s| s.query_ns).sum()
+    }
+    pub fn total_update_ns(&self) -> f64 {
+        self.steps.iter().map(|s| s.update_ns).sum()
+    }
+    pub fn total_time_ns(&self) -> f64 {
+        self.steps.iter().map(Step::time_ns).sum()
+    }
+}
+
+/// How much larger the bottom-up radii are than the exact ones (ratios, deterministic).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Looseness {
+    /// Internal nodes compared (all objects).
+    pub nodes: usize,
+    pub mean: f64,
+    pub max: f64,
+    /// Mean over the objects' roots (when they are internal).
+    pub root_mean: f64,
+}
+
 /// Relative error `(predicted - measured) / measured` (0 when nothing was measured).
 pub fn rel_err(predicted: f64, measured: f64) -> f64 {
     if measured > 0.0 {
@@ -281,6 +367,8 @@ pub struct Snapshot {
 pub struct Report {
     pub scene: SceneInfo,
     pub methods: Vec<MethodReport>,
+    /// The DH refit study (when DH is measured).
+    pub refit_study: Option<RefitStudy>,
     /// The step with the most contacts (the first one if there are none).
     pub snapshot: Snapshot,
     /// Wall time of the phases (seconds; calibration is interleaved with measurement).
@@ -351,22 +439,26 @@ pub fn run(
     let frames = simulate(sim, &meshes, &trees, &pairs, config, progress)?;
     let simulate_s = t.elapsed().as_secs_f64();
 
-    let mut hierarchies: Vec<Vec<AnyHierarchy>> = config
-        .methods
+    // Every variant is built lazy: the study's eager refits are called (and timed) apart.
+    let variants = config.variants();
+    let mut hierarchies: Vec<Vec<AnyHierarchy>> = variants
         .iter()
-        .map(|&m| {
+        .map(|&(m, _)| {
             meshes
                 .iter()
                 .zip(&trees)
-                .map(|(mesh, tree)| AnyHierarchy::with_tree(m, Arc::clone(tree), mesh, Refit::Lazy))
+                .map(|(mesh, tree)| {
+                    AnyHierarchy::with_tree(m, Arc::clone(tree), mesh, config.options(Refit::Lazy))
+                })
                 .collect::<Result<Vec<_>, _>>()
         })
         .collect::<Result<_, _>>()?;
 
     let t = Instant::now();
     let calib_frames = cost::calibration_frames(config.frames, config.calibration_frames);
-    let (steps, samples, calibrate_s) = measure(
+    let (mut steps, samples, calibrate_s) = measure(
         &mut hierarchies,
+        &variants,
         &frames,
         &pairs,
         &calib_frames,
@@ -375,6 +467,15 @@ pub fn run(
     )?;
     let measure_s = t.elapsed().as_secs_f64() - calibrate_s;
 
+    let study_steps = steps.split_off(config.methods.len());
+    let refit_study = (!study_steps.is_empty()).then(|| RefitStudy {
+        looseness: looseness(&hierarchies[config.methods.len()..]),
+        rows: RefitStudy::REFITS
+            .into_iter()
+            .zip(study_steps)
+            .map(|(refit, steps)| RefitRow { refit, steps })
+            .collect(),
+    });
     let mut methods = Vec::with_capacity(config.methods.len());
     for (k, ((hs, mut steps), samples)) in hierarchies.iter().zip(steps).zip(samples).enumerate() {
         let costs = cost::combine(&samples);
@@ -402,6 +503,7 @@ pub fn run(
         nodes_per_hierarchy: trees[0].node_count(),
         frames: config.frames,
         levels: config.levels,
+        central: config.central,
         threads: config.par()?.thread_count(),
         seed: config.seed,
         object_pairs: pairs.len(),
@@ -409,6 +511,7 @@ pub fn run(
     Ok(Report {
         scene,
         methods,
+        refit_study,
         snapshot,
         simulate_s,
         measure_s,
@@ -429,7 +532,9 @@ fn simulate(
     let mut dh: Vec<AnyHierarchy> = meshes
         .iter()
         .zip(trees)
-        .map(|(m, t)| AnyHierarchy::with_tree(Method::Dh, Arc::clone(t), m, Refit::Lazy))
+        .map(|(m, t)| {
+            AnyHierarchy::with_tree(Method::Dh, Arc::clone(t), m, config.options(Refit::Lazy))
+        })
         .collect::<Result<_, _>>()?;
     let mut ws = Workspace::default();
     let mut frames = Frames {
@@ -466,13 +571,16 @@ fn simulate(
     Ok(frames)
 }
 
-/// Per method: the measured steps (prediction still 0) and the calibration samples; and
-/// the seconds spent calibrating.
+/// Per variant: the measured steps (prediction still 0); per method: the calibration
+/// samples; and the seconds spent calibrating.
 type Measured = (Vec<Vec<Step>>, Vec<Vec<cost::FrameSamples>>, f64);
 
-/// Phase 2: every method on every frame, calibrating at the calibration frames.
+/// Phase 2: every variant (`(method, refit)`, [`Config::variants`]; `hierarchies` holds
+/// one list per variant) on every frame, calibrating the lazy ones (the methods) at the
+/// calibration frames.
 fn measure(
     hierarchies: &mut [Vec<AnyHierarchy>],
+    variants: &[(Method, Refit)],
     frames: &Frames,
     pairs: &[(usize, usize)],
     calib_frames: &[usize],
@@ -482,15 +590,17 @@ fn measure(
     let par = config.par()?;
     let methods = &config.methods;
     let mut ws = Workspace::default();
-    let mut steps: Vec<Vec<Step>> = vec![Vec::with_capacity(config.frames); methods.len()];
+    let mut steps: Vec<Vec<Step>> = vec![Vec::with_capacity(config.frames); variants.len()];
     let mut samples: Vec<Vec<cost::FrameSamples>> = vec![Vec::new(); methods.len()];
     let mut calibrate_s = 0.0;
     let mut update_t = vec![0.0; config.timing_reps];
+    let mut refit_t = vec![0.0; config.timing_reps];
     let mut query_t = vec![0.0; config.timing_reps];
     for (s, positions) in frames.positions.iter().enumerate() {
         progress(Phase::Measure, s, config.frames);
-        for r in 0..methods.len() {
-            let k = (r + s) % methods.len();
+        for r in 0..variants.len() {
+            let k = (r + s) % variants.len();
+            let (method, refit) = variants[k];
             let hs = &mut hierarchies[k];
             let mut counters = Counters::default();
             for rep in 0..config.timing_reps {
@@ -499,6 +609,18 @@ fn measure(
                     h.update_positions(p)?;
                 }
                 let t1 = Instant::now();
+                // The study's eager refit, timed apart (lazy: none, inside the query).
+                let t1r = match refit {
+                    Refit::Eager => {
+                        hs.iter_mut().for_each(AnyHierarchy::refit_all);
+                        Instant::now()
+                    }
+                    Refit::EagerBottomUp => {
+                        hs.iter_mut().for_each(AnyHierarchy::refit_bottom_up);
+                        Instant::now()
+                    }
+                    _ => t1,
+                };
                 let mut sum = Counters::default();
                 for (q, &(i, j)) in pairs.iter().enumerate() {
                     let (a, b) = two_mut(hs, i, j);
@@ -511,14 +633,15 @@ fn measure(
                             object_b: j,
                             method_a: Method::Dh.name(),
                             count_a: frames.contacts[s][q].len(),
-                            method_b: methods[k].name(),
+                            method_b: method.name(),
                             count_b: c.pairs.len(),
                         });
                     }
                 }
                 let t2 = Instant::now();
                 update_t[rep] = (t1 - t0).as_nanos() as f64;
-                query_t[rep] = (t2 - t1).as_nanos() as f64;
+                refit_t[rep] = (t1r - t1).as_nanos() as f64;
+                query_t[rep] = (t2 - t1r).as_nanos() as f64;
                 debug_assert!(
                     rep == 0 || sum == counters,
                     "replayed step counted differently"
@@ -528,10 +651,11 @@ fn measure(
             steps[k].push(Step {
                 counters,
                 update_ns: cost::least(&update_t),
+                refit_ns: cost::least(&refit_t),
                 query_ns: cost::least(&query_t),
                 predicted_ns: 0.0,
             });
-            if calib_frames.contains(&s) {
+            if k < methods.len() && calib_frames.contains(&s) {
                 let t = Instant::now();
                 samples[k].push(cost::calibrate_frame(
                     hs,
@@ -547,6 +671,39 @@ fn measure(
     }
     progress(Phase::Measure, config.frames, config.frames);
     Ok((steps, samples, calibrate_s))
+}
+
+/// Bottom-up over exact radii of the internal nodes, from the study's hierarchies (exact
+/// first, then bottom-up; both fitted to the last frame by the last replay).
+fn looseness(study: &[Vec<AnyHierarchy>]) -> Looseness {
+    let [exact, bottom_up] = study else {
+        return Looseness::default();
+    };
+    let mut l = Looseness::default();
+    let (mut sum, mut roots, mut root_count) = (0.0, 0.0, 0);
+    for (e, b) in exact.iter().zip(bottom_up) {
+        let (AnyHierarchy::Dh(e), AnyHierarchy::Dh(b)) = (e, b) else {
+            continue;
+        };
+        for n in (0..e.node_count()).filter(|&n| !e.tree().is_leaf(n)) {
+            let (Some(re), Some(rb)) = (e.record(n), b.record(n)) else {
+                continue;
+            };
+            let ratio = rb.radius as f64 / re.radius as f64;
+            sum += ratio;
+            l.max = l.max.max(ratio);
+            l.nodes += 1;
+            if n == 0 {
+                roots += ratio;
+                root_count += 1;
+            }
+        }
+    }
+    if l.nodes > 0 {
+        l.mean = sum / l.nodes as f64;
+        l.root_mean = roots / root_count as f64;
+    }
+    l
 }
 
 /// The step with the most contacts, with its contact triangles per object.

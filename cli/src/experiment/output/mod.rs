@@ -8,9 +8,10 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
-use super::{cost::Constant, MethodReport, Report};
+use super::{cost::Constant, MethodReport, RefitRow, RefitStudy, Report, Step};
 use dhcd::bv::Method;
 use dhcd::error::{Error, Result};
+use dhcd::hierarchy::Refit;
 
 /// Files written by [`write_all`], in order.
 pub const FILES: [&str; 8] = [
@@ -45,17 +46,10 @@ fn method_json(m: &MethodReport) -> Value {
         .steps
         .iter()
         .map(|s| {
-            json!({
-                "bv_tests": s.counters.bv_tests,
-                "prim_tests": s.counters.prim_tests,
-                "bv_updates": s.counters.bv_updates,
-                "contacts": s.counters.contacts,
-                "time_ns": s.time_ns(),
-                "predicted_ns": s.predicted_ns,
-                "update_ns": s.update_ns,
-                "query_ns": s.query_ns,
-                "fixed_ns": m.fixed_ns(),
-            })
+            let mut v = step_json(s);
+            v["predicted_ns"] = json!(s.predicted_ns);
+            v["fixed_ns"] = json!(m.fixed_ns());
+            v
         })
         .collect();
     json!({
@@ -100,6 +94,60 @@ fn method_json(m: &MethodReport) -> Value {
     })
 }
 
+/// A step's counters and times (the fields every variant has).
+fn step_json(s: &Step) -> Value {
+    json!({
+        "bv_tests": s.counters.bv_tests,
+        "prim_tests": s.counters.prim_tests,
+        "bv_updates": s.counters.bv_updates,
+        "contacts": s.counters.contacts,
+        "time_ns": s.time_ns(),
+        "update_ns": s.update_ns,
+        "refit_ns": s.refit_ns,
+        "query_ns": s.query_ns,
+    })
+}
+
+/// The radius a refit mode fits.
+fn radius_label(refit: Refit) -> &'static str {
+    match refit {
+        Refit::EagerBottomUp => "bottom-up bound",
+        _ => "exact",
+    }
+}
+
+fn study_json(study: &RefitStudy) -> Value {
+    let l = &study.looseness;
+    let rows: Vec<Value> = study
+        .rows
+        .iter()
+        .map(|row| {
+            let t = row.totals();
+            json!({
+                "refit": row.refit.name(),
+                "radius": radius_label(row.refit),
+                "totals": {
+                    "bv_tests": t.bv_tests,
+                    "prim_tests": t.prim_tests,
+                    "bv_updates": t.bv_updates,
+                    "contacts": t.contacts,
+                    "update_ns": row.total_update_ns(),
+                    "refit_ns": row.total_refit_ns(),
+                    "query_ns": row.total_query_ns(),
+                },
+                "total_time_ns": row.total_time_ns(),
+                "steps": row.steps.iter().map(step_json).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    json!({
+        "method": Method::Dh.name(),
+        "baseline": "methods.dh (exact radius, lazy refit)",
+        "looseness": {"internal_nodes": l.nodes, "mean": l.mean, "max": l.max, "root_mean": l.root_mean},
+        "rows": rows,
+    })
+}
+
 /// The machine-readable report.
 pub fn to_json(r: &Report) -> Value {
     let s = &r.scene;
@@ -119,11 +167,13 @@ pub fn to_json(r: &Report) -> Value {
             "object_pairs": s.object_pairs,
             "frames": s.frames,
             "levels": s.levels,
+            "central": s.central.name(),
             "threads": s.threads,
             "seed": s.seed,
             "snapshot_step": r.snapshot.step,
         },
         "methods": methods,
+        "refit_study": r.refit_study.as_ref().map(study_json),
         "wall_s": {"simulate": r.simulate_s, "measure": r.measure_s, "calibrate": r.calibrate_s},
     })
 }
@@ -170,7 +220,122 @@ pub fn summary_table(r: &Report) -> String {
             pct(m.model_error())
         );
     }
+    if let Some(study) = &r.refit_study {
+        let _ = writeln!(
+            s,
+            "\nDH radius (same frames): {:<16} {:>10} {:>12} {:>12} {:>10} {:>10} {:>10}",
+            "radius, refit", "N_V", "N_P", "N_U", "refit ms", "query ms", "time ms"
+        );
+        for row in study_rows(r, study) {
+            let _ = writeln!(
+                s,
+                "{:<24} {:<16} {:>10} {:>12} {:>12} {:>10} {:>10} {:>10}",
+                "",
+                format!("{}, {}", row.radius, row.refit),
+                row.counters.bv_tests,
+                row.counters.prim_tests,
+                row.counters.bv_updates,
+                row.refit_ms,
+                ms(row.query_ns),
+                ms(row.time_ns)
+            );
+        }
+    }
     s
+}
+
+/// One row of the refit study's tables: the default lazy exact refit (DH's row of the
+/// methods) or one of the study's eager modes.
+struct StudyLine {
+    radius: &'static str,
+    refit: &'static str,
+    counters: dhcd::Counters,
+    /// Eager: measured; lazy: `N_U*C_U` (the refit is inside the query).
+    refit_ms: String,
+    update_ns: f64,
+    query_ns: f64,
+    time_ns: f64,
+}
+
+fn study_rows(r: &Report, study: &RefitStudy) -> Vec<StudyLine> {
+    let mut rows = Vec::new();
+    if let Some(dh) = r.method(Method::Dh) {
+        let t = dh.totals();
+        rows.push(StudyLine {
+            radius: radius_label(Refit::Lazy),
+            refit: "lazy (default)",
+            counters: t,
+            refit_ms: format!("~{}", ms(t.bv_updates as f64 * dh.costs.c_u.value)),
+            update_ns: dh.total_update_ns(),
+            query_ns: dh.total_query_ns(),
+            time_ns: dh.total_time_ns(),
+        });
+    }
+    rows.extend(study.rows.iter().map(|row: &RefitRow| StudyLine {
+        radius: radius_label(row.refit),
+        refit: "eager",
+        counters: row.totals(),
+        refit_ms: ms(row.total_refit_ns()),
+        update_ns: row.total_update_ns(),
+        query_ns: row.total_query_ns(),
+        time_ns: row.total_time_ns(),
+    }));
+    rows
+}
+
+/// The refit study's section of the Markdown report.
+fn study_markdown(md: &mut String, r: &Report, study: &RefitStudy) {
+    let _ = writeln!(md, "\n## DH radius: exact against the bottom-up bound\n");
+    let _ = writeln!(
+        md,
+        "The same frames, DH with the same central vertices ({}), refitted three ways: the default (the exact radius, lazily: a node's radius is recomputed from its region's vertices just before its first test in a step, inside the query), the exact radius of every node before the query (eager), and the bottom-up bound of every node before the query (eager: leaves exact, each internal node `r_p = max_c(|C_p - C_c| + r_c)` from its children; the paper's future work, cheaper radius updates). Contacts are identical (checked). Times are totals over the run of the least time over replays of each step; the lazy refit cannot be timed apart from the query, so its column is the calibrated `N_U·C_U`.\n",
+        r.scene.central
+    );
+    let _ = writeln!(
+        md,
+        "| radius | refit | N_V (BV pairs) | N_P (triangle pairs) | N_U (BV updates) | contacts | update ms | refit ms | query ms | total ms |"
+    );
+    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let rows = study_rows(r, study);
+    for row in &rows {
+        let c = row.counters;
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            row.radius,
+            row.refit,
+            c.bv_tests,
+            c.prim_tests,
+            c.bv_updates,
+            c.contacts,
+            ms(row.update_ns),
+            row.refit_ms,
+            ms(row.query_ns),
+            ms(row.time_ns)
+        );
+    }
+    let eager = |refit: Refit| study.rows.iter().find(|row| row.refit == refit);
+    if let (Some(exact), Some(bound)) = (eager(Refit::Eager), eager(Refit::EagerBottomUp)) {
+        let (e, b) = (exact.totals(), bound.totals());
+        let ratio = |x: u64, y: u64| if y > 0 { x as f64 / y as f64 } else { 0.0 };
+        let time_ratio = if exact.total_refit_ns() > 0.0 {
+            bound.total_refit_ns() / exact.total_refit_ns()
+        } else {
+            0.0
+        };
+        let l = &study.looseness;
+        let _ = writeln!(
+            md,
+            "\nThe bottom-up bound refits every node in {:.2}x the time of the exact eager refit; its looser radii cost {:.3}x the BV pairs (N_V) and {:.3}x the triangle pairs (N_P) of the exact radii. At the last step its radii are {:.3}x the exact ones on average over {} internal nodes (at most {:.3}x; {:.3}x at the roots).",
+            time_ratio,
+            ratio(b.bv_tests, e.bv_tests),
+            ratio(b.prim_tests, e.prim_tests),
+            l.mean,
+            l.nodes,
+            l.max,
+            l.root_mean
+        );
+    }
 }
 
 fn spread_cell(c: &Constant) -> String {
@@ -188,9 +353,9 @@ pub fn markdown(r: &Report) -> String {
     let _ = writeln!(md, "# dhcd experiment report\n");
     let _ = writeln!(
         md,
-        "Scene: {} objects ({}), {} triangles and {} vertices in all ({} / {} per object), {} nodes per hierarchy ({} levels), {} frames, {} object pairs per step, {} thread(s), seed {}.\n",
+        "Scene: {} objects ({}), {} triangles and {} vertices in all ({} / {} per object), {} nodes per hierarchy ({} levels), DH central vertex {}, {} frames, {} object pairs per step, {} thread(s), seed {}.\n",
         s.objects, s.mesh, s.triangles, s.vertices, s.triangles_per_object, s.vertices_per_object,
-        s.nodes_per_hierarchy, s.levels, s.frames, s.object_pairs, s.threads, s.seed
+        s.nodes_per_hierarchy, s.levels, s.central, s.frames, s.object_pairs, s.threads, s.seed
     );
     let _ = writeln!(
         md,
@@ -296,6 +461,9 @@ pub fn markdown(r: &Report) -> String {
             ms(m.total_query_ns()),
             pct(m.model_vs_query_error())
         );
+    }
+    if let Some(study) = &r.refit_study {
+        study_markdown(&mut md, r, study);
     }
     let _ = writeln!(md, "\n## Memory\n");
     let _ = writeln!(
