@@ -44,30 +44,27 @@ fn expected(frame: &str) -> usize {
         .1
 }
 
-/// One query on `positions`; with `par_too`, the same state queried again with two threads
-/// must give identical pairs and counters (the hierarchy is made stale again in between, so
-/// both refit the same nodes).
-fn self_collide_at(
-    h: &mut AnyHierarchy,
-    positions: &[[f32; 3]],
-    par_too: bool,
-    what: &str,
-) -> Contacts {
+/// A query on a fresh build (`refit: None`: the volumes fitted by the build), or after
+/// `update_positions(positions)` (`Some`), then again with two threads, which must give
+/// identical pairs and counters (the positions are handed over again in between, so both
+/// queries refit the same nodes).
+fn self_collide_at(h: &mut AnyHierarchy, refit: Option<&[[f32; 3]]>, what: &str) -> Contacts {
     let mut ws = Workspace::default();
+    let Some(positions) = refit else {
+        return h.self_collide(&mut ws, Par::Seq);
+    };
     h.update_positions(positions).unwrap();
     let seq = h.self_collide(&mut ws, Par::Seq);
-    if par_too {
-        h.update_positions(positions).unwrap();
-        let par = h.self_collide(&mut ws, Par::Rayon(2));
-        assert_eq!(
-            par.counters, seq.counters,
-            "{what}: 2 threads vs 1, counters"
-        );
-        assert!(
-            par.pairs == seq.pairs,
-            "{what}: 2 threads vs 1, pairs differ"
-        );
-    }
+    h.update_positions(positions).unwrap();
+    let par = h.self_collide(&mut ws, Par::Rayon(2));
+    assert_eq!(
+        par.counters, seq.counters,
+        "{what}: 2 threads vs 1, counters"
+    );
+    assert!(
+        par.pairs == seq.pairs,
+        "{what}: 2 threads vs 1, pairs differ"
+    );
     seq
 }
 
@@ -114,7 +111,8 @@ fn check_pair(first: &str, second: &str) {
                     if frame == build { "" } else { " (refit)" }
                 );
                 // Two threads on the refit path: each frame once per kind.
-                let c = self_collide_at(&mut h, meshes[frame].positions(), frame != build, &what);
+                let refit = (frame != build).then(|| meshes[frame].positions());
+                let c = self_collide_at(&mut h, refit, &what);
                 assert_eq!(c.pairs.len(), expected(names[frame]), "{what}: contacts");
                 assert_eq!(c.counters.contacts as usize, c.pairs.len(), "{what}");
                 validate_all(&mut h, &what);
