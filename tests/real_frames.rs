@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use dhcd::{AnyHierarchy, Contacts, Mesh, Method, Options, Par, Refit, RegionTree, Workspace};
+use dhcd::{AnyHierarchy, Contacts, Mesh, Method, Options, Par, RegionTree, Workspace};
 
 /// Every frame of the folder and its exact self-contact count (the README's table).
 const EXPECTED: [(&str, usize); 8] = [
@@ -100,7 +100,8 @@ fn check_pair(first: &str, second: &str) {
         tree.check_topology(rest).unwrap();
         let mut reference: Vec<Vec<[u32; 2]>> = Vec::new();
         for method in Method::ALL {
-            let mut h = AnyHierarchy::with_tree(method, tree.clone(), rest, Refit::Lazy).unwrap();
+            let mut h =
+                AnyHierarchy::with_tree(method, tree.clone(), rest, Options::default()).unwrap();
             h.validate().unwrap();
             let mut found = Vec::new();
             for frame in [build, 1 - build] {

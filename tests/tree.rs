@@ -76,7 +76,7 @@ fn outliers_do_not_push_a_cluster_into_one_leaf() {
     // and the triangle pairs tested grow linearly with n (measured for DH, the loosest kind:
     // 4.2 n and 58 n). With the cluster in one leaf the triangle pairs were n^2 / 2 = 5e9.
     for method in Method::ALL {
-        let mut h = AnyHierarchy::with_tree(method, tree.clone(), &mesh, options.refit).unwrap();
+        let mut h = AnyHierarchy::with_tree(method, tree.clone(), &mesh, options).unwrap();
         let c = h.self_collide(&mut Workspace::default(), Par::Seq);
         eprintln!("{method}: {} levels, {:?}", tree.depth_count(), c.counters);
         assert!(
