@@ -105,6 +105,16 @@ fn central_vertex_choices_find_the_same_contacts() {
             }
         }
     }
+    // `scene` takes the same flag: the same contacts either way.
+    let scene: Vec<serde_json::Value> = ["rest-centroid", "min-radius"]
+        .map(|central| {
+            let (code, out, err) = dhcd(&["scene", pa, pb, "--central", central, "--json"]);
+            assert_eq!(code, 0, "{err}");
+            json(&out)["pairs"].clone()
+        })
+        .into();
+    assert_eq!(scene[0], scene[1]);
+    assert_eq!(scene[0].as_array().unwrap().len(), cross.len());
     let (code, out, err) = dhcd(&["self", pa, "--central", "middle"]);
     assert_ne!(code, 0);
     assert!(out.is_empty());
