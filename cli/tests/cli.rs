@@ -32,14 +32,19 @@ fn json(s: &str) -> serde_json::Value {
     serde_json::from_str(s).unwrap()
 }
 
-#[test]
-fn self_json_equals_brute_force() {
+/// An icosphere waved at phase `t` by `amplitude`, moved by `offset`.
+fn waved_sphere(t: f32, amplitude: f32, offset: [f32; 3]) -> Mesh {
     let s = icosphere(2, 1.0, [0.0; 3]);
-    let crumpled = Mesh::new(
-        wave(s.positions(), 1.0, 0.6, [0.0; 3]),
+    Mesh::new(
+        wave(s.positions(), t, amplitude, offset),
         s.triangles().to_vec(),
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn self_json_equals_brute_force() {
+    let crumpled = waved_sphere(1.0, 0.6, [0.0; 3]);
     let path = write_obj("crumpled.obj", &crumpled);
     let expected = brute_force_self_pairs(&crumpled);
     assert!(!expected.is_empty());
@@ -73,17 +78,8 @@ fn self_json_equals_brute_force() {
 
 #[test]
 fn central_vertex_choices_find_the_same_contacts() {
-    let s = icosphere(2, 1.0, [0.0; 3]);
-    let crumpled = Mesh::new(
-        wave(s.positions(), 1.0, 0.6, [0.0; 3]),
-        s.triangles().to_vec(),
-    )
-    .unwrap();
-    let other = Mesh::new(
-        wave(s.positions(), 0.3, 0.2, [1.1, 0.2, 0.0]),
-        s.triangles().to_vec(),
-    )
-    .unwrap();
+    let crumpled = waved_sphere(1.0, 0.6, [0.0; 3]);
+    let other = waved_sphere(0.3, 0.2, [1.1, 0.2, 0.0]);
     let (pa, pb) = (
         write_obj("central-a.obj", &crumpled),
         write_obj("central-b.obj", &other),
@@ -105,6 +101,16 @@ fn central_vertex_choices_find_the_same_contacts() {
             }
         }
     }
+    // `scene` takes the same flag: the same contacts either way.
+    let scene: Vec<serde_json::Value> = ["rest-centroid", "min-radius"]
+        .map(|central| {
+            let (code, out, err) = dhcd(&["scene", pa, pb, "--central", central, "--json"]);
+            assert_eq!(code, 0, "{err}");
+            json(&out)["pairs"].clone()
+        })
+        .into();
+    assert_eq!(scene[0], scene[1]);
+    assert_eq!(scene[0].as_array().unwrap().len(), cross.len());
     let (code, out, err) = dhcd(&["self", pa, "--central", "middle"]);
     assert_ne!(code, 0);
     assert!(out.is_empty());

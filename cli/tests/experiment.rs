@@ -246,30 +246,31 @@ fn bad_configs_are_errors() {
     }
 }
 
-#[test]
-fn cli_writes_every_file() {
-    let dir = temp_dir("experiment-cli");
-    let out = dhcd(&[
-        "experiment",
-        "--frames",
-        "3",
-        "--quiet",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+/// Runs `dhcd experiment ARGS --quiet --out DIR`, which must succeed; its standard output
+/// and `report.json`.
+fn experiment_cli(dir: &std::path::Path, args: &[&str]) -> (String, serde_json::Value) {
+    let mut all = vec!["experiment"];
+    all.extend(args);
+    all.extend(["--quiet", "--out", dir.to_str().unwrap()]);
+    let out = dhcd(&all);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    let json = serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    (String::from_utf8_lossy(&out.stdout).into_owned(), json)
+}
+
+#[test]
+fn cli_writes_every_file() {
+    let dir = temp_dir("experiment-cli");
+    let (stdout, json) = experiment_cli(&dir, &["--frames", "3"]);
     for f in output::FILES {
         let meta = std::fs::metadata(dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
         assert!(meta.len() > 0, "{f} is empty");
     }
-    let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("dh") && stdout.contains("aabb"), "{stdout}");
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
     assert_eq!(json["methods"]["dh"]["steps"].as_array().unwrap().len(), 3);
     assert_eq!(json["scene"]["central"], "rest-centroid");
     assert!(
@@ -278,25 +279,15 @@ fn cli_writes_every_file() {
     );
     assert!(stdout.contains("bottom-up bound, eager"), "{stdout}");
     // The least-radius central vertex, asked for on the command line.
-    let out = dhcd(&[
-        "experiment",
+    let args = [
         "--frames",
         "2",
         "--methods",
         "dh",
         "--central",
         "min-radius",
-        "--quiet",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    ];
+    let (_, json) = experiment_cli(&dir, &args);
     assert_eq!(json["scene"]["central"], "min-radius");
     assert_eq!(json["refit_study"]["rows"].as_array().unwrap().len(), 2);
     let _ = std::fs::remove_dir_all(&dir);

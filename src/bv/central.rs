@@ -18,6 +18,12 @@
 //!
 //! Every bound is one of the terms of the maximum or rounds monotonically above them, so the
 //! pruning never changes the answer: it is the brute-force argmin (tested against it).
+//!
+//! Cost: on real frames (regions up to the whole 46-74K-vertex mesh) the build takes 1.9-2.7x
+//! the paper's choice. The worst case is a region where every radius ties to a few ulps, as
+//! a centrally symmetric sphere (every vertex has an antipode): every candidate is evaluated
+//! and each query scans the vertices near its antipode, about `m^1.5` in all (an
+//! icosphere of 163,842 vertices: 2.3 s against 0.15 s; `O(m^2)` would be minutes).
 
 use super::dist2_f64;
 use crate::hierarchy::CentralVertex;

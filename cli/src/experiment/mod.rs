@@ -250,19 +250,41 @@ pub struct MethodReport {
     pub steps: Vec<Step>,
 }
 
+/// Sums over the steps of one measured variant: a method ([`MethodReport`]) or a row of the
+/// refit study ([`RefitRow`]).
+pub trait StepTotals {
+    fn steps(&self) -> &[Step];
+
+    fn totals(&self) -> Counters {
+        self.steps().iter().map(|s| s.counters).sum()
+    }
+    fn total_time_ns(&self) -> f64 {
+        self.steps().iter().map(Step::time_ns).sum()
+    }
+    fn total_update_ns(&self) -> f64 {
+        self.steps().iter().map(|s| s.update_ns).sum()
+    }
+    fn total_refit_ns(&self) -> f64 {
+        self.steps().iter().map(|s| s.refit_ns).sum()
+    }
+    fn total_query_ns(&self) -> f64 {
+        self.steps().iter().map(|s| s.query_ns).sum()
+    }
+}
+
+impl StepTotals for MethodReport {
+    fn steps(&self) -> &[Step] {
+        &self.steps
+    }
+}
+
+impl StepTotals for RefitRow {
+    fn steps(&self) -> &[Step] {
+        &self.steps
+    }
+}
+
 impl MethodReport {
-    pub fn totals(&self) -> Counters {
-        self.steps.iter().map(|s| s.counters).sum()
-    }
-    pub fn total_time_ns(&self) -> f64 {
-        self.steps.iter().map(Step::time_ns).sum()
-    }
-    pub fn total_update_ns(&self) -> f64 {
-        self.steps.iter().map(|s| s.update_ns).sum()
-    }
-    pub fn total_query_ns(&self) -> f64 {
-        self.steps.iter().map(|s| s.query_ns).sum()
-    }
     /// Sum of the three-term model over all steps.
     pub fn total_predicted_ns(&self) -> f64 {
         self.steps.iter().map(|s| s.predicted_ns).sum()
@@ -312,24 +334,6 @@ impl RefitStudy {
 pub struct RefitRow {
     pub refit: Refit,
     pub steps: Vec<Step>,
-}
-
-impl RefitRow {
-    pub fn totals(&self) -> Counters {
-        self.steps.iter().map(|s| s.counters).sum()
-    }
-    pub fn total_refit_ns(&self) -> f64 {
-        self.steps.iter().map(|s| s.refit_ns).sum()
-    }
-    pub fn total_query_ns(&self) -> f64 {
-        self.steps.iter().map(|s| s.query_ns).sum()
-    }
-    pub fn total_update_ns(&self) -> f64 {
-        self.steps.iter().map(|s| s.update_ns).sum()
-    }
-    pub fn total_time_ns(&self) -> f64 {
-        self.steps.iter().map(Step::time_ns).sum()
-    }
 }
 
 /// How much larger the bottom-up radii are than the exact ones (ratios, deterministic).

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
-use super::{cost::Constant, MethodReport, RefitRow, RefitStudy, Report, Step};
+use super::{cost::Constant, MethodReport, RefitRow, RefitStudy, Report, Step, StepTotals};
 use dhcd::bv::Method;
 use dhcd::error::{Error, Result};
 use dhcd::hierarchy::Refit;
