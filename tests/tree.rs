@@ -204,3 +204,44 @@ fn fixed_levels_give_exactly_that_depth() {
     assert!(tree.leaves().all(|n| tree.tri_range(n).len() == 1));
     assert_eq!(tree.leaf_count(), 80);
 }
+
+/// Seven separate balls in a row, in one mesh (a median cut by triangles would halve the
+/// fourth): no region smaller than a ball spans two balls, so
+/// moving the balls apart (as a simulation does) keeps the refitted bounds tight: the
+/// self-collision work after a large separation stays what it is at rest.
+#[test]
+fn separate_objects_are_never_one_region() {
+    let per_ball = icosphere(2, 1.0, [0.0; 3]).triangle_count();
+    let layout = |gap: f32| {
+        let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+        for i in 0..7 {
+            let centre = [gap * i as f32, 0.0, 0.0];
+            let ball = icosphere(2, 1.0, centre);
+            let base = positions.len() as u32;
+            positions.extend_from_slice(ball.positions());
+            triangles.extend(ball.triangles().iter().map(|t| t.map(|v| v + base)));
+        }
+        Mesh::new(positions, triangles).unwrap()
+    };
+    let rest = layout(2.5);
+    let tree = RegionTree::build(&rest, TreeShape::default()).unwrap();
+    for n in 0..tree.node_count() {
+        let tris = tree.tri_range(n);
+        if tris.len() <= per_ball {
+            let ball = |t: usize| tree.tri_order()[t] as usize / per_ball;
+            let first = ball(tris.start);
+            assert!(
+                tris.clone().all(|t| ball(t) == first),
+                "node {n} spans two balls"
+            );
+        }
+    }
+    let mut h = Hierarchy::<Aabb>::new(&rest, Options::default()).unwrap();
+    let at_rest = dhcd::self_collide(&mut h).counters;
+    h.update_positions(layout(250.0).positions()).unwrap();
+    let apart = dhcd::self_collide(&mut h).counters;
+    assert!(
+        apart.prim_tests <= at_rest.prim_tests,
+        "balls moved apart cost more: {apart:?} vs {at_rest:?}"
+    );
+}

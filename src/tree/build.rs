@@ -7,12 +7,26 @@
 //! longest axis never cuts a near-flat mesh along its noise (which interleaves children
 //! whose bounds never shrink). Ties in the median are broken by triangle index, so even
 //! coincident centroids are separated and the build is deterministic.
+//!
+//! A run holding several connected components (16 balls in one mesh, armadillos and their
+//! rollers) is first cut between whole components, at the component boundary nearest the
+//! median when that leaves at least a quarter on each side and the two sides lie apart along
+//! the axis (components ordered by their centroid along it): a region then never spans two objects that move apart,
+//! whose refitted bounds would otherwise grow with their distance. A run of more than
+//! [`MAX_CUT_COMPONENTS`] components (a triangle soup) gets the plain median cut.
 
 use super::{RegionTree, TreeShape, BLOCK, MAX_CHILDREN};
 use crate::error::Result;
 use crate::mesh::Mesh;
 
 const UNSET: u32 = u32::MAX;
+/// A cut between whole components is taken when the parts' centroid extents along the cut
+/// axis overlap by at most this fraction of their union (measured on the real frames:
+/// bouncing balls and armadillos on rollers gain, twisted strands must not be cut apart).
+const SEPARATE_OBJECTS_OVERLAP: f64 = 0.25;
+/// Most components a run may hold for a cut between whole components (a triangle soup,
+/// every triangle its own component, is cut at the median).
+const MAX_CUT_COMPONENTS: usize = 64;
 
 impl RegionTree {
     /// Builds the region tree of `mesh` (its current positions are the rest pose).
@@ -29,6 +43,7 @@ impl RegionTree {
                 std::array::from_fn(|k| (c[0][k] as f64 + c[1][k] as f64 + c[2][k] as f64) / 3.0)
             })
             .collect();
+        let objects = Objects::new(mesh, centroids);
 
         // Breadth-first: each node owns the run `order[start..end]` of the working triangle
         // array; splitting a node permutes its run into its children's consecutive runs, so
@@ -54,7 +69,7 @@ impl RegionTree {
                 level_start.push(n as u32);
             }
             if shape.splits(e - s, d) {
-                split(&mut order[s..e], &centroids, shape, &mut parts);
+                split(&mut order[s..e], &objects, shape, &mut parts);
                 first_child[n] = tri_start.len() as u32;
                 child_count[n] = parts.len() as u8;
                 for &(ps, pe) in &parts {
@@ -202,12 +217,7 @@ impl TreeShape {
 /// Permutes `run` (triangle ids) into up to [`MAX_CHILDREN`] consecutive parts and writes
 /// their `(start, end)` offsets, in order, into `parts`. Always at least two parts
 /// (`run` has at least two triangles).
-fn split(
-    run: &mut [u32],
-    centroids: &[[f64; 3]],
-    shape: TreeShape,
-    parts: &mut Vec<(usize, usize)>,
-) {
+fn split(run: &mut [u32], objects: &Objects, shape: TreeShape, parts: &mut Vec<(usize, usize)>) {
     debug_assert!(run.len() >= 2);
     parts.clear();
     parts.push((0, run.len()));
@@ -221,33 +231,152 @@ fn split(
         else {
             break;
         };
-        let mid = s + median_cut(&mut run[s..e], centroids);
+        let mid = s + objects.cut(&mut run[s..e]);
         parts[i] = (s, mid);
         parts.insert(i + 1, (mid, e));
     }
 }
 
-/// Reorders `run` so that its first `len / 2` triangles have centroids at or below the
-/// median along the longest axis of the centroids' box (ties by triangle id); returns
-/// `len / 2`.
-fn median_cut(run: &mut [u32], centroids: &[[f64; 3]]) -> usize {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for &t in run.iter() {
-        let c = centroids[t as usize];
-        for k in 0..3 {
-            lo[k] = lo[k].min(c[k]);
-            hi[k] = hi[k].max(c[k]);
+/// Per triangle: its centroid and connected component (triangles sharing a vertex are
+/// connected), and per component the mean of its triangles' centroids.
+struct Objects {
+    centroids: Vec<[f64; 3]>,
+    component: Vec<u32>,
+    component_centroid: Vec<[f64; 3]>,
+}
+
+impl Objects {
+    fn new(mesh: &Mesh, centroids: Vec<[f64; 3]>) -> Self {
+        // Union-find over vertices, with path halving.
+        let mut up: Vec<u32> = (0..mesh.vertex_count() as u32).collect();
+        fn root(up: &mut [u32], mut v: u32) -> u32 {
+            while up[v as usize] != v {
+                up[v as usize] = up[up[v as usize] as usize];
+                v = up[v as usize];
+            }
+            v
+        }
+        for t in mesh.triangles() {
+            let r0 = root(&mut up, t[0]);
+            for &v in &t[1..] {
+                let r = root(&mut up, v);
+                if r != r0 {
+                    up[r as usize] = r0;
+                }
+            }
+        }
+        let mut label = vec![UNSET; up.len()];
+        let mut sums: Vec<([f64; 3], f64)> = Vec::new();
+        let component: Vec<u32> = mesh
+            .triangles()
+            .iter()
+            .zip(&centroids)
+            .map(|(t, c)| {
+                let r = root(&mut up, t[0]) as usize;
+                if label[r] == UNSET {
+                    label[r] = sums.len() as u32;
+                    sums.push(([0.0; 3], 0.0));
+                }
+                let s = &mut sums[label[r] as usize];
+                for (sum, x) in s.0.iter_mut().zip(c) {
+                    *sum += x;
+                }
+                s.1 += 1.0;
+                label[r]
+            })
+            .collect();
+        let component_centroid = sums.iter().map(|(s, n)| s.map(|x| x / n)).collect();
+        Self {
+            centroids,
+            component,
+            component_centroid,
         }
     }
-    let axis = (0..3)
-        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])).then(b.cmp(&a)))
-        .unwrap_or(0);
-    let mid = run.len() / 2;
-    run.select_nth_unstable_by(mid, |&a, &b| {
-        centroids[a as usize][axis]
-            .total_cmp(&centroids[b as usize][axis])
-            .then(a.cmp(&b))
-    });
-    mid
+
+    /// Cuts `run` in two (see the module doc) and returns the length of the first part,
+    /// between `len / 4` and `len - len / 4` for a component cut, `len / 2` otherwise.
+    fn cut(&self, run: &mut [u32]) -> usize {
+        let c = &self.centroids;
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for &t in run.iter() {
+            for k in 0..3 {
+                lo[k] = lo[k].min(c[t as usize][k]);
+                hi[k] = hi[k].max(c[t as usize][k]);
+            }
+        }
+        let axis = (0..3)
+            .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])).then(b.cmp(&a)))
+            .unwrap_or(0);
+        let own = |a: u32, b: u32| {
+            c[a as usize][axis]
+                .total_cmp(&c[b as usize][axis])
+                .then(a.cmp(&b))
+        };
+        let mid = run.len() / 2;
+        if let Some(first) = self.component_cut(run, axis) {
+            return first;
+        }
+        run.select_nth_unstable_by(mid, |&a, &b| own(a, b));
+        mid
+    }
+
+    /// The cut between whole components (see the module doc), if `run` holds between two and
+    /// [`MAX_CUT_COMPONENTS`] components and one is acceptable: partitions `run` and returns
+    /// the first part's length.
+    fn component_cut(&self, run: &mut [u32], axis: usize) -> Option<usize> {
+        // Per component of the run: id, triangle count, centroid extent along the axis.
+        let mut comps: Vec<(u32, usize, f64, f64)> = Vec::new();
+        for &t in run.iter() {
+            let (id, x) = (self.component[t as usize], self.centroids[t as usize][axis]);
+            if let Some(c) = comps.iter_mut().find(|c| c.0 == id) {
+                c.1 += 1;
+                c.2 = c.2.min(x);
+                c.3 = c.3.max(x);
+            } else if comps.len() == MAX_CUT_COMPONENTS {
+                return None;
+            } else {
+                comps.push((id, 1, x, x));
+            }
+        }
+        if comps.len() < 2 {
+            return None;
+        }
+        let key = |c: &(u32, usize, f64, f64)| self.component_centroid[c.0 as usize][axis];
+        comps.sort_unstable_by(|a, b| key(a).total_cmp(&key(b)).then(a.0.cmp(&b.0)));
+        // The boundary nearest the median, at least a quarter of the run on each side.
+        let (len, mid, quarter) = (run.len(), run.len() / 2, run.len() / 4);
+        let mut best: Option<(usize, usize)> = None; // (components before, triangles before)
+        let mut before = 0;
+        for (k, c) in comps.iter().enumerate().take(comps.len() - 1) {
+            before += c.1;
+            if before >= quarter.max(1)
+                && before <= len - quarter
+                && best.is_none_or(|(_, b)| before.abs_diff(mid) < b.abs_diff(mid))
+            {
+                best = Some((k + 1, before));
+            }
+        }
+        let (k, first) = best?;
+        // Only objects apart along the axis: interleaved ones (twisted strands) cut apart
+        // would give two long overlapping parts.
+        let extent = |cs: &[(u32, usize, f64, f64)]| {
+            cs.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| {
+                    (l.min(c.2), h.max(c.3))
+                })
+        };
+        let ((l1, h1), (l2, h2)) = (extent(&comps[..k]), extent(&comps[k..]));
+        let overlap = (h1.min(h2) - l1.max(l2)).max(0.0);
+        if overlap > SEPARATE_OBJECTS_OVERLAP * (h1.max(h2) - l1.min(l2)) {
+            return None;
+        }
+        let left: Vec<u32> = comps[..k].iter().map(|c| c.0).collect();
+        let (a, b): (Vec<u32>, Vec<u32>) = run
+            .iter()
+            .partition(|&&t| left.contains(&self.component[t as usize]));
+        run[..first].copy_from_slice(&a);
+        run[first..].copy_from_slice(&b);
+        Some(first)
+    }
 }
