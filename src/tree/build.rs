@@ -11,8 +11,8 @@
 //! A run holding several connected components (16 balls in one mesh, armadillos and their
 //! rollers) is first cut between whole components, at the component boundary nearest the
 //! median when that leaves at least a quarter on each side and the two sides lie apart along
-//! the axis (components ordered by their centroid along it): a region then never spans two objects that move apart,
-//! whose refitted bounds would otherwise grow with their distance. A run of more than
+//! the axis (components ordered by their centroid along it): a region then never spans two
+//! objects that move apart, whose refitted bounds would otherwise grow with their distance. A run of more than
 //! [`MAX_CUT_COMPONENTS`] components (a triangle soup) gets the plain median cut.
 
 use super::{RegionTree, TreeShape, BLOCK, MAX_CHILDREN};
@@ -325,6 +325,9 @@ impl Objects {
     /// [`MAX_CUT_COMPONENTS`] components and one is acceptable: partitions `run` and returns
     /// the first part's length.
     fn component_cut(&self, run: &mut [u32], axis: usize) -> Option<usize> {
+        if self.component_centroid.len() < 2 {
+            return None; // one object: nothing to cut between
+        }
         // Per component of the run: id, triangle count, centroid extent along the axis.
         let mut comps: Vec<(u32, usize, f64, f64)> = Vec::new();
         for &t in run.iter() {
