@@ -189,6 +189,9 @@ fn bad_input_is_one_error_line() {
         (vec!["bench", "self", frame, "--leaf-size", "0"], "leaf"),
         (vec!["bench", "self", frame, "--central", "mean"], "mean"),
         (vec!["bench", "self", missing], "missing.obj"),
+        // Options are checked before any file is read.
+        (vec!["bench", "self", missing, "--repeat", "0"], "--repeat"),
+        (vec!["bench", "self", missing, "--method", "obb"], "obb"),
         (vec!["bench", "collide", "--a", frame], "--b"),
         (vec!["bench", "self"], "FRAMES"),
         (vec!["bench"], "subcommand"),

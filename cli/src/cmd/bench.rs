@@ -3,9 +3,10 @@
 //! cycles `update_positions` through the frames, timing each step (update + query); reports
 //! the build time, the median and least step time, and each frame's contacts and counters.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
+use dhcd::error::escaped_path;
 use dhcd::{AnyHierarchy, CentralVertex, Counters, Mesh, Method, Options, Par, Workspace};
 use serde_json::json;
 
@@ -85,13 +86,8 @@ struct Run {
 }
 
 pub fn run(args: BenchArgs) -> Result<(), String> {
-    let (opts, a, b) = match &args.what {
-        What::SelfCollide { frames, opts } => (opts, load_frames(&opts.input, frames)?, None),
-        What::Collide { a, b, opts } => (
-            opts,
-            load_frames(&opts.input, a)?,
-            Some(load_frames(&opts.input, b)?),
-        ),
+    let opts = match &args.what {
+        What::SelfCollide { opts, .. } | What::Collide { opts, .. } => opts,
     };
     let methods: Vec<Method> = if opts.method.eq_ignore_ascii_case("all") {
         Method::ALL.to_vec()
@@ -106,6 +102,14 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     }
     let par = Par::threads(opts.threads).map_err(|e| e.to_string())?;
     let threads = par.thread_count();
+    // Options are checked above, before any file is read.
+    let (a, b) = match &args.what {
+        What::SelfCollide { frames, .. } => (load_frames(&opts.input, frames)?, None),
+        What::Collide { a, b, .. } => (
+            load_frames(&opts.input, a)?,
+            Some(load_frames(&opts.input, b)?),
+        ),
+    };
     let options = Options {
         levels: opts.levels,
         leaf_size: opts.leaf_size,
@@ -172,18 +176,14 @@ fn load_frames(input: &InputArgs, paths: &[PathBuf]) -> Result<Vec<Mesh>, String
             if m.vertex_count() != first.vertex_count() || m.triangles() != first.triangles() {
                 return Err(format!(
                     "{}: not a pose of {} (a frame must have the first frame's vertices and triangles)",
-                    shown(path),
-                    shown(&paths[0])
+                    escaped_path(path),
+                    escaped_path(&paths[0])
                 ));
             }
         }
         frames.push(m);
     }
     Ok(frames)
-}
-
-fn shown(p: &Path) -> String {
-    dhcd::error::escaped_path(p)
 }
 
 /// Median and least of `xs` (non-empty).
