@@ -464,9 +464,21 @@ impl<'h, K: BvKind> Walk<'h, K> {
             (true, false) => Leaves::SelfDistinct,
             (true, true) => Leaves::SelfSame,
         };
+        let shared = match leaves {
+            Leaves::Objects => 0,
+            _ => self.a.tree().shared_pairs(x, y),
+        };
         let [la, lb] = &mut out.last;
         let (sa, sb) = (side(self.a, x, la), side(self.b, y, lb));
-        out.counters.prim_tests += leaf_pair(simd, &sa, &sb, leaves, &mut out.rows, &mut out.pairs);
+        out.counters.prim_tests += leaf_pair(
+            simd,
+            &sa,
+            &sb,
+            leaves,
+            shared,
+            &mut out.rows,
+            &mut out.pairs,
+        );
     }
 
     /// Depth-first from each of `seeds`.

@@ -13,6 +13,7 @@ mod narrow;
 mod real_frames;
 mod scene;
 mod self_collision;
+mod shared_pairs;
 mod support;
 mod threads;
 mod tree;

@@ -20,8 +20,12 @@
 //! differences), whose rounding error is at most `(7 + 56 eps) eps P` (eps = 2^-24) when
 //! nothing underflows. Gradual underflow adds an absolute error of at most `2^-150` per
 //! product, which the products by `e` scale: at most `(2 |e|_1 + 3) 2^-150` in all. A sign is
-//! certified only when `|s| > 8 eps P + 2^-147 (|e|_1 + 2)`, which covers both with margin
-//! (and the rounding of the bound itself). Overflow gives an infinite `P` (so `|s|` can never
+//! certified only when `|s| > 8 eps P + 2^-126 (|e|_1 + 2)`, which covers both with margin
+//! (and the rounding of the bound itself). The absolute term is the smallest *normal* `f32`,
+//! not the `2^-147` the underflow needs: a subnormal operand costs an FP assist of about a
+//! hundred cycles on x86, and with a subnormal constant every bound paid six (measured: half
+//! of a cloth self-collision step). It only gives up certifying determinants below about
+//! `1e-38`, i.e. triangles of sides below about `1e-12`, which the exact test then decides. Overflow gives an infinite `P` (so `|s|` can never
 //! exceed the bound: `|s| <= P` holds in floating point by monotonic rounding); NaN compares
 //! false. So a certified sign is the exact sign of the determinant, for every `f32` input.
 //! A degenerate triangle has `N = M = 0` and certifies nothing.
@@ -38,8 +42,9 @@ pub const MAX_ROW: usize = 64;
 
 /// The relative factor of the plane filter's certification bound: `8 eps`, `eps = 2^-24`.
 pub const PLANE_ERR: f32 = 8.0 * (f32::EPSILON / 2.0);
-/// The absolute factor for gradual underflow: `2^-147` (a subnormal).
-pub const PLANE_TINY: f32 = f32::from_bits(4);
+/// The absolute factor for gradual underflow: `2^-126`, the smallest normal `f32` (a
+/// subnormal factor would make every bound an FP assist; see the module doc).
+pub const PLANE_TINY: f32 = f32::MIN_POSITIVE;
 
 /// Triangles in structure-of-arrays form: a [`Tile`] of fifteen fields (coordinate `k` of
 /// corner `c` is field `3c + k`, then the closed box: min x, y, z, max x, y, z) and a tile of
@@ -241,9 +246,8 @@ pub fn leaf_candidates_scalar(
     nb: usize,
     pairing: Pairing,
     out: &mut [u64],
-) -> u64 {
+) {
     check(&a, na, &b, nb, out);
-    let mut counted = 0;
     for i in 0..na {
         let ta = a.corners(i);
         let va = [a.vertex(0)[i], a.vertex(1)[i], a.vertex(2)[i]];
@@ -255,7 +259,6 @@ pub fn leaf_candidates_scalar(
             if pairing != Pairing::All && (0..3).any(|c| va.contains(&b.vertex(c)[j])) {
                 continue;
             }
-            counted += 1;
             let boxes = (0..3).all(|k| a.lo(k)[i] <= b.hi(k)[j] && b.lo(k)[j] <= a.hi(k)[i]);
             if boxes && !plane_separated(&ta, &b.corners(j)) {
                 row |= 1 << j;
@@ -263,14 +266,13 @@ pub fn leaf_candidates_scalar(
         }
         out[i] = row;
     }
-    counted
 }
 
 /// The candidate pairs of the first `na` triangles of `a` and the first `nb <= MAX_ROW` of
 /// `b`: `out[i]` gets bit `j` set iff `(i, j)` is allowed by `pairing`, the boxes overlap and
-/// no separating plane is certified. Returns the number of allowed pairs (the narrow phase's
-/// `N_P`). Panics if `nb > MAX_ROW`, a block is shorter than its count, or `out` is shorter
-/// than `na`.
+/// no separating plane is certified. Panics if `nb > MAX_ROW`, a block is shorter than its
+/// count, or `out` is shorter than `na`. (It does not count the allowed pairs, `N_P`: that
+/// is a fact of the mesh's topology, which the caller tabulates once.)
 pub fn leaf_candidates(
     a: TriSoa,
     na: usize,
@@ -278,7 +280,7 @@ pub fn leaf_candidates(
     nb: usize,
     pairing: Pairing,
     out: &mut [u64],
-) -> u64 {
+) {
     crate::arch().dispatch(LeafCandidates {
         a,
         na,
@@ -299,9 +301,9 @@ struct LeafCandidates<'a> {
 }
 
 impl WithSimd for LeafCandidates<'_> {
-    type Output = u64;
+    type Output = ();
     #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> u64 {
+    fn with_simd<S: Simd>(self, simd: S) {
         leaf_candidates_with(
             simd,
             self.a,
@@ -336,8 +338,10 @@ fn splat3<S: Simd>(simd: S, v: [f32; 3]) -> [S::f32s; 3] {
 /// [`leaf_candidates`] on the backend `simd` (inlined into the caller's dispatched body).
 ///
 /// PERF: the second block is loaded one vector of lanes at a time, with its planes, and
-/// every triangle of the first block is tested against it from registers; the plane filter
-/// runs only for rows with a pair left after the box and shared-vertex tests. No closures
+/// every triangle of the first block is tested against it from registers; the shared-vertex
+/// mask only for rows with a box hit, the plane filter only for rows with a pair left after
+/// both (most rows of neighbouring leaves have no hit: the mask was 15% of a cloth step when
+/// every row built it to count `N_P`). No closures
 /// here: they may be compiled without the dispatched target features.
 #[inline(always)]
 pub fn leaf_candidates_with<S: Simd>(
@@ -348,7 +352,7 @@ pub fn leaf_candidates_with<S: Simd>(
     nb: usize,
     pairing: Pairing,
     out: &mut [u64],
-) -> u64 {
+) {
     check(&a, na, &b, nb, out);
     for row in out[..na].iter_mut() {
         *row = 0;
@@ -362,7 +366,6 @@ pub fn leaf_candidates_with<S: Simd>(
         simd.splat_f32s(2.0),
         simd.splat_f32s(0.0),
     );
-    let mut counted = 0u64;
     let mut base = 0;
     while base < nb {
         let end = (base + S::F32_LANES).min(len);
@@ -412,6 +415,9 @@ pub fn leaf_candidates_with<S: Simd>(
                 );
             }
             let mut bits = u64::from(mask_bits(simd, hit)) & valid;
+            if bits == 0 {
+                continue;
+            }
             if let Some(bv) = &bv {
                 let mut share = simd.equal_u32s(simd.splat_u32s(fa.vertex[0][i]), bv[0]);
                 for k in 0..3 {
@@ -422,11 +428,7 @@ pub fn leaf_candidates_with<S: Simd>(
                         }
                     }
                 }
-                let share = u64::from(mask_bits(simd, share));
-                counted += u64::from((valid & !share).count_ones());
-                bits &= !share;
-            } else {
-                counted += u64::from(valid.count_ones());
+                bits &= !u64::from(mask_bits(simd, share));
             }
             if bits == 0 {
                 continue;
@@ -454,7 +456,6 @@ pub fn leaf_candidates_with<S: Simd>(
         }
         base += S::F32_LANES;
     }
-    counted
 }
 
 /// The lane-wise [`plane`].

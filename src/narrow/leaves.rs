@@ -4,7 +4,8 @@
 //!
 //! Every filter only drops pairs that cannot intersect, so the contacts are exactly those of
 //! the exact test on every pair. `N_P` counts every triangle pair of the leaf pair (the cost
-//! model's unit), minus the vertex-sharing pairs of a self query.
+//! model's unit), minus the vertex-sharing pairs of a self query, which the region tree
+//! tabulates (`RegionTree::shared_pairs`): the kernel never counts.
 
 use dhcd_kernels::narrow::{leaf_candidates_with, Pairing, MAX_ROW};
 use pulp::Simd;
@@ -30,29 +31,35 @@ pub(crate) enum Leaves {
     SelfSame,
 }
 
-/// Tests the candidate pairs of leaves `a` x `b`; pushes contacts (original indices;
-/// `[min, max]` for self queries) and returns the number of pairs counted in `N_P`.
+/// Tests the candidate pairs of leaves `a` x `b`, of which `shared` share a vertex (0 for
+/// two objects); pushes contacts (original indices; `[min, max]` for self queries) and
+/// returns the number of pairs counted in `N_P`.
 #[inline(always)]
 pub(crate) fn leaf_pair<S: Simd>(
     simd: S,
     a: &LeafSide,
     b: &LeafSide,
     leaves: Leaves,
+    shared: u64,
     rows: &mut [u64; MAX_ROW],
     out: &mut Vec<[u32; 2]>,
 ) -> u64 {
     let (na, nb) = (a.tris.len, b.tris.len);
-    let pairing = match leaves {
-        Leaves::Objects => Pairing::All,
-        Leaves::SelfDistinct => Pairing::NoSharedVertex,
-        Leaves::SelfSame => Pairing::NoSharedVertexUpper,
+    let (pairing, allowed) = match leaves {
+        Leaves::Objects => (Pairing::All, na * nb),
+        // No shared vertex: the kernel skips the shared-vertex mask.
+        Leaves::SelfDistinct if shared == 0 => (Pairing::All, na * nb),
+        Leaves::SelfDistinct => (Pairing::NoSharedVertex, na * nb),
+        Leaves::SelfSame => (Pairing::NoSharedVertexUpper, na * na.saturating_sub(1) / 2),
     };
+    let ordered = leaves != Leaves::Objects;
+    let counted = allowed as u64 - shared;
     if na <= MAX_ROW && nb <= MAX_ROW {
         // Adaptive trees: one block per leaf.
-        return blocks(simd, a, 0, na, b, 0, nb, pairing, rows, out);
+        blocks(simd, a, 0, na, b, 0, nb, pairing, ordered, rows, out);
+        return counted;
     }
     // Leaves longer than a block (fixed-depth trees): blocks of MAX_ROW triangles.
-    let mut counted = 0;
     for a0 in (0..na).step_by(MAX_ROW) {
         for b0 in (0..nb).step_by(MAX_ROW) {
             let pairing = match pairing {
@@ -62,13 +69,14 @@ pub(crate) fn leaf_pair<S: Simd>(
                 p => p,
             };
             let (ra, rb) = ((na - a0).min(MAX_ROW), (nb - b0).min(MAX_ROW));
-            counted += blocks(simd, a, a0, ra, b, b0, rb, pairing, rows, out);
+            blocks(simd, a, a0, ra, b, b0, rb, pairing, ordered, rows, out);
         }
     }
     counted
 }
 
-/// Triangles `a0..a0 + na` of `a` against `b0..b0 + nb` of `b` (`nb <= MAX_ROW`).
+/// Triangles `a0..a0 + na` of `a` against `b0..b0 + nb` of `b` (`nb <= MAX_ROW`); contacts
+/// as `[min, max]` when `ordered`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn blocks<S: Simd>(
@@ -80,12 +88,13 @@ fn blocks<S: Simd>(
     b0: usize,
     nb: usize,
     pairing: Pairing,
+    ordered: bool,
     rows: &mut [u64; MAX_ROW],
     out: &mut Vec<[u32; 2]>,
-) -> u64 {
+) {
     let (sa, sb) = (a.tris.soa.skip(a0), b.tris.soa.skip(b0));
     debug_assert!(na <= MAX_ROW);
-    let counted = leaf_candidates_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
+    leaf_candidates_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
     for (i, &row) in rows[..na].iter().enumerate() {
         let mut bits = row;
         if bits == 0 {
@@ -97,13 +106,12 @@ fn blocks<S: Simd>(
             bits &= bits - 1;
             if triangles_intersect(&ti, &sb.corners(j)) {
                 let (oi, oj) = (a.order[a0 + i], b.order[b0 + j]);
-                out.push(if pairing == Pairing::All {
-                    [oi, oj]
-                } else {
+                out.push(if ordered {
                     [oi.min(oj), oi.max(oj)]
+                } else {
+                    [oi, oj]
                 });
             }
         }
     }
-    counted
 }

@@ -15,6 +15,7 @@
 //! objects that move apart, whose refitted bounds would otherwise grow with their distance. A run of more than
 //! [`MAX_CUT_COMPONENTS`] components (a triangle soup) gets the plain median cut.
 
+use super::shared::SharedPairs;
 use super::{RegionTree, TreeShape, BLOCK, MAX_CHILDREN};
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -166,7 +167,7 @@ impl RegionTree {
             leaf_slot.push(leaf_slot.last().copied().unwrap_or(0) + padded as u32);
         }
 
-        let tree = RegionTree {
+        let mut tree = RegionTree {
             shape,
             first_child,
             child_count,
@@ -190,7 +191,9 @@ impl RegionTree {
             vert_order,
             vert_slot,
             referenced_vertices,
+            shared: None,
         };
+        tree.shared = SharedPairs::build(&tree);
         debug_assert_eq!(tree.check_topology(mesh), Ok(()));
         Ok(tree)
     }

@@ -13,6 +13,7 @@
 //! - `tri_order`/`vert_order` map internal indices back to the caller's original ones.
 
 mod build;
+mod shared;
 mod validate;
 
 pub use validate::TreeError;
@@ -111,6 +112,8 @@ pub struct RegionTree {
     vert_order: Vec<u32>,
     vert_slot: Vec<u32>,
     referenced_vertices: u32,
+    /// The vertex-sharing triangle pairs of each leaf pair (`None` over its build budget).
+    shared: Option<shared::SharedPairs>,
 }
 
 impl RegionTree {
@@ -311,6 +314,19 @@ impl RegionTree {
         self.referenced_vertices as usize
     }
 
+    /// The triangle pairs of leaves `x` and `y` (node ids; `x == y`: unordered pairs of
+    /// distinct triangles) that share a vertex index: the pairs a self query skips. Read
+    /// from a table built with the tree (counted directly for a mesh over its budget).
+    /// Panics unless both are leaves.
+    #[inline]
+    pub fn shared_pairs(&self, x: usize, y: usize) -> u64 {
+        assert!(self.is_leaf(x) && self.is_leaf(y), "shared_pairs of leaves");
+        match &self.shared {
+            Some(table) => table.get(self.leaf_rank[x] as usize, self.leaf_rank[y] as usize),
+            None => shared::count_direct(self, x, y),
+        }
+    }
+
     /// Bytes of topology (shared by the three kinds; not part of a BV's record).
     pub fn topology_bytes(&self) -> usize {
         use std::mem::size_of_val;
@@ -329,5 +345,6 @@ impl RegionTree {
             + size_of_val(&self.vert_end[..])
             + size_of_val(&self.borrowed_start[..])
             + size_of_val(&self.borrowed[..])
+            + self.shared.as_ref().map_or(0, |s| s.bytes())
     }
 }

@@ -1,6 +1,6 @@
 //! Structural invariants of the region tree.
 
-use super::{RegionTree, TreeShape, MAX_CHILDREN};
+use super::{shared, RegionTree, TreeShape, MAX_CHILDREN};
 use crate::mesh::Mesh;
 
 /// A broken structural invariant of a [`RegionTree`] (a bug in dhcd, never bad input).
@@ -145,6 +145,32 @@ impl RegionTree {
         }
         if let Some(t) = covered.iter().position(|&c| !c) {
             return fail(0, format!("triangle {t} is in no leaf"));
+        }
+        self.check_shared_pairs()
+    }
+
+    /// The shared-pair table: every entry symmetric and (for leaf pairs small enough to
+    /// compare directly) equal to the direct count, and the entries adding up to the
+    /// mesh's total by inclusion-exclusion (so none is missing).
+    fn check_shared_pairs(&self) -> Result<(), TreeError> {
+        let Some(table) = &self.shared else {
+            return Ok(());
+        };
+        let leaves: Vec<usize> = self.leaves().collect();
+        let mut sum = 0;
+        for (x, y, count) in table.entries() {
+            let (nx, ny) = (leaves[x], leaves[y]);
+            if count == 0 || table.get(y, x) != count {
+                return fail(nx, format!("shared pairs with leaf {ny} not symmetric"));
+            }
+            let size = self.tri_range(nx).len() * self.tri_range(ny).len();
+            if size <= 1 << 16 && shared::count_direct(self, nx, ny) != count {
+                return fail(nx, format!("shared pairs with leaf {ny} miscounted"));
+            }
+            sum += if x <= y { count } else { 0 };
+        }
+        if sum != shared::total_by_inclusion_exclusion(self) {
+            return fail(0, "shared pairs missing from the table");
         }
         Ok(())
     }
