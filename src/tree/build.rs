@@ -15,7 +15,8 @@
 //! objects that move apart, whose refitted bounds would otherwise grow with their distance. A run of more than
 //! [`MAX_CUT_COMPONENTS`] components (a triangle soup) gets the plain median cut.
 
-use super::shared::SharedPairs;
+use std::sync::OnceLock;
+
 use super::{RegionTree, TreeShape, BLOCK, MAX_CHILDREN};
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -167,7 +168,7 @@ impl RegionTree {
             leaf_slot.push(leaf_slot.last().copied().unwrap_or(0) + padded as u32);
         }
 
-        let mut tree = RegionTree {
+        let tree = RegionTree {
             shape,
             first_child,
             child_count,
@@ -191,9 +192,8 @@ impl RegionTree {
             vert_order,
             vert_slot,
             referenced_vertices,
-            shared: None,
+            shared: OnceLock::new(),
         };
-        tree.shared = SharedPairs::build(&tree);
         debug_assert_eq!(tree.check_topology(mesh), Ok(()));
         Ok(tree)
     }

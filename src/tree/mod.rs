@@ -19,6 +19,7 @@ mod validate;
 pub use validate::TreeError;
 
 use std::ops::Range;
+use std::sync::OnceLock;
 
 use crate::error::{Error, Result};
 
@@ -112,8 +113,9 @@ pub struct RegionTree {
     vert_order: Vec<u32>,
     vert_slot: Vec<u32>,
     referenced_vertices: u32,
-    /// The vertex-sharing triangle pairs of each leaf pair (`None` over its build budget).
-    shared: Option<shared::SharedPairs>,
+    /// The vertex-sharing triangle pairs of each leaf pair, built by the first self query
+    /// (`None` inside: over its build budget).
+    shared: OnceLock<Option<shared::SharedPairs>>,
 }
 
 impl RegionTree {
@@ -316,18 +318,27 @@ impl RegionTree {
 
     /// The triangle pairs of leaves `x` and `y` (node ids; `x == y`: unordered pairs of
     /// distinct triangles) that share a vertex index: the pairs a self query skips. Read
-    /// from a table built with the tree (counted directly for a mesh over its budget).
-    /// Panics unless both are leaves.
+    /// from a table built by the first call (counted directly for a mesh over the table's
+    /// budget). Panics unless both are leaves.
     #[inline]
     pub fn shared_pairs(&self, x: usize, y: usize) -> u64 {
         assert!(self.is_leaf(x) && self.is_leaf(y), "shared_pairs of leaves");
-        match &self.shared {
+        match self.shared_table() {
             Some(table) => table.get(self.leaf_rank[x] as usize, self.leaf_rank[y] as usize),
             None => shared::count_direct(self, x, y),
         }
     }
 
-    /// Bytes of topology (shared by the three kinds; not part of a BV's record).
+    /// The shared-pair table, built on first use.
+    #[inline]
+    fn shared_table(&self) -> Option<&shared::SharedPairs> {
+        self.shared
+            .get_or_init(|| shared::SharedPairs::build(self))
+            .as_ref()
+    }
+
+    /// Bytes of topology (shared by the three kinds; not part of a BV's record; the
+    /// shared-pair table once a self query built it).
     pub fn topology_bytes(&self) -> usize {
         use std::mem::size_of_val;
         size_of_val(&self.first_child[..])
@@ -345,6 +356,10 @@ impl RegionTree {
             + size_of_val(&self.vert_end[..])
             + size_of_val(&self.borrowed_start[..])
             + size_of_val(&self.borrowed[..])
-            + self.shared.as_ref().map_or(0, |s| s.bytes())
+            + self
+                .shared
+                .get()
+                .and_then(Option::as_ref)
+                .map_or(0, |s| s.bytes())
     }
 }

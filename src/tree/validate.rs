@@ -153,7 +153,7 @@ impl RegionTree {
     /// compare directly) equal to the direct count, and the entries adding up to the
     /// mesh's total by inclusion-exclusion (so none is missing).
     fn check_shared_pairs(&self) -> Result<(), TreeError> {
-        let Some(table) = &self.shared else {
+        let Some(table) = self.shared_table() else {
             return Ok(());
         };
         let leaves: Vec<usize> = self.leaves().collect();
