@@ -236,6 +236,7 @@ pub struct Soa3<'a> {
 }
 
 impl<'a> Soa3<'a> {
+    #[inline]
     pub fn new(x: &'a [f32], y: &'a [f32], z: &'a [f32]) -> Self {
         assert!(
             x.len() == y.len() && y.len() == z.len(),

@@ -59,6 +59,7 @@ pub struct TriSoa<'a> {
 
 impl<'a> TriSoa<'a> {
     /// Panics unless `tile` has 15 fields and `vertex` 3 fields of the same stride.
+    #[inline]
     pub fn new(tile: Tile<'a>, vertex: &'a [u32]) -> Self {
         assert!(
             tile.has_fields(15) && vertex.len() == 3 * tile.stride(),

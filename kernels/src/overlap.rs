@@ -30,6 +30,7 @@ pub struct SphereSoa<'a> {
 
 impl<'a> SphereSoa<'a> {
     /// Panics unless `tile` has four fields.
+    #[inline]
     pub fn new(tile: Tile<'a>) -> Self {
         assert!(tile.has_fields(4), "SphereSoa: cx, cy, cz, r");
         Self { tile }
@@ -78,6 +79,7 @@ pub struct AabbSoa<'a> {
 
 impl<'a> AabbSoa<'a> {
     /// Panics unless `tile` has six fields.
+    #[inline]
     pub fn new(tile: Tile<'a>) -> Self {
         assert!(tile.has_fields(6), "AabbSoa: min xyz, max xyz");
         Self { tile }
