@@ -10,7 +10,7 @@
 use dhcd_kernels::narrow::{leaf_candidates_with, Pairing, MAX_ROW};
 use pulp::Simd;
 
-use super::triangles_intersect;
+use super::tritri::intersects_given_boxes_overlap;
 use crate::hierarchy::LeafTris;
 
 /// One leaf of a leaf pair: its cached triangles and their original indices.
@@ -104,7 +104,7 @@ fn blocks<S: Simd>(
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            if triangles_intersect(&ti, &sb.corners(j)) {
+            if intersects_given_boxes_overlap(&ti, &sb.corners(j)) {
                 let (oi, oj) = (a.order[a0 + i], b.order[b0 + j]);
                 out.push(if ordered {
                     [oi.min(oj), oi.max(oj)]

@@ -120,9 +120,15 @@ fn extreme_corners(t: &Tri) -> (usize, usize) {
 /// [`tri_tri`], the general test, which is also the oracle the fast path is tested against.
 #[inline]
 pub(crate) fn intersects(a: &Tri, b: &Tri) -> bool {
-    if !aabb_overlap(a, b) {
-        return false;
-    }
+    aabb_overlap(a, b) && intersects_given_boxes_overlap(a, b)
+}
+
+/// [`intersects`] for triangles whose closed boxes are known to overlap (the narrow phase's
+/// candidates, whose boxes the leaf filter compared exactly): the same answer without
+/// comparing them again.
+#[inline]
+pub(crate) fn intersects_given_boxes_overlap(a: &Tri, b: &Tri) -> bool {
+    debug_assert!(aabb_overlap(a, b));
     // Vertices of `a` against the plane of `b`: (x - b2) . ((b0 - b2) x (b1 - b2)).
     let pb = Plane::new(b);
     let sa = [pb.side(&a[0]), pb.side(&a[1]), pb.side(&a[2])];
