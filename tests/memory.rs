@@ -23,6 +23,15 @@ use crate::support::peak_bytes;
 /// The fixed part of the bound (see the module docs).
 const QUERY_SCRATCH_BOUND: usize = 1 << 20;
 
+/// Small leaves (12 triangles, the default before it became 32): the deepest trees and the
+/// most node pairs, where a frontier would be largest.
+fn deep() -> Options {
+    Options {
+        leaf_size: 12,
+        ..Options::default()
+    }
+}
+
 /// Asserts the bound on one query's peak, and that the query did many node tests and
 /// found many contacts (so the bound is tested where the old frontier was large).
 fn assert_bounded(what: &str, c: &Contacts, peak: usize) {
@@ -59,8 +68,8 @@ fn collide_scratch_does_not_grow_with_the_work() {
     let a = noisy_grid(cells, [0.0; 3], 1);
     let b = noisy_grid(cells, [0.31 / cells as f32, 0.17 / cells as f32, 0.0], 2);
     for method in Method::ALL {
-        let mut ha = AnyHierarchy::new(method, &a, Options::default()).unwrap();
-        let mut hb = AnyHierarchy::new(method, &b, Options::default()).unwrap();
+        let mut ha = AnyHierarchy::new(method, &a, deep()).unwrap();
+        let mut hb = AnyHierarchy::new(method, &b, deep()).unwrap();
         let (c, peak) = peak_bytes(|| {
             ha.collide(&mut hb, &mut Workspace::default(), Par::Seq)
                 .unwrap()
@@ -80,7 +89,7 @@ fn self_collide_scratch_does_not_grow_with_the_work() {
         3,
     );
     for method in Method::ALL {
-        let mut h = AnyHierarchy::new(method, &rest, Options::default()).unwrap();
+        let mut h = AnyHierarchy::new(method, &rest, deep()).unwrap();
         h.update_positions(&folded).unwrap();
         // The tree's shared-pair table is mesh data, built once per tree by its first self
         // query (docs/LIMITS.md); build it here so that every profile measures the query.
