@@ -90,7 +90,7 @@ fn outliers_do_not_push_a_cluster_into_one_leaf() {
             c.counters.bv_tests
         );
         assert!(
-            c.counters.prim_tests <= 10 * (options.leaf_size * n) as u64,
+            c.counters.prim_tests <= 7 * (options.leaf_size * n) as u64,
             "{method}: N_P {} for {n} triangles",
             c.counters.prim_tests
         );

@@ -25,9 +25,9 @@
 //! not the `2^-147` the underflow needs: a subnormal operand costs an FP assist of about a
 //! hundred cycles on x86, and with a subnormal constant every bound paid six (measured: half
 //! of a cloth self-collision step). It only gives up certifying determinants below about
-//! `1e-38`, i.e. triangles of sides below about `1e-12`, which the exact test then decides. Overflow gives an infinite `P` (so `|s|` can never
-//! exceed the bound: `|s| <= P` holds in floating point by monotonic rounding); NaN compares
-//! false. So a certified sign is the exact sign of the determinant, for every `f32` input.
+//! `1e-38`, i.e. triangles of sides below about `1e-12`, which the exact test then decides.
+//! Overflow gives an infinite `P` (so `|s|` can never exceed the bound: `|s| <= P` holds in
+//! floating point by monotonic rounding); NaN compares false. So a certified sign is the exact sign of the determinant, for every `f32` input.
 //! A degenerate triangle has `N = M = 0` and certifies nothing.
 //!
 //! Results are bit-identical to [`leaf_candidates_scalar`] on every backend (same operation
@@ -342,8 +342,8 @@ fn splat3<S: Simd>(simd: S, v: [f32; 3]) -> [S::f32s; 3] {
 /// every triangle of the first block is tested against it from registers; the shared-vertex
 /// mask only for rows with a box hit, the plane filter only for rows with a pair left after
 /// both (most rows of neighbouring leaves have no hit: the mask was 15% of a cloth step when
-/// every row built it to count `N_P`). No closures
-/// here: they may be compiled without the dispatched target features.
+/// every row built it to count `N_P`). No closures here: they may be compiled without the
+/// dispatched target features.
 #[inline(always)]
 pub fn leaf_candidates_with<S: Simd>(
     simd: S,

@@ -18,7 +18,7 @@ use super::RegionTree;
 /// Largest `sum over vertices of valence^2` for which the table is built, per triangle,
 /// plus a constant: every mesh of bounded valence fits (a regular mesh is about 18 per
 /// triangle; a few poles of valence 500 fit in the constant).
-pub const BUILD_BUDGET: (u64, u64) = (64, 1 << 20);
+const BUILD_BUDGET: (u64, u64) = (64, 1 << 20);
 
 /// Per leaf rank `r`: the entries `start[r]..start[r + 1]` of `leaf` (ascending ranks,
 /// `r` itself included when some of its own pairs share) and `count`.

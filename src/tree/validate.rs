@@ -22,7 +22,8 @@ impl RegionTree {
     /// Checks the topology against the mesh it was built from: levels contiguous and
     /// breadth-first, children nested and partitioning their parent's triangles, leaves
     /// covering every triangle exactly once, each node's vertex set (run + borrowed) equal
-    /// to the vertices of its triangles, and the permutations consistent with the mesh.
+    /// to the vertices of its triangles, and the permutations consistent with the mesh; and
+    /// the shared-pair table (which this builds if no self query has yet).
     pub fn check_topology(&self, mesh: &Mesh) -> Result<(), TreeError> {
         let nodes = self.node_count();
         if self.tris.len() != mesh.triangle_count() || self.vert_order.len() != mesh.vertex_count()
