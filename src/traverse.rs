@@ -466,7 +466,7 @@ impl<'h, K: BvKind> Walk<'h, K> {
         };
         let shared = match leaves {
             Leaves::Objects => 0,
-            _ => self.a.tree().shared_pairs(x, y),
+            _ => self.a.tree().shared_pairs_of_leaves(x, y),
         };
         let [la, lb] = &mut out.last;
         let (sa, sb) = (side(self.a, x, la), side(self.b, y, lb));

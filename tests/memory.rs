@@ -95,7 +95,7 @@ fn self_collide_scratch_does_not_grow_with_the_work() {
         // query (docs/LIMITS.md); build it here so that every profile measures the query.
         let tree = h.tree().clone();
         let leaf = tree.leaves().next().unwrap();
-        tree.shared_pairs(leaf, leaf);
+        tree.shared_pairs(leaf, leaf).unwrap();
         let (c, peak) = peak_bytes(|| h.self_collide(&mut Workspace::default(), Par::Seq));
         assert_bounded(&format!("self {method}"), &c, peak);
     }

@@ -7,7 +7,7 @@ use dhcd::bv::{Aabb, Dh, Sphere};
 use dhcd::narrow::brute_force_self_pairs;
 use dhcd::shapes::{grid, icosphere, jitter};
 use dhcd::tree::TreeShape;
-use dhcd::{self_collide, Hierarchy, Mesh, Options, RegionTree};
+use dhcd::{self_collide, Error, Hierarchy, Mesh, Options, RegionTree};
 
 /// Pairs of triangles `t` of leaf `x` and `u` of leaf `y` with a common corner index
 /// (`t < u` when `x == y`), straight from the definition.
@@ -71,11 +71,27 @@ fn the_table_equals_a_direct_count_on_every_leaf_pair() {
             for (i, &x) in leaves.iter().enumerate() {
                 for &y in &leaves {
                     let want = direct(&tree, x, y);
-                    assert_eq!(tree.shared_pairs(x, y), want, "{name} {shape:?} {x} {y}");
+                    assert_eq!(
+                        tree.shared_pairs(x, y).unwrap(),
+                        want,
+                        "{name} {shape:?} {x} {y}"
+                    );
                     total += if y >= leaves[i] { want } else { 0 };
                 }
             }
             assert_eq!(total, sharing_pairs(&mesh), "{name} {shape:?}");
+            // Bad node ids are typed errors.
+            let n = tree.node_count();
+            assert!(matches!(
+                tree.shared_pairs(n, leaves[0]),
+                Err(Error::NodeOutOfRange { .. })
+            ));
+            if !tree.is_leaf(0) {
+                assert!(matches!(
+                    tree.shared_pairs(leaves[0], 0),
+                    Err(Error::NotALeaf { node: 0 })
+                ));
+            }
         }
     }
 }
@@ -126,7 +142,7 @@ fn a_mesh_over_the_table_budget_is_answered_without_it() {
     let leaves: Vec<usize> = tree.leaves().collect();
     for &x in leaves.iter().step_by(7) {
         for &y in leaves.iter().step_by(5) {
-            assert_eq!(tree.shared_pairs(x, y), direct(&tree, x, y));
+            assert_eq!(tree.shared_pairs(x, y).unwrap(), direct(&tree, x, y));
         }
     }
     assert_eq!(self_collide(&mut h).pairs, expected);

@@ -319,10 +319,28 @@ impl RegionTree {
     /// The triangle pairs of leaves `x` and `y` (node ids; `x == y`: unordered pairs of
     /// distinct triangles) that share a vertex index: the pairs a self query skips. Read
     /// from a table built by the first call (counted directly for a mesh over the table's
-    /// budget). Panics unless both are leaves.
+    /// budget). A node beyond the tree is an [`Error::NodeOutOfRange`], an internal node an
+    /// [`Error::NotALeaf`].
+    pub fn shared_pairs(&self, x: usize, y: usize) -> Result<u64> {
+        for n in [x, y] {
+            if n >= self.node_count() {
+                return Err(Error::NodeOutOfRange {
+                    node: u32::try_from(n).unwrap_or(u32::MAX),
+                    node_count: self.node_count(),
+                });
+            }
+            if !self.is_leaf(n) {
+                return Err(Error::NotALeaf { node: n as u32 });
+            }
+        }
+        Ok(self.shared_pairs_of_leaves(x, y))
+    }
+
+    /// [`shared_pairs`](Self::shared_pairs) for two leaves the caller knows (the walk's hot
+    /// path: no checks).
     #[inline]
-    pub fn shared_pairs(&self, x: usize, y: usize) -> u64 {
-        assert!(self.is_leaf(x) && self.is_leaf(y), "shared_pairs of leaves");
+    pub(crate) fn shared_pairs_of_leaves(&self, x: usize, y: usize) -> u64 {
+        debug_assert!(self.is_leaf(x) && self.is_leaf(y));
         match self.shared_table() {
             Some(table) => table.get(self.leaf_rank[x] as usize, self.leaf_rank[y] as usize),
             None => shared::count_direct(self, x, y),
