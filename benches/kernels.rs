@@ -3,9 +3,10 @@
 //! - `kernels/{sphere,aabb}_block/{scalar,simd}`: 4,096 wide node tests (one volume against
 //!   a block of 8, the children of an octree node), as the traversal calls them: the SIMD
 //!   body inside one dispatch (`*_with`), never dispatched per test. Throughput in BV pairs.
-//! - `kernels/leaf_candidates{,_self}/{scalar,simd}`: the narrow phase's filter (boxes,
-//!   shared vertices, separating planes) on 1,024 pairs of leaves of 8 nearby triangles,
-//!   throughput in triangle pairs.
+//! - `kernels/leaf_contacts{,_self}/{scalar,simd}`: the narrow phase's kernel (boxes, shared
+//!   vertices, separating planes, then the certified canonical form on the candidates) on
+//!   1,024 pairs of leaves of 8 nearby triangles, throughput in triangle pairs. (Before the
+//!   canonical form moved into the kernel this was `leaf_candidates`, the filter alone.)
 //! - `kernels/<refit reduction>/{scalar,dispatched}/<n>`: refit reductions over `n` points.
 //!
 //! Inputs come from a seeded RNG and are generated once.
@@ -202,12 +203,15 @@ impl WithSimd for AllLeafPairs<'_> {
     type Output = u64;
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) -> u64 {
-        let mut rows = [0u64; LEAF];
+        let mut rows = [narrow::Row::default(); LEAF];
         let mut n = 0;
         for p in 0..LEAF_PAIRS {
             let (a, b) = (self.leaves.leaf(2 * p), self.leaves.leaf(2 * p + 1));
-            narrow::leaf_candidates_with(simd, a, LEAF, b, LEAF, self.pairing, &mut rows);
-            n += rows.iter().map(|r| r.count_ones() as u64).sum::<u64>();
+            narrow::leaf_contacts_with(simd, a, LEAF, b, LEAF, self.pairing, &mut rows);
+            n += rows
+                .iter()
+                .map(|r| r.candidates().count_ones() as u64)
+                .sum::<u64>();
         }
         n
     }
@@ -216,19 +220,22 @@ impl WithSimd for AllLeafPairs<'_> {
 fn leaf_benches(c: &mut Criterion) {
     let leaves = LeafPairs::new(&mut Rng::new(2));
     for (name, pairing) in [
-        ("leaf_candidates", Pairing::All),
-        ("leaf_candidates_self", Pairing::NoSharedVertex),
+        ("leaf_contacts", Pairing::All),
+        ("leaf_contacts_self", Pairing::NoSharedVertex),
     ] {
         let mut g = c.benchmark_group(format!("kernels/{name}"));
         g.throughput(Throughput::Elements((LEAF_PAIRS * LEAF * LEAF) as u64));
         g.bench_function("scalar", |bench| {
             bench.iter(|| {
-                let mut rows = [0u64; LEAF];
+                let mut rows = [narrow::Row::default(); LEAF];
                 let mut n = 0;
                 for p in 0..LEAF_PAIRS {
                     let (a, b) = (leaves.leaf(2 * p), leaves.leaf(2 * p + 1));
-                    narrow::leaf_candidates_scalar(a, LEAF, b, LEAF, pairing, &mut rows);
-                    n += rows.iter().map(|r| r.count_ones() as u64).sum::<u64>();
+                    narrow::leaf_contacts_scalar(a, LEAF, b, LEAF, pairing, &mut rows);
+                    n += rows
+                        .iter()
+                        .map(|r| r.candidates().count_ones() as u64)
+                        .sum::<u64>();
                 }
                 black_box(n)
             })

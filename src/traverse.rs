@@ -32,7 +32,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::narrow::leaves::{leaf_pair, LeafSide, Leaves};
 use crate::par::Par;
-use dhcd_kernels::narrow::MAX_ROW;
+use dhcd_kernels::narrow::{Row, MAX_ROW};
 
 /// Result of a query: contacts as `[triangle of A, triangle of B]` in the caller's original
 /// triangle indices, sorted ascending, and the counted work.
@@ -254,7 +254,7 @@ struct Output<'h> {
     pairs: Vec<[u32; 2]>,
     counters: Counters,
     leaves: Vec<[u32; 2]>,
-    rows: [u64; MAX_ROW],
+    rows: [Row; MAX_ROW],
     last: [Option<(usize, LeafSide<'h>)>; 2],
 }
 
@@ -264,7 +264,7 @@ impl Default for Output<'_> {
             pairs: Vec::new(),
             counters: Counters::default(),
             leaves: Vec::new(),
-            rows: [0; MAX_ROW],
+            rows: [Row::default(); MAX_ROW],
             last: [None, None],
         }
     }

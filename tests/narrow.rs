@@ -6,6 +6,7 @@ use dhcd::narrow::{
     brute_force_pairs, brute_force_self_pairs, intersection_segment, triangles_intersect,
 };
 use dhcd::Mesh;
+use dhcd_kernels::narrow::{pair_verdict, Verdict};
 use proptest::prelude::*;
 
 type Tri = [[f32; 3]; 3];
@@ -201,8 +202,18 @@ fn check_segment(a: &Tri, b: &Tri, hit: bool) {
     }
 }
 
+/// The narrow kernel's certified verdict (`f32` filters and canonical form) never
+/// contradicts the exact answer `want`; `Undecided` is always allowed.
+fn check_verdict(a: &Tri, b: &Tri, want: bool) {
+    match pair_verdict(a, b) {
+        Verdict::Contact => assert!(want, "kernel certified a contact: {a:?} {b:?}"),
+        Verdict::Apart => assert!(!want, "kernel certified apart: {a:?} {b:?}"),
+        Verdict::Undecided => {}
+    }
+}
+
 /// Asserts `expected` for both argument orders and all 36 corner permutations, for the
-/// decision and the segment's presence; also checks the exact reference when `scale` is
+/// decision, the kernel's verdict and the segment's presence; also checks the exact reference when `scale` is
 /// given (coordinates integral after scaling by `2^scale`).
 fn check_scaled(a: Tri, b: Tri, expected: bool, scale: Option<i32>) {
     if let Some(s) = scale {
@@ -217,6 +228,8 @@ fn check_scaled(a: Tri, b: Tri, expected: bool, scale: Option<i32>) {
             let (x, y) = (permute(&a, pa), permute(&b, pb));
             assert_eq!(triangles_intersect(&x, &y), expected, "{x:?} vs {y:?}");
             assert_eq!(triangles_intersect(&y, &x), expected, "{y:?} vs {x:?}");
+            check_verdict(&x, &y, expected);
+            check_verdict(&y, &x, expected);
             check_segment(&x, &y, expected);
             check_segment(&y, &x, expected);
         }
@@ -797,6 +810,8 @@ proptest! {
         let want = reference(&a, &b);
         prop_assert_eq!(triangles_intersect(&a, &b), want);
         prop_assert_eq!(triangles_intersect(&b, &a), want);
+        check_verdict(&a, &b, want);
+        check_verdict(&b, &a, want);
         check_segment(&a, &b, want);
         for p in PERMS {
             prop_assert_eq!(triangles_intersect(&permute(&a, p), &b), want);
@@ -822,6 +837,8 @@ proptest! {
         let want = reference(&a, &b);
         prop_assert_eq!(triangles_intersect(&a, &b), want);
         prop_assert_eq!(triangles_intersect(&b, &a), want);
+        check_verdict(&a, &b, want);
+        check_verdict(&b, &a, want);
         check_segment(&a, &b, want);
     }
 
@@ -831,6 +848,8 @@ proptest! {
         prop_assert_eq!(triangles_intersect(&a, &b), want);
         prop_assert_eq!(triangles_intersect(&b, &a), want);
         prop_assert_eq!(intersection_segment(&a, &b).is_some(), want);
+        check_verdict(&a, &b, want);
+        check_verdict(&b, &a, want);
     }
 
     #[test]
@@ -843,6 +862,8 @@ proptest! {
         for p in PERMS {
             prop_assert_eq!(triangles_intersect(&permute(&a, p), &permute(&b, p)), want);
         }
+        check_verdict(&a, &b, want);
+        check_verdict(&b, &a, want);
         check_segment(&a, &b, want);
         // The reference needs integral coordinates after scaling: compare on a 2^-20 grid.
         let snap = |t: Tri| t.map(|p| p.map(|c| (c * 1_048_576.0).round() / 1_048_576.0));
@@ -884,7 +905,44 @@ proptest! {
         let want = reference_scaled(&a, &b, 20);
         prop_assert_eq!(triangles_intersect(&a, &b), want);
         prop_assert_eq!(triangles_intersect(&b, &a), want);
+        check_verdict(&a, &b, want);
+        check_verdict(&b, &a, want);
         check_segment(&a, &b, want);
+    }
+}
+
+/// The kernel's certified verdicts at scales from tiny to huge, on crossing and near-miss
+/// pairs: never wrong, and in general position undecided only rarely (so the narrow phase
+/// seldom needs the exact test) while the `f32` determinants neither underflow nor
+/// overflow; at 1e-30 and 1e30 they do, and everything is left to the exact test.
+#[test]
+fn kernel_verdicts_are_exact_and_mostly_decided() {
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+    };
+    for scale in [1.0f32, 1e-6, 1e6, 1e-30, 1e30] {
+        let (mut decided, mut contacts, mut n) = (0, 0, 0);
+        for _ in 0..20_000 {
+            // Two triangles around the origin, each a third of the box: about half cross.
+            let a: Tri = std::array::from_fn(|_| std::array::from_fn(|_| next() * scale));
+            let b: Tri = std::array::from_fn(|_| std::array::from_fn(|_| next() * scale));
+            let want = triangles_intersect(&a, &b);
+            check_verdict(&a, &b, want);
+            n += 1;
+            contacts += usize::from(want);
+            decided += usize::from(pair_verdict(&a, &b) != Verdict::Undecided);
+        }
+        assert!(contacts > n / 10, "scale {scale}: too few crossing pairs");
+        if (1e-6..=1e6).contains(&scale) {
+            assert!(
+                decided * 100 >= n * 99,
+                "scale {scale}: {decided} of {n} decided"
+            );
+        }
     }
 }
 

@@ -1,6 +1,7 @@
-//! The narrow phase's front filter: the *candidate pairs* of two blocks of triangles (the
-//! triangles of two leaves, in structure-of-arrays form), as one bit row per triangle of
-//! the first block. A pair is a candidate when
+//! The narrow phase's kernel: the verdicts on the triangle pairs of two blocks of triangles
+//! (the triangles of two leaves, in structure-of-arrays form), as two bit rows per triangle
+//! of the first block: certain *contacts*, and *undecided* pairs the caller decides with its
+//! exact test. Every other pair certainly does not intersect. A pair is a *candidate* when
 //!
 //! 1. the pairing allows it (self-collision excludes pairs sharing a vertex index, and pairs
 //!    `j <= i` inside one leaf),
@@ -9,7 +10,8 @@
 //!    one side of the other's plane, by a semi-static floating-point filter (below).
 //!
 //! Every dropped pair certainly does not intersect, so running the exact test on the
-//! candidates alone gives exactly the contacts of the exact test on every pair.
+//! candidates alone gives exactly the contacts of the exact test on every pair; most
+//! candidates are then decided here too (below).
 //!
 //! **The plane filter.** In `f32`, `s = det[u, v, e]` with `u = b - a`, `v = c - a` (the
 //! plane triangle's edges from corner `a`) and `e = d - a` (the tested corner), computed as
@@ -30,8 +32,20 @@
 //! floating point by monotonic rounding); NaN compares false. So a certified sign is the exact sign of the determinant, for every `f32` input.
 //! A degenerate triangle has `N = M = 0` and certifies nothing.
 //!
-//! Results are bit-identical to [`leaf_candidates_scalar`] on every backend (same operation
-//! order, no fused multiply-add).
+//! **The decision.** A candidate whose six corner-plane signs are all certified (none is
+//! zero, none unknown) is then decided by Guigue and Devillers' canonical form ("Fast and
+//! robust triangle-triangle overlap test using orientation predicates", JGT 8(1), 2003): each
+//! triangle is rotated so that its vertex alone on its side of the other's plane comes first,
+//! the other triangle's last two vertices swapped when that vertex is on the negative side,
+//! and the pair intersects iff two more orientations are `>= 0`. Those two are computed with
+//! the same arithmetic and bound from the same `f32` corners, so a certified verdict is the
+//! exact one. The pair is then a *contact* (both certified positive) or dropped (one
+//! certified negative); everything else is *undecided* and left to the caller's exact test.
+//! The `dhcd` crate's exact test (`src/narrow/tritri.rs`) is the same formulation on exact
+//! predicates, and its tests check every certified verdict against it.
+//!
+//! Results are bit-identical to [`leaf_contacts_scalar`] on every backend (same operation
+//! order, no fused multiply-add; the canonical form's vertex choices are selects).
 
 use crate::lanes::{load_prefix, load_prefix_u32, mask_bits};
 use crate::Tile;
@@ -224,7 +238,95 @@ pub fn plane_separated(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
     separated(a, b) || separated(b, a)
 }
 
-fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[u64]) {
+/// One row of verdicts: triangle `i` of the first block against the second block, bit `j`
+/// for triangle `j`. The two rows are disjoint; a pair in neither certainly does not
+/// intersect (or is not allowed by the pairing).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Row {
+    /// Pairs that certainly intersect.
+    pub contact: u64,
+    /// Pairs the filters could not decide: the caller's exact test does.
+    pub undecided: u64,
+}
+
+impl Row {
+    /// The pairs not certainly apart: `contact | undecided`.
+    #[inline(always)]
+    pub fn candidates(&self) -> u64 {
+        self.contact | self.undecided
+    }
+}
+
+/// The verdict on one pair (the scalar reference's unit).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Certainly disjoint.
+    Apart,
+    /// Certainly intersecting.
+    Contact,
+    /// Not certified either way.
+    Undecided,
+}
+
+/// The verdict of the plane filter and the certified canonical form on one pair whose closed
+/// boxes overlap (module doc), in the kernel's arithmetic.
+pub fn pair_verdict(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> Verdict {
+    let (an, am) = plane(a);
+    let (bn, bm) = plane(b);
+    // sa: a's corners against b's plane; sb: b's corners against a's plane.
+    let sa = a.map(|p| side(&b[0], &bn, &bm, &p));
+    let sb = b.map(|p| side(&a[0], &an, &am, &p));
+    let all = |s: [i32; 3], v: i32| s.iter().all(|&x| x == v);
+    if all(sa, 1) || all(sa, -1) || all(sb, 1) || all(sb, -1) {
+        return Verdict::Apart;
+    }
+    if sa.contains(&0) || sb.contains(&0) {
+        return Verdict::Undecided;
+    }
+    // a rotated so its lone vertex comes first; b's last two swapped if that one is below.
+    let i = lone(sa);
+    let (p1, mut q1, mut r1) = (a[i], a[(i + 1) % 3], a[(i + 2) % 3]);
+    let (tb, tsb) = if sa[i] < 0 {
+        ([b[0], b[2], b[1]], [sb[0], sb[2], sb[1]])
+    } else {
+        (*b, sb)
+    };
+    let j = lone(tsb);
+    let (p2, q2, r2) = (tb[j], tb[(j + 1) % 3], tb[(j + 2) % 3]);
+    if tsb[j] < 0 {
+        (q1, r1) = (r1, q1);
+    }
+    let o1 = oriented_side(&[q2, p2, p1], &q1);
+    let o2 = oriented_side(&[r2, p2, r1], &p1);
+    if o1 < 0 || o2 < 0 {
+        Verdict::Apart
+    } else if o1 > 0 && o2 > 0 {
+        Verdict::Contact
+    } else {
+        Verdict::Undecided
+    }
+}
+
+/// The index of the one sign that differs from the other two (all nonzero, not all equal).
+#[inline(always)]
+fn lone(s: [i32; 3]) -> usize {
+    if s[1] == s[2] {
+        0
+    } else if s[0] == s[2] {
+        1
+    } else {
+        2
+    }
+}
+
+/// The certified sign of `det[t1 - t0, t2 - t0, d - t0]` (0: not certified).
+#[inline(always)]
+fn oriented_side(t: &[[f32; 3]; 3], d: &[f32; 3]) -> i32 {
+    let (n, m) = plane(t);
+    side(&t[0], &n, &m, d)
+}
+
+fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[Row]) {
     assert!(
         nb <= MAX_ROW,
         "the second block holds at most {MAX_ROW} triangles"
@@ -239,20 +341,20 @@ fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[u64]) {
     );
 }
 
-/// Scalar reference of [`leaf_candidates`] (one pair at a time).
-pub fn leaf_candidates_scalar(
+/// Scalar reference of [`leaf_contacts`] (one pair at a time).
+pub fn leaf_contacts_scalar(
     a: TriSoa,
     na: usize,
     b: TriSoa,
     nb: usize,
     pairing: Pairing,
-    out: &mut [u64],
+    out: &mut [Row],
 ) {
     check(&a, na, &b, nb, out);
     for i in 0..na {
         let ta = a.corners(i);
         let va = [a.vertex(0)[i], a.vertex(1)[i], a.vertex(2)[i]];
-        let mut row = 0;
+        let mut row = Row::default();
         for j in 0..nb {
             if pairing == Pairing::NoSharedVertexUpper && j <= i {
                 continue;
@@ -261,28 +363,35 @@ pub fn leaf_candidates_scalar(
                 continue;
             }
             let boxes = (0..3).all(|k| a.lo(k)[i] <= b.hi(k)[j] && b.lo(k)[j] <= a.hi(k)[i]);
-            if boxes && !plane_separated(&ta, &b.corners(j)) {
-                row |= 1 << j;
+            if !boxes {
+                continue;
+            }
+            match pair_verdict(&ta, &b.corners(j)) {
+                Verdict::Apart => {}
+                Verdict::Contact => row.contact |= 1 << j,
+                Verdict::Undecided => row.undecided |= 1 << j,
             }
         }
         out[i] = row;
     }
 }
 
-/// The candidate pairs of the first `na` triangles of `a` and the first `nb <= MAX_ROW` of
-/// `b`: `out[i]` gets bit `j` set iff `(i, j)` is allowed by `pairing`, the boxes overlap and
-/// no separating plane is certified. Panics if `nb > MAX_ROW`, a block is shorter than its
-/// count, or `out` is shorter than `na`. (It does not count the allowed pairs, `N_P`: that
-/// is a fact of the mesh's topology, which the caller tabulates once.)
-pub fn leaf_candidates(
+/// The verdicts on the first `na` triangles of `a` against the first `nb <= MAX_ROW` of `b`:
+/// `out[i]` gets bit `j` in `contact` iff `(i, j)` is allowed by `pairing`, the closed boxes
+/// overlap and the pair certainly intersects, in `undecided` iff it is allowed, the boxes
+/// overlap and neither a separating plane nor the canonical form is certified (module doc).
+/// Panics if `nb > MAX_ROW`, a block is shorter than its count, or `out` is shorter than
+/// `na`. (It does not count the allowed pairs, `N_P`: that is a fact of the mesh's topology,
+/// which the caller tabulates once.)
+pub fn leaf_contacts(
     a: TriSoa,
     na: usize,
     b: TriSoa,
     nb: usize,
     pairing: Pairing,
-    out: &mut [u64],
+    out: &mut [Row],
 ) {
-    crate::arch().dispatch(LeafCandidates {
+    crate::arch().dispatch(LeafContacts {
         a,
         na,
         b,
@@ -292,20 +401,20 @@ pub fn leaf_candidates(
     })
 }
 
-struct LeafCandidates<'a> {
+struct LeafContacts<'a> {
     a: TriSoa<'a>,
     na: usize,
     b: TriSoa<'a>,
     nb: usize,
     pairing: Pairing,
-    out: &'a mut [u64],
+    out: &'a mut [Row],
 }
 
-impl WithSimd for LeafCandidates<'_> {
+impl WithSimd for LeafContacts<'_> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
-        leaf_candidates_with(
+        leaf_contacts_with(
             simd,
             self.a,
             self.na,
@@ -336,49 +445,96 @@ fn splat3<S: Simd>(simd: S, v: [f32; 3]) -> [S::f32s; 3] {
     ]
 }
 
-/// [`leaf_candidates`] on the backend `simd` (inlined into the caller's dispatched body).
+/// The splatted constants of the plane arithmetic: `PLANE_ERR`, `PLANE_TINY`, `2`, `0`.
+#[derive(Clone, Copy)]
+struct Consts<S: Simd> {
+    err: S::f32s,
+    tiny: S::f32s,
+    two: S::f32s,
+    zero: S::f32s,
+    /// Every lane true.
+    all: S::m32s,
+}
+
+impl<S: Simd> Consts<S> {
+    #[inline(always)]
+    fn new(simd: S) -> Self {
+        let (two, zero) = (simd.splat_f32s(2.0), simd.splat_f32s(0.0));
+        Self {
+            err: simd.splat_f32s(PLANE_ERR),
+            tiny: simd.splat_f32s(PLANE_TINY),
+            two,
+            zero,
+            all: simd.less_than_or_equal_f32s(zero, two),
+        }
+    }
+}
+
+/// [`leaf_contacts`] on the backend `simd` (inlined into the caller's dispatched body).
+///
+/// Two passes: the filter (boxes, shared vertices, separating planes) leaves the candidates
+/// in `undecided`, then the canonical form decides the candidates it can certify.
 ///
 /// PERF: the second block is loaded one vector of lanes at a time, with its planes, and
 /// every triangle of the first block is tested against it from registers; the shared-vertex
 /// mask only for rows with a box hit, the plane filter only for rows with a pair left after
 /// both (most rows of neighbouring leaves have no hit: the mask was 15% of a cloth step when
-/// every row built it to count `N_P`). No closures here: they may be compiled without the
-/// dispatched target features.
+/// every row built it to count `N_P`). The decision is a second pass over the rows with
+/// candidates: inside the filter's loop, inlined, its dozen live masks spilled the filter's
+/// registers, and out of line, the call made every vector register live across it a stack
+/// slot (both measured ~18% slower filters on a mesh with few candidates). No closures
+/// here: they may be compiled without the dispatched target features.
 #[inline(always)]
-pub fn leaf_candidates_with<S: Simd>(
+pub fn leaf_contacts_with<S: Simd>(
     simd: S,
     a: TriSoa,
     na: usize,
     b: TriSoa,
     nb: usize,
     pairing: Pairing,
-    out: &mut [u64],
+    out: &mut [Row],
 ) {
     check(&a, na, &b, nb, out);
     for row in out[..na].iter_mut() {
-        *row = 0;
+        *row = Row::default();
     }
     // B is read in whole vectors: its fields over the lanes covering `nb` (padding allowed).
     let len = nb.next_multiple_of(S::F32_LANES).min(b.len());
     let (fa, fb) = (a.fields(na), b.fields(len));
-    let (err, tiny, two, zero) = (
-        simd.splat_f32s(PLANE_ERR),
-        simd.splat_f32s(PLANE_TINY),
-        simd.splat_f32s(2.0),
-        simd.splat_f32s(0.0),
-    );
+    let k = Consts::new(simd);
+    if filter(simd, k, &fa, na, &fb, nb, len, pairing, out) {
+        decide(simd, k, &fa, na, &fb, nb, len, out);
+    }
+}
+
+/// The filter pass of [`leaf_contacts_with`]: the candidates in `undecided`. Returns whether
+/// there is any.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn filter<S: Simd>(
+    simd: S,
+    k: Consts<S>,
+    fa: &Fields,
+    na: usize,
+    fb: &Fields,
+    nb: usize,
+    len: usize,
+    pairing: Pairing,
+    out: &mut [Row],
+) -> bool {
+    let mut any = 0;
     let mut base = 0;
     while base < nb {
         let end = (base + S::F32_LANES).min(len);
         let lanes_valid = low_bits((nb - base).min(S::F32_LANES));
-        let mut blo = [zero; 3];
-        let mut bhi = [zero; 3];
-        let mut bc = [[zero; 3]; 3];
-        for k in 0..3 {
-            blo[k] = load_prefix(simd, &fb.lo[k][base..end]);
-            bhi[k] = load_prefix(simd, &fb.hi[k][base..end]);
+        let mut blo = [k.zero; 3];
+        let mut bhi = [k.zero; 3];
+        let mut bc = [[k.zero; 3]; 3];
+        for d in 0..3 {
+            blo[d] = load_prefix(simd, &fb.lo[d][base..end]);
+            bhi[d] = load_prefix(simd, &fb.hi[d][base..end]);
             for c in 0..3 {
-                bc[c][k] = load_prefix(simd, &fb.corner[c][k][base..end]);
+                bc[c][d] = load_prefix(simd, &fb.corner[c][d][base..end]);
             }
         }
         let (bn, bm) = plane_simd(simd, &bc);
@@ -405,14 +561,14 @@ pub fn leaf_candidates_with<S: Simd>(
                 hit,
                 simd.less_than_or_equal_f32s(blo[0], simd.splat_f32s(fa.hi[0][i])),
             );
-            for k in 1..3 {
+            for d in 1..3 {
                 hit = simd.and_m32s(
                     hit,
-                    simd.less_than_or_equal_f32s(simd.splat_f32s(fa.lo[k][i]), bhi[k]),
+                    simd.less_than_or_equal_f32s(simd.splat_f32s(fa.lo[d][i]), bhi[d]),
                 );
                 hit = simd.and_m32s(
                     hit,
-                    simd.less_than_or_equal_f32s(blo[k], simd.splat_f32s(fa.hi[k][i])),
+                    simd.less_than_or_equal_f32s(blo[d], simd.splat_f32s(fa.hi[d][i])),
                 );
             }
             let mut bits = u64::from(mask_bits(simd, hit)) & valid;
@@ -421,10 +577,10 @@ pub fn leaf_candidates_with<S: Simd>(
             }
             if let Some(bv) = &bv {
                 let mut share = simd.equal_u32s(simd.splat_u32s(fa.vertex[0][i]), bv[0]);
-                for k in 0..3 {
-                    let v = simd.splat_u32s(fa.vertex[k][i]);
+                for d in 0..3 {
+                    let v = simd.splat_u32s(fa.vertex[d][i]);
                     for (c, w) in bv.iter().enumerate() {
-                        if k != 0 || c != 0 {
+                        if d != 0 || c != 0 {
                             share = simd.or_m32s(share, simd.equal_u32s(v, *w));
                         }
                     }
@@ -443,20 +599,97 @@ pub fn leaf_candidates_with<S: Simd>(
             ];
             // The block's corners against triangle i's plane, then i's corners against the
             // block's planes.
-            let sep_a = separated_simd(
-                simd,
-                [err, tiny, two, zero],
-                &pc[0],
-                &splat3(simd, an),
-                &splat3(simd, am),
-                &bc,
-            );
-            let sep_b = separated_simd(simd, [err, tiny, two, zero], &bc[0], &bn, &bm, &pc);
+            let (sep_a, cert_a) =
+                separated_simd(simd, k, &pc[0], &splat3(simd, an), &splat3(simd, am), &bc);
+            let (sep_b, cert_b) = separated_simd(simd, k, &bc[0], &bn, &bm, &pc);
             bits &= !u64::from(mask_bits(simd, simd.or_m32s(sep_a, sep_b)));
-            out[i] |= bits << base;
+            let decidable = bits & u64::from(mask_bits(simd, simd.and_m32s(cert_a, cert_b)));
+            // `contact` holds the decidable candidates until the decision pass.
+            out[i].contact |= decidable << base;
+            out[i].undecided |= bits << base;
+            any |= decidable;
         }
         base += S::F32_LANES;
     }
+    any != 0
+}
+
+/// The decision pass of [`leaf_contacts_with`]: moves the candidates the canonical form
+/// certifies out of `undecided` (into `contact`, or dropped).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn decide<S: Simd>(
+    simd: S,
+    k: Consts<S>,
+    fa: &Fields,
+    na: usize,
+    fb: &Fields,
+    nb: usize,
+    len: usize,
+    out: &mut [Row],
+) {
+    let mut base = 0;
+    while base < nb {
+        let end = (base + S::F32_LANES).min(len);
+        let lanes = low_bits(S::F32_LANES) << base;
+        if out[..na].iter().all(|r| r.contact & lanes == 0) {
+            base += S::F32_LANES;
+            continue;
+        }
+        let mut bc = [[k.zero; 3]; 3];
+        for c in 0..3 {
+            for d in 0..3 {
+                bc[c][d] = load_prefix(simd, &fb.corner[c][d][base..end]);
+            }
+        }
+        let (bn, bm) = plane_simd(simd, &bc);
+        for i in 0..na {
+            let decidable = (out[i].contact & lanes) >> base;
+            if decidable == 0 {
+                continue;
+            }
+            let ta = fa.corners(i);
+            let (an, am) = plane(&ta);
+            let pc = [
+                splat3(simd, ta[0]),
+                splat3(simd, ta[1]),
+                splat3(simd, ta[2]),
+            ];
+            // Every sign is certified on these lanes: "positive" is "not negative".
+            let pb = positive_simd(simd, k, &pc[0], &splat3(simd, an), &splat3(simd, am), &bc);
+            let pa = positive_simd(simd, k, &bc[0], &bn, &bm, &pc);
+            let (yes, no) = canonical_simd(simd, k, &pc, &bc, &pa, &pb);
+            let contact = decidable & u64::from(mask_bits(simd, yes));
+            let apart = decidable & !contact & u64::from(mask_bits(simd, no));
+            out[i].contact &= !(decidable << base);
+            out[i].contact |= contact << base;
+            out[i].undecided &= !((contact | apart) << base);
+        }
+        base += S::F32_LANES;
+    }
+}
+
+/// The lane-wise [`separated`]: (the three points `d` all certainly strictly on one side of
+/// the plane `(a, n, m)`, all three signs certified).
+#[inline(always)]
+fn separated_simd<S: Simd>(
+    simd: S,
+    k: Consts<S>,
+    a: &[S::f32s; 3],
+    n: &[S::f32s; 3],
+    m: &[S::f32s; 3],
+    d: &[[S::f32s; 3]; 3],
+) -> (S::m32s, S::m32s) {
+    let mut pos = k.all;
+    let mut neg = pos;
+    let mut certified = pos;
+    for p in d {
+        let (sp, sn) = side_simd(simd, k, a, n, m, p);
+        pos = simd.and_m32s(pos, sp);
+        neg = simd.and_m32s(neg, sn);
+        certified = simd.and_m32s(certified, simd.or_m32s(sp, sn));
+    }
+    (simd.or_m32s(pos, neg), certified)
 }
 
 /// The lane-wise [`plane`].
@@ -490,46 +723,152 @@ fn abs_sum<S: Simd>(simd: S, a: S::f32s, b: S::f32s) -> S::f32s {
     simd.add_f32s(simd.abs_f32s(a), simd.abs_f32s(b))
 }
 
-/// The lane-wise [`separated`] of the three points `d` against the plane `(a, n, m)`;
-/// `c = [PLANE_ERR, PLANE_TINY, 2, 0]` splatted.
+/// The lane-wise [`side`] of one point `d` against the plane `(a, n, m)`: (certainly
+/// positive, certainly negative).
 #[inline(always)]
-fn separated_simd<S: Simd>(
+fn side_simd<S: Simd>(
     simd: S,
-    c: [S::f32s; 4],
+    k: Consts<S>,
+    a: &[S::f32s; 3],
+    n: &[S::f32s; 3],
+    m: &[S::f32s; 3],
+    d: &[S::f32s; 3],
+) -> (S::m32s, S::m32s) {
+    let e = [
+        simd.sub_f32s(d[0], a[0]),
+        simd.sub_f32s(d[1], a[1]),
+        simd.sub_f32s(d[2], a[2]),
+    ];
+    let s = simd.add_f32s(
+        simd.add_f32s(simd.mul_f32s(e[0], n[0]), simd.mul_f32s(e[1], n[1])),
+        simd.mul_f32s(e[2], n[2]),
+    );
+    let ae = [
+        simd.abs_f32s(e[0]),
+        simd.abs_f32s(e[1]),
+        simd.abs_f32s(e[2]),
+    ];
+    let perm = simd.add_f32s(
+        simd.add_f32s(simd.mul_f32s(ae[0], m[0]), simd.mul_f32s(ae[1], m[1])),
+        simd.mul_f32s(ae[2], m[2]),
+    );
+    let l = simd.add_f32s(simd.add_f32s(ae[0], ae[1]), ae[2]);
+    let bound = simd.add_f32s(
+        simd.mul_f32s(k.err, perm),
+        simd.mul_f32s(k.tiny, simd.add_f32s(l, k.two)),
+    );
+    (
+        simd.greater_than_f32s(s, bound),
+        simd.less_than_f32s(s, simd.sub_f32s(k.zero, bound)),
+    )
+}
+
+/// The lane-wise "certainly positive" [`side`]s of the three points `d` against the plane
+/// `(a, n, m)`.
+#[inline(always)]
+fn positive_simd<S: Simd>(
+    simd: S,
+    k: Consts<S>,
     a: &[S::f32s; 3],
     n: &[S::f32s; 3],
     m: &[S::f32s; 3],
     d: &[[S::f32s; 3]; 3],
+) -> [S::m32s; 3] {
+    [
+        side_simd(simd, k, a, n, m, &d[0]).0,
+        side_simd(simd, k, a, n, m, &d[1]).0,
+        side_simd(simd, k, a, n, m, &d[2]).0,
+    ]
+}
+
+/// Lane-wise `if m { x } else { y }` on points.
+#[inline(always)]
+fn select3<S: Simd>(simd: S, m: S::m32s, x: &[S::f32s; 3], y: &[S::f32s; 3]) -> [S::f32s; 3] {
+    [
+        simd.select_f32s(m, x[0], y[0]),
+        simd.select_f32s(m, x[1], y[1]),
+        simd.select_f32s(m, x[2], y[2]),
+    ]
+}
+
+/// Lane-wise mask `x == y`.
+#[inline(always)]
+fn mask_eq<S: Simd>(simd: S, k: Consts<S>, x: S::m32s, y: S::m32s) -> S::m32s {
+    simd.xor_m32s(simd.xor_m32s(x, y), k.all)
+}
+
+/// Lane-wise [`lone`] of three nonzero signs given by their positive masks: masks of "lone is
+/// 0" and "lone is 1" (else 2).
+#[inline(always)]
+fn lone_simd<S: Simd>(simd: S, k: Consts<S>, pos: &[S::m32s; 3]) -> (S::m32s, S::m32s) {
+    let l0 = mask_eq(simd, k, pos[1], pos[2]);
+    let l1 = simd.and_m32s(simd.xor_m32s(l0, k.all), mask_eq(simd, k, pos[0], pos[2]));
+    (l0, l1)
+}
+
+/// Lane-wise `[x0, x1, x2][lone]` for the lone masks of [`lone_simd`].
+#[inline(always)]
+fn pick<S: Simd>(simd: S, (l0, l1): (S::m32s, S::m32s), x: [&[S::f32s; 3]; 3]) -> [S::f32s; 3] {
+    select3(simd, l0, x[0], &select3(simd, l1, x[1], x[2]))
+}
+
+/// Lane-wise `[x0, x1, x2][lone]` on masks.
+#[inline(always)]
+fn pick_mask<S: Simd>(
+    simd: S,
+    k: Consts<S>,
+    (l0, l1): (S::m32s, S::m32s),
+    x: [S::m32s; 3],
 ) -> S::m32s {
-    let [err, tiny, two, zero] = c;
-    let mut pos = simd.less_than_or_equal_f32s(zero, two); // all lanes true
-    let mut neg = pos;
-    for p in d {
-        let e = [
-            simd.sub_f32s(p[0], a[0]),
-            simd.sub_f32s(p[1], a[1]),
-            simd.sub_f32s(p[2], a[2]),
-        ];
-        let s = simd.add_f32s(
-            simd.add_f32s(simd.mul_f32s(e[0], n[0]), simd.mul_f32s(e[1], n[1])),
-            simd.mul_f32s(e[2], n[2]),
-        );
-        let ae = [
-            simd.abs_f32s(e[0]),
-            simd.abs_f32s(e[1]),
-            simd.abs_f32s(e[2]),
-        ];
-        let perm = simd.add_f32s(
-            simd.add_f32s(simd.mul_f32s(ae[0], m[0]), simd.mul_f32s(ae[1], m[1])),
-            simd.mul_f32s(ae[2], m[2]),
-        );
-        let l = simd.add_f32s(simd.add_f32s(ae[0], ae[1]), ae[2]);
-        let bound = simd.add_f32s(
-            simd.mul_f32s(err, perm),
-            simd.mul_f32s(tiny, simd.add_f32s(l, two)),
-        );
-        pos = simd.and_m32s(pos, simd.greater_than_f32s(s, bound));
-        neg = simd.and_m32s(neg, simd.less_than_f32s(s, simd.sub_f32s(zero, bound)));
-    }
-    simd.or_m32s(pos, neg)
+    let l2 = simd.xor_m32s(simd.or_m32s(l0, l1), k.all);
+    simd.or_m32s(
+        simd.or_m32s(simd.and_m32s(l0, x[0]), simd.and_m32s(l1, x[1])),
+        simd.and_m32s(l2, x[2]),
+    )
+}
+
+/// The lane-wise [`pair_verdict`] past the plane filter, for lanes whose six signs are
+/// certified and not separating: `a` (the row's triangle, splatted) and `b` (the block's
+/// triangles), `pa`/`pb` the positive masks of a's corners against b's plane and of b's
+/// against a's. Returns (certainly intersecting, certainly apart).
+#[inline(always)]
+fn canonical_simd<S: Simd>(
+    simd: S,
+    k: Consts<S>,
+    a: &[[S::f32s; 3]; 3],
+    b: &[[S::f32s; 3]; 3],
+    pa: &[S::m32s; 3],
+    pb: &[S::m32s; 3],
+) -> (S::m32s, S::m32s) {
+    // a rotated so that its lone vertex comes first.
+    let la = lone_simd(simd, k, pa);
+    let p1 = pick(simd, la, [&a[0], &a[1], &a[2]]);
+    let q1 = pick(simd, la, [&a[1], &a[2], &a[0]]);
+    let r1 = pick(simd, la, [&a[2], &a[0], &a[1]]);
+    // p1 below b's plane: swap b's last two (with their signs).
+    let flip = simd.xor_m32s(pick_mask(simd, k, la, *pa), k.all);
+    let b1 = select3(simd, flip, &b[2], &b[1]);
+    let b2 = select3(simd, flip, &b[1], &b[2]);
+    let s1 = simd.or_m32s(
+        simd.and_m32s(flip, pb[2]),
+        simd.and_m32s(simd.xor_m32s(flip, k.all), pb[1]),
+    );
+    let s2 = simd.or_m32s(
+        simd.and_m32s(flip, pb[1]),
+        simd.and_m32s(simd.xor_m32s(flip, k.all), pb[2]),
+    );
+    // b rotated so that its lone vertex comes first.
+    let tb = [pb[0], s1, s2];
+    let lb = lone_simd(simd, k, &tb);
+    let p2 = pick(simd, lb, [&b[0], &b1, &b2]);
+    let q2 = pick(simd, lb, [&b1, &b2, &b[0]]);
+    let r2 = pick(simd, lb, [&b2, &b[0], &b1]);
+    // p2 below a's plane: swap q1 and r1.
+    let flip = simd.xor_m32s(pick_mask(simd, k, lb, tb), k.all);
+    let (q1, r1) = (select3(simd, flip, &r1, &q1), select3(simd, flip, &q1, &r1));
+    let (n1, m1) = plane_simd(simd, &[q2, p2, p1]);
+    let (pos1, neg1) = side_simd(simd, k, &q2, &n1, &m1, &q1);
+    let (n2, m2) = plane_simd(simd, &[r2, p2, r1]);
+    let (pos2, neg2) = side_simd(simd, k, &r2, &n2, &m2, &p1);
+    (simd.and_m32s(pos1, pos2), simd.or_m32s(neg1, neg2))
 }

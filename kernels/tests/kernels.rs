@@ -363,8 +363,8 @@ fn check_block_special_values<S: Simd>(simd: S) {
                 row[pos] = tri(bb);
                 let rb = Tris::new(&row, 0);
                 let ra = Tris::new(&[tri(ba)], 100);
-                let mut out = [0u64; 1];
-                narrow::leaf_candidates_with(
+                let mut out = [narrow::Row::default(); 1];
+                narrow::leaf_contacts_with(
                     simd,
                     ra.soa(),
                     1,
@@ -373,7 +373,11 @@ fn check_block_special_values<S: Simd>(simd: S) {
                     narrow::Pairing::All,
                     &mut out,
                 );
-                assert_eq!(out[0], (want as u64) << pos, "{simd:?} row case {ci} n={n}");
+                assert_eq!(
+                    out[0].candidates(),
+                    (want as u64) << pos,
+                    "{simd:?} row case {ci} n={n}"
+                );
             }
         }
     }
@@ -495,7 +499,7 @@ const PAIRINGS: [narrow::Pairing; 3] = [
     narrow::Pairing::NoSharedVertexUpper,
 ];
 
-fn check_leaf_candidates<S: Simd>(simd: S) {
+fn check_leaf_contacts<S: Simd>(simd: S) {
     let mut rng = Rng::new(4);
     for scale in [1.0, 1e-30, 1e30, 3e-3] {
         for nb in block_sizes(S::F32_LANES, narrow::MAX_ROW) {
@@ -509,25 +513,33 @@ fn check_leaf_candidates<S: Simd>(simd: S) {
                     3 * rng.below(8) as u32,
                 );
                 for pairing in PAIRINGS {
-                    let mut want = vec![7u64; na + 1];
-                    let mut got = vec![9u64; na + 1];
-                    narrow::leaf_candidates_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
-                    narrow::leaf_candidates_with(simd, a.soa(), na, b.soa(), nb, pairing, &mut got);
+                    let row = |x| narrow::Row {
+                        contact: x,
+                        undecided: x,
+                    };
+                    let mut want = vec![row(7); na + 1];
+                    let mut got = vec![row(9); na + 1];
+                    narrow::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
+                    narrow::leaf_contacts_with(simd, a.soa(), na, b.soa(), nb, pairing, &mut got);
                     assert_eq!(
                         &got[..na],
                         &want[..na],
                         "{simd:?} na={na} nb={nb} {pairing:?} scale={scale}"
                     );
-                    assert_eq!(got[na], 9, "wrote past na rows");
+                    assert_eq!(got[na], row(9), "wrote past na rows");
                     assert!(
-                        got[..na].iter().all(|r| r & !low64(nb) == 0),
+                        got[..na].iter().all(|r| r.contact & r.undecided == 0),
+                        "a pair both certain and undecided"
+                    );
+                    assert!(
+                        got[..na].iter().all(|r| r.candidates() & !low64(nb) == 0),
                         "bits past nb"
                     );
                     if pairing == narrow::Pairing::NoSharedVertexUpper {
                         assert!(got[..na]
                             .iter()
                             .enumerate()
-                            .all(|(i, r)| r & low64(i + 1) == 0));
+                            .all(|(i, r)| r.candidates() & low64(i + 1) == 0));
                     }
                 }
             }
@@ -536,21 +548,22 @@ fn check_leaf_candidates<S: Simd>(simd: S) {
 }
 
 #[test]
-fn leaf_candidates_match_reference_on_all_backends() {
-    on_all_backends!(check_leaf_candidates);
+fn leaf_contacts_match_reference_on_all_backends() {
+    on_all_backends!(check_leaf_contacts);
 }
 
 #[test]
-fn dispatched_leaf_candidates_match_reference() {
+fn dispatched_leaf_contacts_match_reference() {
     let mut rng = Rng::new(9);
     for _ in 0..50 {
         let (na, nb) = (rng.below(65), rng.below(65));
         let a = Tris::new(&random_tris(&mut rng, na, 1.0), 0);
         let b = Tris::new(&random_tris(&mut rng, nb, 1.0), 3 * rng.below(20) as u32);
         for pairing in PAIRINGS {
-            let (mut want, mut got) = (vec![0; na], vec![0; na]);
-            narrow::leaf_candidates(a.soa(), na, b.soa(), nb, pairing, &mut got);
-            narrow::leaf_candidates_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
+            let mut want = vec![narrow::Row::default(); na];
+            let mut got = want.clone();
+            narrow::leaf_contacts(a.soa(), na, b.soa(), nb, pairing, &mut got);
+            narrow::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
             assert_eq!(got, want);
         }
     }
@@ -559,15 +572,17 @@ fn dispatched_leaf_candidates_match_reference() {
 /// The pairings: which pairs reach the box and plane filters at all. Ten copies of one
 /// triangle (boxes overlap, coplanar: no plane certified) keep exactly the allowed pairs.
 #[test]
-fn leaf_candidates_keep_exactly_the_allowed_pairs() {
+fn leaf_contacts_keep_exactly_the_allowed_pairs() {
     let copies = vec![[[0.0, 0.0, 0.0], [2.0, 1.0, 0.0], [0.0, 1.0, 0.0]]; 10];
     let a = Tris::new(&copies, 0);
     let mut shared = Tris::new(&copies, 0);
     shared.set_vertex(1, 3, 0); // triangle 3 of b shares vertex 0 with triangle 0 of a
     let rows = |b: &Tris, pairing| {
-        let mut out = [0u64; 10];
-        narrow::leaf_candidates(a.soa(), 10, b.soa(), 10, pairing, &mut out);
-        out
+        let mut out = [narrow::Row::default(); 10];
+        narrow::leaf_contacts(a.soa(), 10, b.soa(), 10, pairing, &mut out);
+        // Coplanar copies certify no sign: every candidate is left to the exact test.
+        assert!(out.iter().all(|r| r.contact == 0));
+        out.map(|r| r.candidates())
     };
     assert_eq!(rows(&a, narrow::Pairing::All), [0x3ff; 10]);
     // The same block: each triangle shares its own three indices with itself only.
@@ -582,7 +597,7 @@ fn leaf_candidates_keep_exactly_the_allowed_pairs() {
 
 /// The box and plane filters on a strip of triangles.
 #[test]
-fn leaf_candidates_filter_a_strip() {
+fn leaf_contacts_filter_a_strip() {
     // A strip in the plane z = 0: neighbours' boxes touch (x = t + 1), the others are apart.
     let tris: Vec<[[f32; 3]; 3]> = (0..10)
         .map(|t| {
@@ -591,9 +606,9 @@ fn leaf_candidates_filter_a_strip() {
         })
         .collect();
     let a = Tris::new(&tris, 0);
-    let mut out = [0u64; 10];
-    // Coplanar neighbours in one plane, boxes overlapping: kept for the exact test.
-    narrow::leaf_candidates(
+    let mut out = [narrow::Row::default(); 10];
+    // Coplanar neighbours in one plane, boxes overlapping: left to the exact test.
+    narrow::leaf_contacts(
         a.soa(),
         10,
         a.soa(),
@@ -602,9 +617,90 @@ fn leaf_candidates_filter_a_strip() {
         &mut out,
     );
     assert_eq!(
-        out[0], 0b10,
-        "touching neighbour 1 kept, far ones dropped by the boxes"
+        out[0],
+        narrow::Row {
+            contact: 0,
+            undecided: 0b10
+        },
+        "touching neighbour 1 undecided, far ones dropped by the boxes"
     );
+}
+
+/// The canonical form's three outcomes on pairs whose six corner-plane signs are certified,
+/// on every backend, in every rotation of both triangles (the lone vertices move) and both
+/// orders.
+fn check_canonical_form<S: Simd>(simd: S) {
+    use narrow::Verdict::{Apart, Contact};
+    let base = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+    let cases: [([[f32; 3]; 3], narrow::Verdict); 4] = [
+        // Pierces base's interior: intersect.
+        (
+            [[1.0, 1.0, -1.0], [1.0, 1.0, 1.0], [1.5, 1.2, 1.0]],
+            Contact,
+        ),
+        // Crosses base's plane beyond its hypotenuse: the planes' common line misses base.
+        ([[3.0, 3.0, -1.0], [3.0, 3.0, 1.0], [3.5, 3.2, 1.0]], Apart),
+        // Straddles base's plane but stops short of it along the common line.
+        (
+            [[-2.0, 1.0, -1.0], [-2.0, 1.0, 1.0], [-1.0, 1.0, 1.0]],
+            Apart,
+        ),
+        // A long sliver crossing the whole of base.
+        (
+            [[-1.0, 1.0, 0.5], [6.0, 1.0, -0.5], [-1.0, 1.1, 0.5]],
+            Contact,
+        ),
+    ];
+    let rot = |t: [[f32; 3]; 3], r: usize| [t[r % 3], t[(r + 1) % 3], t[(r + 2) % 3]];
+    let mirror = |t: [[f32; 3]; 3]| [t[0], t[2], t[1]];
+    for (ci, &(other, want)) in cases.iter().enumerate() {
+        for r in 0..6 {
+            let a = if r < 3 {
+                rot(base, r)
+            } else {
+                mirror(rot(base, r))
+            };
+            for s in 0..6 {
+                let b = if s < 3 {
+                    rot(other, s)
+                } else {
+                    mirror(rot(other, s))
+                };
+                for (x, y) in [(a, b), (b, a)] {
+                    assert!(
+                        !narrow::plane_separated(&x, &y),
+                        "case {ci}: no plane separates"
+                    );
+                    assert_eq!(narrow::pair_verdict(&x, &y), want, "case {ci} r={r} s={s}");
+                    let (tx, ty) = (Tris::new(&[x], 0), Tris::new(&[y], 10));
+                    let mut out = [narrow::Row::default(); 1];
+                    narrow::leaf_contacts_with(
+                        simd,
+                        tx.soa(),
+                        1,
+                        ty.soa(),
+                        1,
+                        narrow::Pairing::All,
+                        &mut out,
+                    );
+                    let bit = u64::from(want == Contact);
+                    assert_eq!(
+                        out[0],
+                        narrow::Row {
+                            contact: bit,
+                            undecided: 0
+                        },
+                        "{simd:?} case {ci} r={r} s={s}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn canonical_form_on_all_backends() {
+    on_all_backends!(check_canonical_form);
 }
 
 /// Exact sign of `orient3d` (the robust crate is exact for f64 inputs, and f32 converts

@@ -1,16 +1,18 @@
-//! The narrow phase of one leaf pair: the candidate pairs of the two leaves' triangles
-//! (`dhcd_kernels::narrow::leaf_candidates`: closed boxes, shared vertices for
-//! self-collision, certified separating planes), then the exact test on the candidates.
+//! The narrow phase of one leaf pair: the verdicts of the kernel on the two leaves' triangles
+//! (`dhcd_kernels::narrow::leaf_contacts`: closed boxes, shared vertices for self-collision,
+//! certified separating planes, then the certified canonical form), then the exact test on
+//! the pairs it left undecided.
 //!
-//! Every filter only drops pairs that cannot intersect, so the contacts are exactly those of
-//! the exact test on every pair. `N_P` counts every triangle pair of the leaf pair (the cost
+//! The kernel only drops pairs that cannot intersect and only reports pairs that do, so the
+//! contacts are exactly those of the exact test on every pair (debug builds re-check every
+//! certified contact with the exact test). `N_P` counts every triangle pair of the leaf pair (the cost
 //! model's unit), minus the vertex-sharing pairs of a self query, which the region tree
 //! tabulates (`RegionTree::shared_pairs`): the kernel never counts.
 
-use dhcd_kernels::narrow::{leaf_candidates_with, Pairing, MAX_ROW};
+use dhcd_kernels::narrow::{leaf_contacts_with, Pairing, Row, MAX_ROW};
 use pulp::Simd;
 
-use super::tritri::intersects_given_boxes_overlap;
+use super::tritri::{intersects, intersects_given_boxes_overlap};
 use crate::hierarchy::LeafTris;
 
 /// One leaf of a leaf pair: its cached triangles and their original indices.
@@ -41,7 +43,7 @@ pub(crate) fn leaf_pair<S: Simd>(
     b: &LeafSide,
     leaves: Leaves,
     shared: u64,
-    rows: &mut [u64; MAX_ROW],
+    rows: &mut [Row; MAX_ROW],
     out: &mut Vec<[u32; 2]>,
 ) -> u64 {
     let (na, nb) = (a.tris.len, b.tris.len);
@@ -89,28 +91,38 @@ fn blocks<S: Simd>(
     nb: usize,
     pairing: Pairing,
     ordered: bool,
-    rows: &mut [u64; MAX_ROW],
+    rows: &mut [Row; MAX_ROW],
     out: &mut Vec<[u32; 2]>,
 ) {
     let (sa, sb) = (a.tris.soa.skip(a0), b.tris.soa.skip(b0));
     debug_assert!(na <= MAX_ROW);
-    leaf_candidates_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
-    for (i, &row) in rows[..na].iter().enumerate() {
-        let mut bits = row;
-        if bits == 0 {
+    leaf_contacts_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
+    let contact = |i: usize, j: usize| {
+        let (oi, oj) = (a.order[a0 + i], b.order[b0 + j]);
+        if ordered {
+            [oi.min(oj), oi.max(oj)]
+        } else {
+            [oi, oj]
+        }
+    };
+    for (i, row) in rows[..na].iter().enumerate() {
+        if row.candidates() == 0 {
             continue;
         }
         let ti = sa.corners(i);
+        let mut bits = row.contact;
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            debug_assert!(intersects(&ti, &sb.corners(j)), "certified contact");
+            out.push(contact(i, j));
+        }
+        let mut bits = row.undecided;
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
             if intersects_given_boxes_overlap(&ti, &sb.corners(j)) {
-                let (oi, oj) = (a.order[a0 + i], b.order[b0 + j]);
-                out.push(if ordered {
-                    [oi.min(oj), oi.max(oj)]
-                } else {
-                    [oi, oj]
-                });
+                out.push(contact(i, j));
             }
         }
     }
