@@ -15,22 +15,29 @@
 //!
 //! **The plane filter.** In `f32`, `s = det[u, v, e]` with `u = b - a`, `v = c - a` (the
 //! plane triangle's edges from corner `a`) and `e = d - a` (the tested corner), computed as
-//! `(e_x N_x + e_y N_y) + e_z N_z` with `N = u x v`, next to the permanent
-//! `P = (|e_x| M_x + |e_y| M_y) + |e_z| M_z`, `M_x = |u_y v_z| + |u_z v_y|` (cyclically),
-//! from the same rounded products. That is Shewchuk's `orient3d` arithmetic (a Laplace
-//! expansion of the same determinant: rounded differences times rounded 2x2 minors of rounded
-//! differences), whose rounding error is at most `(7 + 56 eps) eps P` (eps = 2^-24) when
-//! nothing underflows. Gradual underflow adds an absolute error of at most `2^-150` per
-//! product, which the products by `e` scale: at most `(2 |e|_1 + 3) 2^-150` in all. A sign is
-//! certified only when `|s| > 8 eps P + 2^-126 (|e|_1 + 2)`, which covers both with margin
-//! (and the rounding of the bound itself). The absolute term is the smallest *normal* `f32`,
-//! not the `2^-147` the underflow needs: a subnormal operand costs an FP assist of about a
-//! hundred cycles on x86, and with a subnormal constant every bound paid six (measured: half
-//! of a cloth self-collision step). It only gives up certifying determinants below about
-//! `1e-38`, i.e. triangles of sides below about `1e-12`, which the exact test then decides.
-//! Overflow gives an infinite `P` (so `|s|` can never exceed the bound: `|s| <= P` holds in
-//! floating point by monotonic rounding); NaN compares false. So a certified sign is the exact sign of the determinant, for every `f32` input.
-//! A degenerate triangle has `N = M = 0` and certifies nothing.
+//! `(e_x N_x + e_y N_y) + e_z N_z` with `N = u x v`. Shewchuk's `orient3d` arithmetic (a
+//! Laplace expansion of the same determinant: rounded differences times rounded 2x2 minors of
+//! rounded differences) has a rounding error of at most `(7 + 56 eps) eps P` (eps = 2^-24)
+//! when nothing underflows, `P = (|e_x| M_x + |e_y| M_y) + |e_z| M_z` the permanent computed
+//! from the same rounded products, `M_x = |u_y v_z| + |u_z v_y|` (cyclically). Gradual
+//! underflow adds an absolute error of at most `2^-150` per product, which the products by `e`
+//! scale: at most `(2 |e|_1 + 3) 2^-150` in all. The filter bounds `|e|` once per pair
+//! instead of once per corner: both corners of every tested difference lie in the union of
+//! the two triangles' closed boxes, so `|e_k| <= E_k`, the union box's extent along `k`
+//! (rounded: `fl(|e_k|) <= fl(E_k)` by monotonic rounding, and so on through every rounded
+//! sum and product). A sign is certified only when `|s| > 8 eps P' + 2^-126 (|E|_1 + 2)`,
+//! `P' = (E_x M_x + E_y M_y) + E_z M_z >= P`, which covers both errors with margin (and the
+//! rounding of the bound itself), with one bound per plane for the three corners tested
+//! against it (a third of the arithmetic of a bound per corner; nearby triangles have `|e|`
+//! about `E` anyway). The absolute term is the smallest *normal* `f32`, not the `2^-147` the
+//! underflow needs: a subnormal operand costs an FP assist of about a hundred cycles on x86,
+//! and with a subnormal constant every bound paid six (measured: half of a cloth
+//! self-collision step). It only gives up certifying determinants below about `1e-38`, i.e.
+//! triangles of sides below about `1e-12`, which the exact test then decides. Overflow gives
+//! an infinite bound (so `|s|` can never exceed it: `|s| <= P` holds in floating point by
+//! monotonic rounding); NaN compares false. So a certified sign is the exact sign of the
+//! determinant, for every `f32` input. A degenerate triangle has `N = M = 0` and certifies
+//! nothing.
 //!
 //! **The decision.** A candidate whose six corner-plane signs are all certified (none is
 //! zero, none unknown) is then decided by Guigue and Devillers' canonical form ("Fast and
@@ -38,8 +45,8 @@
 //! triangle is rotated so that its vertex alone on its side of the other's plane comes first,
 //! the other triangle's last two vertices swapped when that vertex is on the negative side,
 //! and the pair intersects iff two more orientations are `>= 0`. Those two are computed with
-//! the same arithmetic and bound from the same `f32` corners, so a certified verdict is the
-//! exact one. The pair is then a *contact* (both certified positive) or dropped (one
+//! the same arithmetic from the same `f32` corners, with the bound of each point (`|e|` in
+//! place of `E`), so a certified verdict is the exact one. The pair is then a *contact* (both certified positive) or dropped (one
 //! certified negative); everything else is *undecided* and left to the caller's exact test.
 //! The `dhcd` crate's exact test (`src/narrow/tritri.rs`) is the same formulation on exact
 //! predicates, and its tests check every certified verdict against it.
@@ -213,8 +220,8 @@ fn plane(t: &[[f32; 3]; 3]) -> ([f32; 3], [f32; 3]) {
     )
 }
 
-/// Side of `d` against the plane `(a, n, m)`: `1` certainly positive, `-1` certainly
-/// negative, `0` unknown (or on the plane).
+/// Side of `d` against the plane `(a, n, m)`, with the bound of the point itself: `1`
+/// certainly positive, `-1` certainly negative, `0` unknown (or on the plane).
 #[inline(always)]
 fn side(a: &[f32; 3], n: &[f32; 3], m: &[f32; 3], d: &[f32; 3]) -> i32 {
     let e = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
@@ -225,17 +232,63 @@ fn side(a: &[f32; 3], n: &[f32; 3], m: &[f32; 3], d: &[f32; 3]) -> i32 {
     i32::from(s > bound) - i32::from(s < 0.0 - bound)
 }
 
-/// Whether the triangle `d` lies certainly strictly on one side of `t`'s plane.
+/// A triangle's closed box, as the callers' leaf tiles store it.
 #[inline(always)]
-fn separated(t: &[[f32; 3]; 3], d: &[[f32; 3]; 3]) -> bool {
-    let (n, m) = plane(t);
-    let s = d.map(|p| side(&t[0], &n, &m, &p));
-    (s[0] == 1 && s[1] == 1 && s[2] == 1) || (s[0] == -1 && s[1] == -1 && s[2] == -1)
+fn corner_box(t: &[[f32; 3]; 3]) -> ([f32; 3], [f32; 3]) {
+    let lo = std::array::from_fn(|k| t[0][k].min(t[1][k]).min(t[2][k]));
+    let hi = std::array::from_fn(|k| t[0][k].max(t[1][k]).max(t[2][k]));
+    (lo, hi)
 }
 
-/// Whether a separating plane of `a` or `b` is certified (the plane filter on one pair).
+/// The extents `E` of the union of two closed boxes (module doc).
+#[inline(always)]
+fn union_extents(a: &([f32; 3], [f32; 3]), b: &([f32; 3], [f32; 3])) -> [f32; 3] {
+    std::array::from_fn(|k| a.1[k].max(b.1[k]) - a.0[k].min(b.0[k]))
+}
+
+/// The filter's certification bound for every corner of a pair against the plane of
+/// magnitudes `m`, the pair's union extents `ext` (module doc).
+#[inline(always)]
+fn pair_bound(m: &[f32; 3], ext: &[f32; 3]) -> f32 {
+    let p = ext[0] * m[0] + ext[1] * m[1] + ext[2] * m[2];
+    let l = ext[0] + ext[1] + ext[2];
+    PLANE_ERR * p + PLANE_TINY * (l + 2.0)
+}
+
+/// The filter's sides of the three points `d` against the plane `(a, n)` with the pair's
+/// `bound`: `1` certainly positive, `-1` certainly negative, `0` unknown.
+#[inline(always)]
+fn sides_within(a: &[f32; 3], n: &[f32; 3], bound: f32, d: &[[f32; 3]; 3]) -> [i32; 3] {
+    d.map(|d| {
+        let e = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+        let s = e[0] * n[0] + e[1] * n[1] + e[2] * n[2];
+        i32::from(s > bound) - i32::from(s < 0.0 - bound)
+    })
+}
+
+/// The filter's signs of a pair: `a`'s corners against `b`'s plane, `b`'s against `a`'s,
+/// `ext` the union extents of their boxes.
+#[inline(always)]
+fn filter_signs(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], ext: &[f32; 3]) -> ([i32; 3], [i32; 3]) {
+    let (an, am) = plane(a);
+    let (bn, bm) = plane(b);
+    (
+        sides_within(&b[0], &bn, pair_bound(&bm, ext), a),
+        sides_within(&a[0], &an, pair_bound(&am, ext), b),
+    )
+}
+
+/// All three signs certain and equal.
+#[inline(always)]
+fn one_side(s: [i32; 3]) -> bool {
+    s[0] != 0 && s[0] == s[1] && s[0] == s[2]
+}
+
+/// Whether a separating plane of `a` or `b` is certified (the plane filter on one pair,
+/// boxes from the corners).
 pub fn plane_separated(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
-    separated(a, b) || separated(b, a)
+    let (sa, sb) = filter_signs(a, b, &union_extents(&corner_box(a), &corner_box(b)));
+    one_side(sa) || one_side(sb)
 }
 
 /// One row of verdicts: triangle `i` of the first block against the second block, bit `j`
@@ -268,16 +321,17 @@ pub enum Verdict {
     Undecided,
 }
 
-/// The verdict of the plane filter and the certified canonical form on one pair whose closed
-/// boxes overlap (module doc), in the kernel's arithmetic.
+/// The verdict of the plane filter and the certified canonical form on one pair (module
+/// doc), in the kernel's arithmetic, boxes from the corners.
 pub fn pair_verdict(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> Verdict {
-    let (an, am) = plane(a);
-    let (bn, bm) = plane(b);
+    verdict_within(a, b, &union_extents(&corner_box(a), &corner_box(b)))
+}
+
+/// [`pair_verdict`] with the union extents of the pair's boxes.
+fn verdict_within(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], ext: &[f32; 3]) -> Verdict {
     // sa: a's corners against b's plane; sb: b's corners against a's plane.
-    let sa = a.map(|p| side(&b[0], &bn, &bm, &p));
-    let sb = b.map(|p| side(&a[0], &an, &am, &p));
-    let all = |s: [i32; 3], v: i32| s.iter().all(|&x| x == v);
-    if all(sa, 1) || all(sa, -1) || all(sb, 1) || all(sb, -1) {
+    let (sa, sb) = filter_signs(a, b, ext);
+    if one_side(sa) || one_side(sb) {
         return Verdict::Apart;
     }
     if sa.contains(&0) || sb.contains(&0) {
@@ -366,7 +420,14 @@ pub fn leaf_contacts_scalar(
             if !boxes {
                 continue;
             }
-            match pair_verdict(&ta, &b.corners(j)) {
+            let stored = |t: &TriSoa, i: usize| {
+                (
+                    [t.lo(0)[i], t.lo(1)[i], t.lo(2)[i]],
+                    [t.hi(0)[i], t.hi(1)[i], t.hi(2)[i]],
+                )
+            };
+            let ext = union_extents(&stored(&a, i), &stored(&b, j));
+            match verdict_within(&ta, &b.corners(j), &ext) {
                 Verdict::Apart => {}
                 Verdict::Contact => row.contact |= 1 << j,
                 Verdict::Undecided => row.undecided |= 1 << j,
@@ -597,11 +658,24 @@ fn filter<S: Simd>(
                 splat3(simd, ta[1]),
                 splat3(simd, ta[2]),
             ];
+            // One bound per plane for its three corners, from the pairs' union boxes.
+            let mut ext = [k.zero; 3];
+            for d in 0..3 {
+                ext[d] = simd.sub_f32s(
+                    simd.max_f32s(simd.splat_f32s(fa.hi[d][i]), bhi[d]),
+                    simd.min_f32s(simd.splat_f32s(fa.lo[d][i]), blo[d]),
+                );
+            }
+            let tiny = simd.mul_f32s(
+                k.tiny,
+                simd.add_f32s(simd.add_f32s(simd.add_f32s(ext[0], ext[1]), ext[2]), k.two),
+            );
+            let bound_a = bound_simd(simd, k, &ext, &splat3(simd, am), tiny);
+            let bound_b = bound_simd(simd, k, &ext, &bm, tiny);
             // The block's corners against triangle i's plane, then i's corners against the
             // block's planes.
-            let (sep_a, cert_a) =
-                separated_simd(simd, k, &pc[0], &splat3(simd, an), &splat3(simd, am), &bc);
-            let (sep_b, cert_b) = separated_simd(simd, k, &bc[0], &bn, &bm, &pc);
+            let (sep_a, cert_a) = separated_simd(simd, k, &pc[0], &splat3(simd, an), bound_a, &bc);
+            let (sep_b, cert_b) = separated_simd(simd, k, &bc[0], &bn, bound_b, &pc);
             bits &= !u64::from(mask_bits(simd, simd.or_m32s(sep_a, sep_b)));
             let decidable = bits & u64::from(mask_bits(simd, simd.and_m32s(cert_a, cert_b)));
             // `contact` holds the decidable candidates until the decision pass.
@@ -669,22 +743,51 @@ fn decide<S: Simd>(
     }
 }
 
-/// The lane-wise [`separated`]: (the three points `d` all certainly strictly on one side of
-/// the plane `(a, n, m)`, all three signs certified).
+/// The lane-wise [`pair_bound`], its absolute term `tiny` given.
+#[inline(always)]
+fn bound_simd<S: Simd>(
+    simd: S,
+    k: Consts<S>,
+    ext: &[S::f32s; 3],
+    m: &[S::f32s; 3],
+    tiny: S::f32s,
+) -> S::f32s {
+    let p = simd.add_f32s(
+        simd.add_f32s(simd.mul_f32s(ext[0], m[0]), simd.mul_f32s(ext[1], m[1])),
+        simd.mul_f32s(ext[2], m[2]),
+    );
+    simd.add_f32s(simd.mul_f32s(k.err, p), tiny)
+}
+
+/// The lane-wise [`sides_within`] folded: (the three points `d` all certainly strictly on
+/// one side of the plane `(a, n)`, all three signs certified), with the pair's `bound`.
 #[inline(always)]
 fn separated_simd<S: Simd>(
     simd: S,
     k: Consts<S>,
     a: &[S::f32s; 3],
     n: &[S::f32s; 3],
-    m: &[S::f32s; 3],
+    bound: S::f32s,
     d: &[[S::f32s; 3]; 3],
 ) -> (S::m32s, S::m32s) {
+    let neg_bound = simd.sub_f32s(k.zero, bound);
     let mut pos = k.all;
     let mut neg = pos;
     let mut certified = pos;
     for p in d {
-        let (sp, sn) = side_simd(simd, k, a, n, m, p);
+        let e = [
+            simd.sub_f32s(p[0], a[0]),
+            simd.sub_f32s(p[1], a[1]),
+            simd.sub_f32s(p[2], a[2]),
+        ];
+        let s = simd.add_f32s(
+            simd.add_f32s(simd.mul_f32s(e[0], n[0]), simd.mul_f32s(e[1], n[1])),
+            simd.mul_f32s(e[2], n[2]),
+        );
+        let (sp, sn) = (
+            simd.greater_than_f32s(s, bound),
+            simd.less_than_f32s(s, neg_bound),
+        );
         pos = simd.and_m32s(pos, sp);
         neg = simd.and_m32s(neg, sn);
         certified = simd.and_m32s(certified, simd.or_m32s(sp, sn));
