@@ -536,8 +536,12 @@ impl<S: Simd> Consts<S> {
 /// Two passes: the filter (boxes, shared vertices, separating planes) leaves the candidates
 /// in `undecided`, then the canonical form decides the candidates it can certify.
 ///
-/// PERF: the second block is loaded one vector of lanes at a time, with its planes, and
-/// every triangle of the first block is tested against it from registers; the shared-vertex
+/// PERF: first each block's union box against the other block's triangles: only the rows
+/// and lane vectors that meet it are visited (leaves whose volumes overlap but whose
+/// triangles are far apart, the norm with spheres, cost two union boxes; measured 1.1-1.3x on
+/// DH and sphere steps, 18-22% fewer instructions). The second block is loaded one vector of
+/// lanes at a time, with its planes, and every remaining triangle of the first block is
+/// tested against it from registers; the shared-vertex
 /// mask only for rows with a box hit, the plane filter only for rows with a pair left after
 /// both (most rows of neighbouring leaves have no hit: the mask was 15% of a cloth step when
 /// every row built it to count `N_P`). The decision is a second pass over the rows with
@@ -584,10 +588,25 @@ fn filter<S: Simd>(
     out: &mut [Row],
 ) -> bool {
     let mut any = 0;
+    // Rows of A that meet B's union box, lanes of B that meet A's: the others cannot meet
+    // anything across (one block with itself: all of them do).
+    let (rows, lanes) = if pairing == Pairing::NoSharedVertexUpper {
+        (low_bits(na), low_bits(nb))
+    } else {
+        let (ua, ub) = (union_box(simd, fa, na), union_box(simd, fb, nb));
+        (meet(simd, fa, na, &ub), meet(simd, fb, nb, &ua))
+    };
+    if rows == 0 || lanes == 0 {
+        return false;
+    }
     let mut base = 0;
     while base < nb {
         let end = (base + S::F32_LANES).min(len);
-        let lanes_valid = low_bits((nb - base).min(S::F32_LANES));
+        let lanes_valid = (lanes >> base) & low_bits((nb - base).min(S::F32_LANES));
+        if lanes_valid == 0 {
+            base += S::F32_LANES;
+            continue;
+        }
         let mut blo = [k.zero; 3];
         let mut bhi = [k.zero; 3];
         let mut bc = [[k.zero; 3]; 3];
@@ -608,7 +627,10 @@ fn filter<S: Simd>(
                 load_prefix_u32(simd, &fb.vertex[2][base..end]),
             ])
         };
-        for i in 0..na {
+        let mut todo = rows;
+        while todo != 0 {
+            let i = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
             let mut valid = lanes_valid;
             if pairing == Pairing::NoSharedVertexUpper {
                 // Only j > i.
@@ -686,6 +708,82 @@ fn filter<S: Simd>(
         base += S::F32_LANES;
     }
     any != 0
+}
+
+/// The union of the closed boxes of the first `n` triangles of `f` (NaN bounds skipped;
+/// empty: `+inf..-inf`).
+#[inline(always)]
+fn union_box<S: Simd>(simd: S, f: &Fields, n: usize) -> ([f32; 3], [f32; 3]) {
+    let lanes = S::F32_LANES;
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    if n < lanes {
+        for t in 0..n {
+            for d in 0..3 {
+                // Comparisons, not `min`: a NaN bound is skipped on every backend.
+                if f.lo[d][t] < lo[d] {
+                    lo[d] = f.lo[d][t];
+                }
+                if f.hi[d][t] > hi[d] {
+                    hi[d] = f.hi[d][t];
+                }
+            }
+        }
+        return (lo, hi);
+    }
+    for d in 0..3 {
+        let (mut vlo, mut vhi) = (simd.splat_f32s(lo[d]), simd.splat_f32s(hi[d]));
+        // Whole vectors, the last one ending at `n` (overlapping is harmless here).
+        let mut start = 0;
+        loop {
+            let x = crate::lanes::load::<S>(&f.lo[d][start..]);
+            vlo = simd.select_f32s(simd.less_than_f32s(x, vlo), x, vlo);
+            let x = crate::lanes::load::<S>(&f.hi[d][start..]);
+            vhi = simd.select_f32s(simd.greater_than_f32s(x, vhi), x, vhi);
+            if start + lanes == n {
+                break;
+            }
+            start = (start + lanes).min(n - lanes);
+        }
+        lo[d] = simd.reduce_min_f32s(vlo);
+        hi[d] = simd.reduce_max_f32s(vhi);
+    }
+    (lo, hi)
+}
+
+/// The triangles among the first `n` of `f` whose closed boxes meet the box `u`, as bits.
+#[inline(always)]
+fn meet<S: Simd>(simd: S, f: &Fields, n: usize, u: &([f32; 3], [f32; 3])) -> u64 {
+    let mut bits = 0;
+    let mut base = 0;
+    while base < n {
+        let end = (base + S::F32_LANES).min(n);
+        let mut m = simd.less_than_or_equal_f32s(
+            load_prefix(simd, &f.lo[0][base..end]),
+            simd.splat_f32s(u.1[0]),
+        );
+        for d in 0..3 {
+            if d > 0 {
+                m = simd.and_m32s(
+                    m,
+                    simd.less_than_or_equal_f32s(
+                        load_prefix(simd, &f.lo[d][base..end]),
+                        simd.splat_f32s(u.1[d]),
+                    ),
+                );
+            }
+            m = simd.and_m32s(
+                m,
+                simd.less_than_or_equal_f32s(
+                    simd.splat_f32s(u.0[d]),
+                    load_prefix(simd, &f.hi[d][base..end]),
+                ),
+            );
+        }
+        bits |= u64::from(mask_bits(simd, m)) << base;
+        base += S::F32_LANES;
+    }
+    bits & low_bits(n)
 }
 
 /// The decision pass of [`leaf_contacts_with`]: moves the candidates the canonical form

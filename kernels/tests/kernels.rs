@@ -433,6 +433,11 @@ impl Tris {
         narrow::TriSoa::new(Tile::new(&self.tile, self.stride), &self.vertex)
     }
     /// Sets corner `c`'s index of triangle `t`.
+    /// Overwrites bound field `f` (9..15: min x, y, z, max x, y, z) of triangle `t`.
+    fn set_bound(&mut self, f: usize, t: usize, v: f32) {
+        self.tile[f * self.stride + t] = v;
+    }
+
     fn set_vertex(&mut self, c: usize, t: usize, v: u32) {
         self.vertex[c * self.stride + t] = v;
     }
@@ -624,6 +629,49 @@ fn leaf_contacts_filter_a_strip() {
         },
         "touching neighbour 1 undecided, far ones dropped by the boxes"
     );
+}
+
+/// The leaf-level prefilter (each block's union box against the other's triangles) must
+/// not lose a pair: one triangle of a block with a NaN or infinite bound, or far away,
+/// never hides its neighbours' hits, on every backend and block size.
+fn check_union_boxes<S: Simd>(simd: S) {
+    // Vertical triangles crossing the plane z = 0 inside the base triangle.
+    let base = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+    let post = |x: f32| [[x, 0.5, -1.0], [x, 0.5, 1.0], [x + 0.1, 0.7, 1.0]];
+    for n in block_sizes(S::F32_LANES, narrow::MAX_ROW)
+        .into_iter()
+        .filter(|&n| n > 1)
+    {
+        for odd in 0..n {
+            for (f, v) in [
+                (9, f32::NAN),
+                (12, f32::NAN),
+                (10, f32::NEG_INFINITY),
+                (13, 1e30),
+            ] {
+                let posts: Vec<_> = (0..n).map(|t| post(0.5 + 0.02 * t as f32)).collect();
+                let mut b = Tris::new(&posts, 100);
+                b.set_bound(f, odd, v);
+                let a = Tris::new(&[base], 0);
+                for (x, nx, y, ny) in [(&a, 1, &b, n), (&b, n, &a, 1)] {
+                    let mut got = vec![narrow::Row::default(); nx];
+                    let mut want = got.clone();
+                    let pairing = narrow::Pairing::All;
+                    narrow::leaf_contacts_with(simd, x.soa(), nx, y.soa(), ny, pairing, &mut got);
+                    narrow::leaf_contacts_scalar(x.soa(), nx, y.soa(), ny, pairing, &mut want);
+                    assert_eq!(got, want, "{simd:?} n={n} odd={odd} field {f}");
+                    let hits: u32 = got.iter().map(|r| r.candidates().count_ones()).sum();
+                    let lost = u32::from(v.is_nan());
+                    assert_eq!(hits, n as u32 - lost, "{simd:?} n={n} odd={odd} field {f}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn union_boxes_lose_no_pair_on_all_backends() {
+    on_all_backends!(check_union_boxes);
 }
 
 /// The canonical form's three outcomes on pairs whose six corner-plane signs are certified,
