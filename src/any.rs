@@ -11,7 +11,8 @@ use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
 use crate::mesh::Mesh;
 use crate::par::Par;
 use crate::traverse::{
-    broad_phase, collide_with, narrow_phase, self_collide_with, Contacts, Workspace,
+    broad_phase, collide_with, narrow_phase, self_broad_phase, self_collide_with, Contacts,
+    Workspace,
 };
 use crate::tree::RegionTree;
 
@@ -141,6 +142,12 @@ impl AnyHierarchy {
         par: Par,
     ) -> Result<Counters> {
         pairwise!(self, other, a, b => broad_phase(a, b, ws, par))
+    }
+
+    /// [`self_broad_phase`] of this object: refit and traversal down to the overlapping
+    /// leaf pairs (left in `ws`), no triangle tested.
+    pub fn self_broad_phase(&mut self, ws: &mut Workspace, par: Par) -> Counters {
+        each!(self, h => self_broad_phase(h, ws, par))
     }
 
     /// [`narrow_phase`] on leaf pairs of two hierarchies of the same kind; an error if the

@@ -53,7 +53,7 @@ pub use par::Par;
 pub use scene::{ObjectId, Scene, SceneContacts};
 
 pub use traverse::{
-    broad_phase, collide, collide_with, narrow_phase, self_collide, self_collide_with, Contacts,
-    Workspace,
+    broad_phase, collide, collide_with, narrow_phase, self_broad_phase, self_collide,
+    self_collide_with, Contacts, Workspace,
 };
 pub use tree::RegionTree;

@@ -30,7 +30,7 @@ use crate::bv::BvKind;
 use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
-use crate::narrow::leaves::{leaf_pair, LeafSide, Leaves};
+use crate::narrow::leaves::{counted_pairs, leaf_pair, LeafSide, Leaves};
 use crate::par::Par;
 use dhcd_kernels::narrow::{Row, MAX_ROW};
 
@@ -177,7 +177,50 @@ pub fn broad_phase<K: BvKind>(
     let prim_tests = ws
         .leaves
         .iter()
-        .map(|&[x, y]| (ta.tri_range(x as usize).len() * tb.tri_range(y as usize).len()) as u64)
+        .map(|&[x, y]| {
+            let (na, nb) = (
+                ta.tri_range(x as usize).len(),
+                tb.tri_range(y as usize).len(),
+            );
+            counted_pairs(na, nb, Leaves::Objects, 0)
+        })
+        .sum();
+    Counters {
+        bv_updates: c.counters.bv_updates + updates,
+        prim_tests,
+        ..c.counters
+    }
+}
+
+/// [`broad_phase`] of one object against itself: the lazy refit and traversal of
+/// [`self_collide_with`] down to the overlapping leaf pairs (`[x, y]`, `x <= y`, a leaf with
+/// itself included), left in `ws`; no triangle is tested. Its counters have `bv_tests`,
+/// `bv_updates` and `prim_tests` (the triangle pairs the narrow phase would test: allowed
+/// pairs minus the vertex-sharing ones) as [`self_collide_with`] counts them; `contacts` is
+/// 0. What a self query costs besides its narrow phase (`dhcd bench --broad-only`).
+pub fn self_broad_phase<K: BvKind>(h: &mut Hierarchy<K>, ws: &mut Workspace, par: Par) -> Counters {
+    let updates = h.take_updates();
+    let walk = Walk {
+        a: h,
+        b: h,
+        self_query: true,
+        narrow: false,
+    };
+    let c = par.install(|| walk.run(ws, par.is_parallel()));
+    let tree = h.tree();
+    let prim_tests = ws
+        .leaves
+        .iter()
+        .map(|&[x, y]| {
+            let (x, y) = (x as usize, y as usize);
+            let leaves = if x == y {
+                Leaves::SelfSame
+            } else {
+                Leaves::SelfDistinct
+            };
+            let (na, nb) = (tree.tri_range(x).len(), tree.tri_range(y).len());
+            counted_pairs(na, nb, leaves, tree.shared_pairs_of_leaves(x, y))
+        })
         .sum();
     Counters {
         bv_updates: c.counters.bv_updates + updates,

@@ -212,3 +212,52 @@ fn any_hierarchy_self_collide_matches_generic() {
         assert_eq!(c.pairs, expected, "{method}");
     }
 }
+
+/// The self broad phase is the self query without its triangle tests: the same node tests,
+/// refits and counted triangle pairs, no contacts, leaf pairs `[x, y]` with `x <= y` (a leaf
+/// with itself included), the same for every thread count.
+fn self_broad_phase_matches_query_for<K: BvKind>() {
+    let (rest, _) = folded_grid(12, 0.0, 0.0);
+    let mut found_pairs = false;
+    for step in 0..3 {
+        let (_, posed) = folded_grid(12, step as f32, 0.05);
+        let mut whole = Hierarchy::<K>::new(&rest, Options::default()).unwrap();
+        whole.update_positions(&posed).unwrap();
+        let want = self_collide(&mut whole).counters;
+        let mut first: Option<Vec<[u32; 2]>> = None;
+        for par in [Par::Seq, Par::Rayon(2), Par::Rayon(3)] {
+            let mut h = Hierarchy::<K>::new(&rest, Options::default()).unwrap();
+            h.update_positions(&posed).unwrap();
+            let mut ws = Workspace::default();
+            let got = dhcd::self_broad_phase(&mut h, &mut ws, par);
+            assert_eq!(got.bv_tests, want.bv_tests, "{:?} {par:?}", K::METHOD);
+            assert_eq!(got.bv_updates, want.bv_updates, "{:?} {par:?}", K::METHOD);
+            assert_eq!(got.prim_tests, want.prim_tests, "{:?} {par:?}", K::METHOD);
+            assert_eq!(got.contacts, 0);
+            // Sequential runs list them in walk order, parallel ones sorted.
+            let mut leaves = ws.leaf_pairs().to_vec();
+            leaves.sort_unstable();
+            let tree = h.tree();
+            assert!(leaves
+                .iter()
+                .all(|&[x, y]| x <= y && tree.is_leaf(x as usize) && tree.is_leaf(y as usize)));
+            found_pairs |= leaves.iter().any(|&[x, y]| x != y);
+            h.validate().unwrap();
+            match &first {
+                None => first = Some(leaves),
+                Some(f) => assert_eq!(&leaves, f, "{:?} {par:?}", K::METHOD),
+            }
+        }
+    }
+    assert!(
+        found_pairs,
+        "the folded grid has distinct overlapping leaves"
+    );
+}
+
+#[test]
+fn self_broad_phase_matches_query() {
+    self_broad_phase_matches_query_for::<Dh>();
+    self_broad_phase_matches_query_for::<Sphere>();
+    self_broad_phase_matches_query_for::<Aabb>();
+}

@@ -150,6 +150,54 @@ fn collide_bench_finds_each_frames_contacts_and_cycles_the_shorter_list() {
     assert_eq!(frame_contacts(&run, "aabb", 1, 4), expected);
 }
 
+/// `--broad-only` times the query without its triangle tests: the same node tests, refits
+/// and counted triangle pairs as the full step, no contacts; for self and two-object benches.
+#[test]
+fn broad_only_counts_what_the_full_step_counts_without_contacts() {
+    let dir = temp_dir("bench-broad");
+    let frames = crossing_sheets(&dir, 3);
+    let (moving, fixed) = passing_sphere(&dir, 3);
+    let fixed = fixed.to_str().unwrap();
+    let mut self_args = vec!["bench", "self"];
+    self_args.extend(strs(&frames));
+    let mut collide_args = vec!["bench", "collide", "--a"];
+    collide_args.extend(strs(&moving));
+    collide_args.extend(["--b", fixed]);
+    for base in [self_args, collide_args] {
+        let mut full = base.clone();
+        full.extend(["--method", "all", "--repeat", "1", "--json"]);
+        let mut broad = full.clone();
+        broad.push("--broad-only");
+        let (full, broad) = (json_of(&full), json_of(&broad));
+        let mut some_contacts = false;
+        for (f, b) in full
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(broad.as_array().unwrap())
+        {
+            assert_eq!(f["broad_only"], false);
+            assert_eq!(b["broad_only"], true);
+            for (ff, bf) in f["frames"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .zip(b["frames"].as_array().unwrap())
+            {
+                some_contacts |= ff["contacts"].as_u64().unwrap() > 0;
+                assert_eq!(bf["contacts"], 0, "{b}");
+                for k in ["bv_tests", "prim_tests", "bv_updates"] {
+                    assert_eq!(bf["counters"][k], ff["counters"][k], "{k}: {f} {b}");
+                }
+            }
+        }
+        assert!(some_contacts, "{full}");
+    }
+    let out = dhcd(&["bench", "self", frames[0].to_str().unwrap(), "--broad-only"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("(broad phase only)"), "{text}");
+}
+
 #[test]
 fn text_output_names_the_build_and_step_times_and_every_frame() {
     let dir = temp_dir("bench-text");

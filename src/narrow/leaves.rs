@@ -47,15 +47,15 @@ pub(crate) fn leaf_pair<S: Simd>(
     out: &mut Vec<[u32; 2]>,
 ) -> u64 {
     let (na, nb) = (a.tris.len, b.tris.len);
-    let (pairing, allowed) = match leaves {
-        Leaves::Objects => (Pairing::All, na * nb),
+    let pairing = match leaves {
+        Leaves::Objects => Pairing::All,
         // No shared vertex: the kernel skips the shared-vertex mask.
-        Leaves::SelfDistinct if shared == 0 => (Pairing::All, na * nb),
-        Leaves::SelfDistinct => (Pairing::NoSharedVertex, na * nb),
-        Leaves::SelfSame => (Pairing::NoSharedVertexUpper, na * na.saturating_sub(1) / 2),
+        Leaves::SelfDistinct if shared == 0 => Pairing::All,
+        Leaves::SelfDistinct => Pairing::NoSharedVertex,
+        Leaves::SelfSame => Pairing::NoSharedVertexUpper,
     };
     let ordered = leaves != Leaves::Objects;
-    let counted = allowed as u64 - shared;
+    let counted = counted_pairs(na, nb, leaves, shared);
     if na <= MAX_ROW && nb <= MAX_ROW {
         // Adaptive trees: one block per leaf.
         blocks(simd, a, 0, na, b, 0, nb, pairing, ordered, rows, out);
@@ -75,6 +75,18 @@ pub(crate) fn leaf_pair<S: Simd>(
         }
     }
     counted
+}
+
+/// The triangle pairs of a leaf pair of `na` and `nb` triangles that `N_P` counts: every
+/// pair, minus the `shared` ones sharing a vertex for a self query (one leaf with itself:
+/// each unordered pair once).
+#[inline(always)]
+pub(crate) fn counted_pairs(na: usize, nb: usize, leaves: Leaves, shared: u64) -> u64 {
+    let allowed = match leaves {
+        Leaves::Objects | Leaves::SelfDistinct => na * nb,
+        Leaves::SelfSame => na * na.saturating_sub(1) / 2,
+    };
+    allowed as u64 - shared
 }
 
 /// Triangles `a0..a0 + na` of `a` against `b0..b0 + nb` of `b` (`nb <= MAX_ROW`); contacts

@@ -66,6 +66,11 @@ struct Opts {
     /// Threads of each query (1: the calling thread). Results do not depend on it.
     #[arg(long, default_value_t = 1)]
     threads: usize,
+    /// Time the broad phase alone: update, lazy refit and traversal down to the overlapping
+    /// leaf pairs, no triangle tested (contacts are 0; the triangle pairs counted are those
+    /// the narrow phase would test). A full step's time minus this one is the narrow phase's.
+    #[arg(long)]
+    broad_only: bool,
     /// Passes over the frames (each pass times one step per frame).
     #[arg(long, default_value_t = 5)]
     repeat: usize,
@@ -134,16 +139,21 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
                 let t = Instant::now();
                 ha.update_positions(a[k % a.len()].positions())
                     .map_err(|e| e.to_string())?;
-                let c = match (&mut hb, &b) {
+                *counters = match (&mut hb, &b) {
                     (Some(hb), Some(b)) => {
                         hb.update_positions(b[k % b.len()].positions())
                             .map_err(|e| e.to_string())?;
-                        ha.collide(hb, &mut ws, par).map_err(|e| e.to_string())?
+                        if opts.broad_only {
+                            ha.broad_phase(hb, &mut ws, par)
+                        } else {
+                            ha.collide(hb, &mut ws, par).map(|c| c.counters)
+                        }
+                        .map_err(|e| e.to_string())?
                     }
-                    _ => ha.self_collide(&mut ws, par),
+                    _ if opts.broad_only => ha.self_broad_phase(&mut ws, par),
+                    _ => ha.self_collide(&mut ws, par).counters,
                 };
                 steps_ms.push(t.elapsed().as_secs_f64() * 1e3);
-                *counters = c.counters;
             }
         }
         runs.push(Run {
@@ -154,7 +164,10 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         });
     }
     let out = if opts.json {
-        let values: Vec<serde_json::Value> = runs.iter().map(|r| to_json(r, threads)).collect();
+        let values: Vec<serde_json::Value> = runs
+            .iter()
+            .map(|r| to_json(r, threads, opts.broad_only))
+            .collect();
         let v = if methods.len() == 1 {
             values.into_iter().next().unwrap_or_default()
         } else {
@@ -162,7 +175,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         };
         format!("{v}\n")
     } else {
-        text(&runs, opts.repeat, threads, &a, b.as_deref())
+        text(&runs, opts, threads, &a, b.as_deref())
     };
     super::emit(&out).map_err(|e| e.to_string())
 }
@@ -202,13 +215,14 @@ fn counters_json(c: &Counters) -> serde_json::Value {
     })
 }
 
-/// `{"method", "threads", "build_ms", "step_ms": {"median", "min"}, "frames": [{"contacts",
-/// "counters"}...]}`.
-fn to_json(r: &Run, threads: usize) -> serde_json::Value {
+/// `{"method", "threads", "broad_only", "build_ms", "step_ms": {"median", "min"}, "frames":
+/// [{"contacts", "counters"}...]}`.
+fn to_json(r: &Run, threads: usize, broad_only: bool) -> serde_json::Value {
     let (median, min) = median_min(&r.steps_ms);
     json!({
         "method": r.method.name(),
         "threads": threads,
+        "broad_only": broad_only,
         "build_ms": r.build_ms,
         "step_ms": { "median": median, "min": min },
         "frames": r.frames.iter().map(|c| json!({
@@ -218,7 +232,7 @@ fn to_json(r: &Run, threads: usize) -> serde_json::Value {
     })
 }
 
-fn text(runs: &[Run], repeat: usize, threads: usize, a: &[Mesh], b: Option<&[Mesh]>) -> String {
+fn text(runs: &[Run], opts: &Opts, threads: usize, a: &[Mesh], b: Option<&[Mesh]>) -> String {
     use std::fmt::Write;
     let mut s = String::new();
     let what = match b {
@@ -231,9 +245,14 @@ fn text(runs: &[Run], repeat: usize, threads: usize, a: &[Mesh], b: Option<&[Mes
     };
     let _ = writeln!(
         s,
-        "{what}, {} steps per pass, {} passes, {} thread(s)",
+        "{what}{}, {} steps per pass, {} passes, {} thread(s)",
+        if opts.broad_only {
+            " (broad phase only)"
+        } else {
+            ""
+        },
         runs.first().map_or(0, |r| r.frames.len()),
-        repeat,
+        opts.repeat,
         threads
     );
     for r in runs {
