@@ -166,30 +166,13 @@ pub fn broad_phase<K: BvKind>(
     par: Par,
 ) -> Counters {
     let updates = a.take_updates() + b.take_updates();
-    let walk = Walk {
+    Walk {
         a,
         b,
         self_query: false,
         narrow: false,
-    };
-    let c = par.install(|| walk.run(ws, par.is_parallel()));
-    let (ta, tb) = (a.tree(), b.tree());
-    let prim_tests = ws
-        .leaves
-        .iter()
-        .map(|&[x, y]| {
-            let (na, nb) = (
-                ta.tri_range(x as usize).len(),
-                tb.tri_range(y as usize).len(),
-            );
-            counted_pairs(na, nb, Leaves::Objects, 0)
-        })
-        .sum();
-    Counters {
-        bv_updates: c.counters.bv_updates + updates,
-        prim_tests,
-        ..c.counters
     }
+    .broad(ws, par, updates)
 }
 
 /// [`broad_phase`] of one object against itself: the lazy refit and traversal of
@@ -200,33 +183,13 @@ pub fn broad_phase<K: BvKind>(
 /// 0. What a self query costs besides its narrow phase (`dhcd bench --broad-only`).
 pub fn self_broad_phase<K: BvKind>(h: &mut Hierarchy<K>, ws: &mut Workspace, par: Par) -> Counters {
     let updates = h.take_updates();
-    let walk = Walk {
+    Walk {
         a: h,
         b: h,
         self_query: true,
         narrow: false,
-    };
-    let c = par.install(|| walk.run(ws, par.is_parallel()));
-    let tree = h.tree();
-    let prim_tests = ws
-        .leaves
-        .iter()
-        .map(|&[x, y]| {
-            let (x, y) = (x as usize, y as usize);
-            let leaves = if x == y {
-                Leaves::SelfSame
-            } else {
-                Leaves::SelfDistinct
-            };
-            let (na, nb) = (tree.tri_range(x).len(), tree.tri_range(y).len());
-            counted_pairs(na, nb, leaves, tree.shared_pairs_of_leaves(x, y))
-        })
-        .sum();
-    Counters {
-        bv_updates: c.counters.bv_updates + updates,
-        prim_tests,
-        ..c.counters
     }
+    .broad(ws, par, updates)
 }
 
 /// The narrow phase alone: exact tests of every triangle pair of the given leaf pairs (node
@@ -502,15 +465,7 @@ impl<'h, K: BvKind> Walk<'h, K> {
                 }
             }
         }
-        let leaves = match (self.self_query, x == y) {
-            (false, _) => Leaves::Objects,
-            (true, false) => Leaves::SelfDistinct,
-            (true, true) => Leaves::SelfSame,
-        };
-        let shared = match leaves {
-            Leaves::Objects => 0,
-            _ => self.a.tree().shared_pairs_of_leaves(x, y),
-        };
+        let (leaves, shared) = self.leaf_pair_kind(x, y);
         let [la, lb] = &mut out.last;
         let (sa, sb) = (side(self.a, x, la), side(self.b, y, lb));
         out.counters.prim_tests += leaf_pair(
@@ -522,6 +477,44 @@ impl<'h, K: BvKind> Walk<'h, K> {
             &mut out.rows,
             &mut out.pairs,
         );
+    }
+
+    /// Which pairs of leaf pair `(x, y)` are tested, and how many of them share a vertex.
+    #[inline(always)]
+    fn leaf_pair_kind(&self, x: usize, y: usize) -> (Leaves, u64) {
+        let leaves = match (self.self_query, x == y) {
+            (false, _) => Leaves::Objects,
+            (true, false) => Leaves::SelfDistinct,
+            (true, true) => Leaves::SelfSame,
+        };
+        let shared = match leaves {
+            Leaves::Objects => 0,
+            _ => self.a.tree().shared_pairs_of_leaves(x, y),
+        };
+        (leaves, shared)
+    }
+
+    /// The broad phase of this walk (`narrow` off): the walk's counters, with `updates` from
+    /// outside the query and `prim_tests` as the narrow phase would count the collected leaf
+    /// pairs.
+    fn broad(&self, ws: &mut Workspace, par: Par, updates: u64) -> Counters {
+        debug_assert!(!self.narrow);
+        let c = par.install(|| self.run(ws, par.is_parallel()));
+        let (ta, tb) = (self.a.tree(), self.b.tree());
+        let prim_tests = ws
+            .leaves
+            .iter()
+            .map(|&[x, y]| {
+                let (x, y) = (x as usize, y as usize);
+                let (leaves, shared) = self.leaf_pair_kind(x, y);
+                counted_pairs(ta.tri_range(x).len(), tb.tri_range(y).len(), leaves, shared)
+            })
+            .sum();
+        Counters {
+            bv_updates: c.counters.bv_updates + updates,
+            prim_tests,
+            ..c.counters
+        }
     }
 
     /// Depth-first from each of `seeds`.

@@ -224,8 +224,7 @@ fn plane(t: &[[f32; 3]; 3]) -> ([f32; 3], [f32; 3]) {
 /// certainly positive, `-1` certainly negative, `0` unknown (or on the plane).
 #[inline(always)]
 fn side(a: &[f32; 3], n: &[f32; 3], m: &[f32; 3], d: &[f32; 3]) -> i32 {
-    let e = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
-    let s = e[0] * n[0] + e[1] * n[1] + e[2] * n[2];
+    let (e, s) = det(a, n, d);
     let p = e[0].abs() * m[0] + e[1].abs() * m[1] + e[2].abs() * m[2];
     let l = e[0].abs() + e[1].abs() + e[2].abs();
     let bound = PLANE_ERR * p + PLANE_TINY * (l + 2.0);
@@ -260,10 +259,17 @@ fn pair_bound(m: &[f32; 3], ext: &[f32; 3]) -> f32 {
 #[inline(always)]
 fn sides_within(a: &[f32; 3], n: &[f32; 3], bound: f32, d: &[[f32; 3]; 3]) -> [i32; 3] {
     d.map(|d| {
-        let e = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
-        let s = e[0] * n[0] + e[1] * n[1] + e[2] * n[2];
+        let s = det(a, n, &d).1;
         i32::from(s > bound) - i32::from(s < 0.0 - bound)
     })
+}
+
+/// `e = d - a` and the determinant `s = e . n` of the plane `(a, n)` (module doc), in the
+/// operation order every backend repeats.
+#[inline(always)]
+fn det(a: &[f32; 3], n: &[f32; 3], d: &[f32; 3]) -> ([f32; 3], f32) {
+    let e = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+    (e, e[0] * n[0] + e[1] * n[1] + e[2] * n[2])
 }
 
 /// The filter's signs of a pair: `a`'s corners against `b`'s plane, `b`'s against `a`'s,
@@ -895,15 +901,7 @@ fn separated_simd<S: Simd>(
     let mut neg = pos;
     let mut certified = pos;
     for p in d {
-        let e = [
-            simd.sub_f32s(p[0], a[0]),
-            simd.sub_f32s(p[1], a[1]),
-            simd.sub_f32s(p[2], a[2]),
-        ];
-        let s = simd.add_f32s(
-            simd.add_f32s(simd.mul_f32s(e[0], n[0]), simd.mul_f32s(e[1], n[1])),
-            simd.mul_f32s(e[2], n[2]),
-        );
+        let s = det_simd(simd, a, n, p).1;
         let (sp, sn) = (
             simd.greater_than_f32s(s, bound),
             simd.less_than_f32s(s, neg_bound),
@@ -913,6 +911,26 @@ fn separated_simd<S: Simd>(
         certified = simd.and_m32s(certified, simd.or_m32s(sp, sn));
     }
     (simd.or_m32s(pos, neg), certified)
+}
+
+/// The lane-wise [`det`].
+#[inline(always)]
+fn det_simd<S: Simd>(
+    simd: S,
+    a: &[S::f32s; 3],
+    n: &[S::f32s; 3],
+    d: &[S::f32s; 3],
+) -> ([S::f32s; 3], S::f32s) {
+    let e = [
+        simd.sub_f32s(d[0], a[0]),
+        simd.sub_f32s(d[1], a[1]),
+        simd.sub_f32s(d[2], a[2]),
+    ];
+    let s = simd.add_f32s(
+        simd.add_f32s(simd.mul_f32s(e[0], n[0]), simd.mul_f32s(e[1], n[1])),
+        simd.mul_f32s(e[2], n[2]),
+    );
+    (e, s)
 }
 
 /// The lane-wise [`plane`].
@@ -957,15 +975,7 @@ fn side_simd<S: Simd>(
     m: &[S::f32s; 3],
     d: &[S::f32s; 3],
 ) -> (S::m32s, S::m32s) {
-    let e = [
-        simd.sub_f32s(d[0], a[0]),
-        simd.sub_f32s(d[1], a[1]),
-        simd.sub_f32s(d[2], a[2]),
-    ];
-    let s = simd.add_f32s(
-        simd.add_f32s(simd.mul_f32s(e[0], n[0]), simd.mul_f32s(e[1], n[1])),
-        simd.mul_f32s(e[2], n[2]),
-    );
+    let (e, s) = det_simd(simd, a, n, d);
     let ae = [
         simd.abs_f32s(e[0]),
         simd.abs_f32s(e[1]),
