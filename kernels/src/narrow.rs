@@ -961,7 +961,15 @@ fn plane_simd<S: Simd>(simd: S, t: &[[S::f32s; 3]; 3]) -> ([S::f32s; 3], [S::f32
 
 #[inline(always)]
 fn abs_sum<S: Simd>(simd: S, a: S::f32s, b: S::f32s) -> S::f32s {
-    simd.add_f32s(simd.abs_f32s(a), simd.abs_f32s(b))
+    simd.add_f32s(abs_simd(simd, a), abs_simd(simd, b))
+}
+
+/// Lane-wise `|a|` (clears the sign bit). Not pulp's `abs_f32s`: that default method is only
+/// `#[inline]`, and in the AVX-512 kernels it was compiled out of line, without the target
+/// features, so every call went through memory and `vzeroupper` (~9% of an n-body step).
+#[inline(always)]
+fn abs_simd<S: Simd>(simd: S, a: S::f32s) -> S::f32s {
+    simd.and_f32s(a, simd.splat_f32s(f32::from_bits(0x7fff_ffff)))
 }
 
 /// The lane-wise [`side`] of one point `d` against the plane `(a, n, m)`: (certainly
@@ -977,9 +985,9 @@ fn side_simd<S: Simd>(
 ) -> (S::m32s, S::m32s) {
     let (e, s) = det_simd(simd, a, n, d);
     let ae = [
-        simd.abs_f32s(e[0]),
-        simd.abs_f32s(e[1]),
-        simd.abs_f32s(e[2]),
+        abs_simd(simd, e[0]),
+        abs_simd(simd, e[1]),
+        abs_simd(simd, e[2]),
     ];
     let perm = simd.add_f32s(
         simd.add_f32s(simd.mul_f32s(ae[0], m[0]), simd.mul_f32s(ae[1], m[1])),
