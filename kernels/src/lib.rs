@@ -64,30 +64,75 @@ pub fn f32_lanes() -> usize {
     arch().dispatch(F32Lanes)
 }
 
-/// Lane-width helpers shared by the kernels (no `unsafe`: pulp's vector types are `Pod` with
-/// the alignment of their element, so a slice of `F32_LANES` elements reinterprets in place).
+/// Lane-width helpers shared by the kernels. pulp's vector types are `Pod` with the alignment
+/// of their element, so a slice of `F32_LANES` elements reinterprets in place; the only
+/// `unsafe` is the x86 masked load of a short slice and the backend-token casts.
 pub(crate) mod lanes {
     use pulp::Simd;
 
-    /// Loads `v` (at most `S::F32_LANES` values; missing lanes are zero): one full load
-    /// when `v` fills a register, else pulp's partial load, which reads nothing past `v`.
+    /// Loads `v` (at most `S::F32_LANES` values; missing lanes are zero), reading nothing
+    /// past `v`: one full load when `v` fills a register, else one masked load on x86
+    /// ([`masked_load`]), else pulp's partial load.
     #[inline(always)]
     pub fn load_prefix<S: Simd>(simd: S, v: &[f32]) -> S::f32s {
         if v.len() == S::F32_LANES {
-            S::as_simd_f32s(v).0[0]
-        } else {
-            simd.partial_load_f32s(v)
+            return S::as_simd_f32s(v).0[0];
         }
+        #[cfg(target_arch = "x86_64")]
+        if let Some(x) = masked_load(simd, bytemuck::cast_slice(v)) {
+            return bytemuck::cast(x);
+        }
+        simd.partial_load_f32s(v)
     }
 
     /// [`load_prefix`] for `u32`.
     #[inline(always)]
     pub fn load_prefix_u32<S: Simd>(simd: S, v: &[u32]) -> S::u32s {
         if v.len() == S::U32_LANES {
-            S::as_simd_u32s(v).0[0]
-        } else {
-            simd.partial_load_u32s(v)
+            return S::as_simd_u32s(v).0[0];
         }
+        #[cfg(target_arch = "x86_64")]
+        if let Some(x) = masked_load(simd, v) {
+            return x;
+        }
+        simd.partial_load_u32s(v)
+    }
+
+    /// The `v.len() < S::U32_LANES` values of `v` and zeros above, in one masked load, when
+    /// `simd` is x86-v4 or x86-v3 (`None` on other backends).
+    ///
+    /// PERF: pulp's partial loads jump through a table to a stub per length: an indirect
+    /// branch per load, mispredicted whenever consecutive leaves or sibling groups differ in
+    /// length (the norm on adaptive trees), and every vector field of a short block is such a
+    /// load. A masked load costs about a plain load.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn masked_load<S: Simd>(simd: S, v: &[u32]) -> Option<S::u32s> {
+        use core::arch::x86_64::{__m256i, __m512i};
+        let n = v.len();
+        debug_assert!(n < S::U32_LANES);
+        if let Some(v4) = as_v4(simd) {
+            let k = ((1u32 << n) - 1) as u16;
+            // SAFETY: lane `i < n` reads `v[i]`; AVX-512 masked loads read nothing, and do not
+            // fault, in the masked-off lanes.
+            let x = unsafe { v4.avx512f._mm512_maskz_loadu_epi32(k, v.as_ptr().cast()) };
+            // SAFETY: `__m512i` and `u32x16` are 64 bytes of plain integers.
+            let x: pulp::u32x16 = unsafe { core::mem::transmute::<__m512i, pulp::u32x16>(x) };
+            return Some(bytemuck::cast(x));
+        }
+        if let Some(v3) = as_v3(simd) {
+            let iota = v3.avx._mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+            let mask = v3
+                .avx2
+                ._mm256_cmpgt_epi32(v3.avx._mm256_set1_epi32(n as i32), iota);
+            // SAFETY: lane `i < n` reads `v[i]`; AVX masked loads read nothing, and do not
+            // fault, in the lanes whose mask sign bit is clear.
+            let x = unsafe { v3.avx2._mm256_maskload_epi32(v.as_ptr().cast(), mask) };
+            // SAFETY: `__m256i` and `u32x8` are 32 bytes of plain integers.
+            let x: pulp::u32x8 = unsafe { core::mem::transmute::<__m256i, pulp::u32x8>(x) };
+            return Some(bytemuck::cast(x));
+        }
+        None
     }
 
     /// The lanes of a comparison mask as bits (lane `k` -> bit `k`). pulp's masks are either
@@ -130,6 +175,19 @@ pub(crate) mod lanes {
             // SAFETY: `S` is `V3`, a zero-sized token that exists only when the CPU has
             // x86-v3 (the caller holds one: `simd`).
             Some(unsafe { core::mem::transmute_copy::<S, pulp::x86::V3>(&simd) })
+        } else {
+            None
+        }
+    }
+
+    /// `simd` as pulp's x86-v4 token when that is its type.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn as_v4<S: Simd>(simd: S) -> Option<pulp::x86::V4> {
+        if core::any::TypeId::of::<S>() == core::any::TypeId::of::<pulp::x86::V4>() {
+            // SAFETY: `S` is `V4`, a zero-sized token that exists only when the CPU has
+            // x86-v4 (the caller holds one: `simd`).
+            Some(unsafe { core::mem::transmute_copy::<S, pulp::x86::V4>(&simd) })
         } else {
             None
         }
