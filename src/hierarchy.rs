@@ -213,25 +213,47 @@ impl TriCache {
         leaf: usize,
     ) -> LeafTris<'a> {
         let r = tree.leaf_rank(leaf).expect("a leaf");
-        let tris = tree.tri_range(leaf);
+        let len = tree.tri_range(leaf).len();
         let stride = tree.leaf_slots(r).len();
-        let (tile, _) = self.tiles.get_or_fill(r, |tile| {
-            for (i, t) in tris.clone().enumerate() {
-                let c = tree.triangles()[t].map(|v| p.get(v as usize));
-                for corner in 0..3 {
-                    for k in 0..3 {
-                        tile[(3 * corner + k) * stride + i] = c[corner][k];
-                    }
-                }
-                for k in 0..3 {
-                    tile[(9 + k) * stride + i] = c[0][k].min(c[1][k]).min(c[2][k]);
-                    tile[(12 + k) * stride + i] = c[0][k].max(c[1][k]).max(c[2][k]);
-                }
-            }
-        });
+        let vertices = tree.leaf_vertex_tile(r);
+        let (tile, _) = self
+            .tiles
+            .get_or_fill(r, |tile| fill_leaf_tile(tile, stride, len, vertices, p));
         LeafTris {
-            len: tris.len(),
-            soa: TriSoa::new(Tile::new(tile, stride), tree.leaf_vertex_tile(r)),
+            len,
+            soa: TriSoa::new(Tile::new(tile, stride), vertices),
+        }
+    }
+}
+
+/// Writes the tile of a leaf of `n` triangles (rows of `stride` slots): row `3c + k` holds
+/// axis `k` of corner `c`, rows 9-11 the boxes' minima, rows 12-14 their maxima. `vertices`
+/// is the leaf's vertex tile (corner `c` of triangle `i` at `c * stride + i`).
+///
+/// PERF: one gather loop per corner and axis, then the box rows from the corner rows. The
+/// per-triangle form (gather three points, write fifteen scattered entries) took ~190
+/// instructions a triangle and 10-13% of an n-body step.
+fn fill_leaf_tile(tile: &mut [f32], stride: usize, n: usize, vertices: &[u32], p: &Points) {
+    let (corners, boxes) = tile.split_at_mut(9 * stride);
+    let axes = [&p.x[..], &p.y[..], &p.z[..]];
+    for c in 0..3 {
+        let ids = &vertices[c * stride..][..n];
+        for (k, axis) in axes.iter().enumerate() {
+            let row = &mut corners[(3 * c + k) * stride..][..n];
+            for (x, &v) in row.iter_mut().zip(ids) {
+                *x = axis[v as usize];
+            }
+        }
+    }
+    let (lo, hi) = boxes.split_at_mut(3 * stride);
+    for k in 0..3 {
+        let corner = |c: usize| &corners[(3 * c + k) * stride..][..n];
+        let (a, b, c) = (corner(0), corner(1), corner(2));
+        let lo = &mut lo[k * stride..][..n];
+        let hi = &mut hi[k * stride..][..n];
+        for i in 0..n {
+            lo[i] = a[i].min(b[i]).min(c[i]);
+            hi[i] = a[i].max(b[i]).max(c[i]);
         }
     }
 }
