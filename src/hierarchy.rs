@@ -181,6 +181,8 @@ pub(crate) struct TriCache {
 
 /// Fields per triangle of the cache tiles.
 const TRI_FIELDS: usize = 15;
+/// Entries of a leaf's union box (min xyz, max xyz), after its tile.
+const BOX_FIELDS: usize = 6;
 
 /// The cached triangles of one leaf: the tile of its padded slots (its `len` triangles
 /// first, then padding up to a multiple of [`crate::tree::BLOCK`]).
@@ -193,14 +195,16 @@ pub(crate) struct LeafTris<'a> {
 
 impl TriCache {
     fn new(tree: &RegionTree) -> Self {
+        // Leaf `r`'s group: its tile, then its union box.
         let groups = (0..tree.leaf_count())
             .map(|r| {
                 let s = tree.leaf_slots(r);
-                TRI_FIELDS * s.start..TRI_FIELDS * s.end
+                TRI_FIELDS * s.start + BOX_FIELDS * r..TRI_FIELDS * s.end + BOX_FIELDS * (r + 1)
             })
             .collect();
+        let len = TRI_FIELDS * tree.tri_slot_count() + BOX_FIELDS * tree.leaf_count();
         Self {
-            tiles: LazyTiles::new(TRI_FIELDS * tree.tri_slot_count(), groups),
+            tiles: LazyTiles::new(len, groups),
         }
     }
 
@@ -216,24 +220,32 @@ impl TriCache {
         let len = tree.tri_range(leaf).len();
         let stride = tree.leaf_slots(r).len();
         let vertices = tree.leaf_vertex_tile(r);
-        let (tile, _) = self
+        let (group, _) = self
             .tiles
-            .get_or_fill(r, |tile| fill_leaf_tile(tile, stride, len, vertices, p));
+            .get_or_fill(r, |group| fill_leaf_tile(group, stride, len, vertices, p));
+        let (tile, union) = group.split_at(TRI_FIELDS * stride);
+        let union = (
+            [union[0], union[1], union[2]],
+            [union[3], union[4], union[5]],
+        );
         LeafTris {
             len,
-            soa: TriSoa::new(Tile::new(tile, stride), vertices),
+            soa: TriSoa::new(Tile::new(tile, stride), vertices).with_bounds(union),
         }
     }
 }
 
-/// Writes the tile of a leaf of `n` triangles (rows of `stride` slots): row `3c + k` holds
-/// axis `k` of corner `c`, rows 9-11 the boxes' minima, rows 12-14 their maxima. `vertices`
-/// is the leaf's vertex tile (corner `c` of triangle `i` at `c * stride + i`).
+/// Writes the group of a leaf of `n` triangles: its tile (rows of `stride` slots: row
+/// `3c + k` holds axis `k` of corner `c`, rows 9-11 the boxes' minima, rows 12-14 their
+/// maxima), then the union of the boxes (min xyz, max xyz), which the narrow kernel would
+/// otherwise compute for every leaf pair. `vertices` is the leaf's vertex tile (corner `c`
+/// of triangle `i` at `c * stride + i`).
 ///
 /// PERF: one gather loop per corner and axis, then the box rows from the corner rows. The
 /// per-triangle form (gather three points, write fifteen scattered entries) took ~190
 /// instructions a triangle and 10-13% of an n-body step.
-fn fill_leaf_tile(tile: &mut [f32], stride: usize, n: usize, vertices: &[u32], p: &Points) {
+fn fill_leaf_tile(group: &mut [f32], stride: usize, n: usize, vertices: &[u32], p: &Points) {
+    let (tile, union) = group.split_at_mut(TRI_FIELDS * stride);
     let (corners, boxes) = tile.split_at_mut(9 * stride);
     let axes = [&p.x[..], &p.y[..], &p.z[..]];
     for c in 0..3 {
@@ -255,7 +267,27 @@ fn fill_leaf_tile(tile: &mut [f32], stride: usize, n: usize, vertices: &[u32], p
             lo[i] = a[i].min(b[i]).min(c[i]);
             hi[i] = a[i].max(b[i]).max(c[i]);
         }
+        union[k] = fold8(lo, f32::INFINITY, f32::min);
+        union[3 + k] = fold8(hi, f32::NEG_INFINITY, f32::max);
     }
+}
+
+/// `v` folded with `f` (positions are finite, so `min`/`max` in any order give the same
+/// value) through eight independent accumulators: a single chain of `min`s waits on each
+/// one's latency, eight vectorize.
+#[inline(always)]
+fn fold8(v: &[f32], init: f32, f: impl Fn(f32, f32) -> f32) -> f32 {
+    let mut acc = [init; 8];
+    let mut chunks = v.chunks_exact(8);
+    for c in &mut chunks {
+        for l in 0..8 {
+            acc[l] = f(acc[l], c[l]);
+        }
+    }
+    for (a, &x) in acc.iter_mut().zip(chunks.remainder()) {
+        *a = f(*a, x);
+    }
+    acc.into_iter().fold(init, f)
 }
 
 impl<K: BvKind> Hierarchy<K> {

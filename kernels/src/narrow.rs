@@ -70,13 +70,18 @@ pub const PLANE_TINY: f32 = f32::MIN_POSITIVE;
 /// Triangles in structure-of-arrays form: a [`Tile`] of fifteen fields (coordinate `k` of
 /// corner `c` is field `3c + k`, then the closed box: min x, y, z, max x, y, z) and a tile of
 /// their three corner indices (used by the self pairings only), from entry `offset` on.
-/// Padding past the tested count is allowed.
+/// Padding past the tested count is allowed. Optionally a box known to hold every
+/// triangle's closed box ([`TriSoa::with_bounds`]), which spares the kernels computing it.
 #[derive(Clone, Copy, Debug)]
 pub struct TriSoa<'a> {
     tile: Tile<'a>,
     vertex: &'a [u32],
     offset: usize,
+    bounds: Option<Bounds>,
 }
+
+/// A box as `(min, max)` corners.
+pub type Bounds = ([f32; 3], [f32; 3]);
 
 impl<'a> TriSoa<'a> {
     /// Panics unless `tile` has 15 fields and `vertex` 3 fields of the same stride.
@@ -90,6 +95,21 @@ impl<'a> TriSoa<'a> {
             tile,
             vertex,
             offset: 0,
+            bounds: None,
+        }
+    }
+
+    /// The same triangles with `bounds`, a box that contains the closed box of every
+    /// triangle of the tile (a larger box is allowed: the kernels only use it to skip
+    /// triangles that cannot meet the other block, so a box too large costs work, never a
+    /// pair). A box that misses a triangle would lose its pairs: debug builds check it.
+    /// Callers that cache a leaf's triangles compute it once per leaf instead of once per
+    /// leaf pair.
+    #[inline]
+    pub fn with_bounds(self, bounds: Bounds) -> Self {
+        Self {
+            bounds: Some(bounds),
+            ..self
         }
     }
 
@@ -153,6 +173,7 @@ impl<'a> TriSoa<'a> {
                 &self.vertex[s + o..s + o + n],
                 &self.vertex[2 * s + o..2 * s + o + n],
             ],
+            bounds: self.bounds,
         }
     }
 
@@ -173,6 +194,8 @@ struct Fields<'a> {
     lo: [&'a [f32]; 3],
     hi: [&'a [f32]; 3],
     vertex: [&'a [u32]; 3],
+    /// [`TriSoa::with_bounds`].
+    bounds: Option<Bounds>,
 }
 
 impl Fields<'_> {
@@ -599,7 +622,7 @@ fn filter<S: Simd>(
     let (rows, lanes) = if pairing == Pairing::NoSharedVertexUpper {
         (low_bits(na), low_bits(nb))
     } else {
-        let (ua, ub) = (union_box(simd, fa, na), union_box(simd, fb, nb));
+        let (ua, ub) = (block_box(simd, fa, na), block_box(simd, fb, nb));
         (meet(simd, fa, na, &ub), meet(simd, fb, nb, &ua))
     };
     if rows == 0 || lanes == 0 {
@@ -743,6 +766,25 @@ fn load_corners<S: Simd>(simd: S, f: &Fields, base: usize, end: usize) -> [[S::f
         }
     }
     bc
+}
+
+/// A box containing the closed boxes of the first `n` triangles of `f`: the caller's
+/// [`TriSoa::with_bounds`] if given (checked in debug builds), else [`union_box`].
+#[inline(always)]
+fn block_box<S: Simd>(simd: S, f: &Fields, n: usize) -> Bounds {
+    match f.bounds {
+        Some(b) => {
+            debug_assert!(
+                {
+                    let u = union_box(simd, f, n);
+                    (0..3).all(|d| b.0[d] <= u.0[d] && u.1[d] <= b.1[d])
+                },
+                "TriSoa::with_bounds: the box misses a triangle"
+            );
+            b
+        }
+        None => union_box(simd, f, n),
+    }
 }
 
 /// The union of the closed boxes of the first `n` triangles of `f` (NaN bounds skipped;

@@ -674,6 +674,79 @@ fn union_boxes_lose_no_pair_on_all_backends() {
     on_all_backends!(check_union_boxes);
 }
 
+/// The union box of `tris`.
+fn union_of(tris: &[[[f32; 3]; 3]]) -> narrow::Bounds {
+    let mut u = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for c in tris.iter().flatten() {
+        for k in 0..3 {
+            u.0[k] = u.0[k].min(c[k]);
+            u.1[k] = u.1[k].max(c[k]);
+        }
+    }
+    u
+}
+
+/// Blocks of posts crossing a base triangle, some far away: given bounds (`with_bounds`, as a
+/// leaf cache passes them), exact or larger, give the verdicts of the kernel computing its
+/// own union boxes, on every backend and in both orders.
+fn check_given_bounds<S: Simd>(simd: S) {
+    let base = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+    let post = |x: f32| [[x, 0.5, -1.0], [x, 0.5, 1.0], [x + 0.1, 0.7, 1.0]];
+    for n in block_sizes(S::F32_LANES, narrow::MAX_ROW) {
+        // Every third post far beyond the base: the prefilter's business.
+        let posts: Vec<_> = (0..n)
+            .map(|t| {
+                post(if t % 3 == 2 {
+                    50.0 + t as f32
+                } else {
+                    0.5 + 0.02 * t as f32
+                })
+            })
+            .collect();
+        let (a, b) = (Tris::new(&[base], 0), Tris::new(&posts, 100));
+        let (ua, ub) = (union_of(&[base]), union_of(&posts));
+        let grow = |u: narrow::Bounds| (u.0.map(|x| x - 10.0), u.1.map(|x| x + 10.0));
+        for (x, nx, bx, y, ny, by) in [(&a, 1, ua, &b, n, ub), (&b, n, ub, &a, 1, ua)] {
+            let pairing = narrow::Pairing::All;
+            let mut want = vec![narrow::Row::default(); nx];
+            narrow::leaf_contacts_with(simd, x.soa(), nx, y.soa(), ny, pairing, &mut want);
+            let hits: u32 = want.iter().map(|r| r.candidates().count_ones()).sum();
+            assert_eq!(hits as usize, n - n / 3, "{simd:?} n={n}: the near posts");
+            for (gx, gy) in [(bx, by), (grow(bx), grow(by))] {
+                let mut got = vec![narrow::Row::default(); nx];
+                let (sx, sy) = (x.soa().with_bounds(gx), y.soa().with_bounds(gy));
+                narrow::leaf_contacts_with(simd, sx, nx, sy, ny, pairing, &mut got);
+                assert_eq!(got, want, "{simd:?} n={n}");
+            }
+        }
+    }
+}
+
+#[test]
+fn given_bounds_change_no_verdict_on_all_backends() {
+    on_all_backends!(check_given_bounds);
+}
+
+/// A box that misses a triangle would lose its pairs: debug builds refuse it.
+#[test]
+#[cfg_attr(not(debug_assertions), ignore = "the check is a debug assertion")]
+#[should_panic(expected = "the box misses a triangle")]
+fn given_bounds_that_miss_a_triangle_panic_in_debug_builds() {
+    let base = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+    let post = [[1.0, 0.5, -1.0], [1.0, 0.5, 1.0], [1.1, 0.7, 1.0]];
+    let (a, b) = (Tris::new(&[base], 0), Tris::new(&[post], 10));
+    let short = ([0.0; 3], [1.0; 3]);
+    let mut out = [narrow::Row::default(); 1];
+    narrow::leaf_contacts(
+        a.soa(),
+        1,
+        b.soa().with_bounds(short),
+        1,
+        narrow::Pairing::All,
+        &mut out,
+    );
+}
+
 /// The canonical form's three outcomes on pairs whose six corner-plane signs are certified,
 /// on every backend, in every rotation of both triangles (the lone vertices move) and both
 /// orders.
