@@ -10,7 +10,7 @@ use crate::points::Points;
 use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
 use dhcd_kernels::lazy::LazyTiles;
 use dhcd_kernels::narrow::TriSoa;
-use dhcd_kernels::Tile;
+use dhcd_kernels::{refit, Soa3, Tile};
 
 /// When bounding volumes follow a deformation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -267,27 +267,17 @@ fn fill_leaf_tile(group: &mut [f32], stride: usize, n: usize, vertices: &[u32], 
             lo[i] = a[i].min(b[i]).min(c[i]);
             hi[i] = a[i].max(b[i]).max(c[i]);
         }
-        union[k] = fold8(lo, f32::INFINITY, f32::min);
-        union[3 + k] = fold8(hi, f32::NEG_INFINITY, f32::max);
     }
+    // The union of the boxes: the minima's least, the maxima's greatest (the SIMD bounds
+    // reduction; a single `min` chain per axis waits on each one's latency).
+    union[..3].copy_from_slice(&refit::bounds(three_rows(lo, stride, n)).0);
+    union[3..].copy_from_slice(&refit::bounds(three_rows(hi, stride, n)).1);
 }
 
-/// `v` folded with `f` (positions are finite, so `min`/`max` in any order give the same
-/// value) through eight independent accumulators: a single chain of `min`s waits on each
-/// one's latency, eight vectorize.
-#[inline(always)]
-fn fold8(v: &[f32], init: f32, f: impl Fn(f32, f32) -> f32) -> f32 {
-    let mut acc = [init; 8];
-    let mut chunks = v.chunks_exact(8);
-    for c in &mut chunks {
-        for l in 0..8 {
-            acc[l] = f(acc[l], c[l]);
-        }
-    }
-    for (a, &x) in acc.iter_mut().zip(chunks.remainder()) {
-        *a = f(*a, x);
-    }
-    acc.into_iter().fold(init, f)
+/// The first `n` entries of three consecutive rows of `stride` slots, as x, y and z.
+fn three_rows(rows: &[f32], stride: usize, n: usize) -> Soa3<'_> {
+    let row = |k: usize| &rows[k * stride..][..n];
+    Soa3::new(row(0), row(1), row(2))
 }
 
 impl<K: BvKind> Hierarchy<K> {

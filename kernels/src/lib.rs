@@ -171,23 +171,23 @@ pub(crate) mod lanes {
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn as_v3<S: Simd>(simd: S) -> Option<pulp::x86::V3> {
-        if core::any::TypeId::of::<S>() == core::any::TypeId::of::<pulp::x86::V3>() {
-            // SAFETY: `S` is `V3`, a zero-sized token that exists only when the CPU has
-            // x86-v3 (the caller holds one: `simd`).
-            Some(unsafe { core::mem::transmute_copy::<S, pulp::x86::V3>(&simd) })
-        } else {
-            None
-        }
+        as_backend(simd)
     }
 
     /// `simd` as pulp's x86-v4 token when that is its type.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn as_v4<S: Simd>(simd: S) -> Option<pulp::x86::V4> {
-        if core::any::TypeId::of::<S>() == core::any::TypeId::of::<pulp::x86::V4>() {
-            // SAFETY: `S` is `V4`, a zero-sized token that exists only when the CPU has
-            // x86-v4 (the caller holds one: `simd`).
-            Some(unsafe { core::mem::transmute_copy::<S, pulp::x86::V4>(&simd) })
+        as_backend(simd)
+    }
+
+    /// `simd` as the backend token `T` when `S` is `T`.
+    #[inline(always)]
+    fn as_backend<S: Simd, T: Simd>(simd: S) -> Option<T> {
+        if core::any::TypeId::of::<S>() == core::any::TypeId::of::<T>() {
+            // SAFETY: `S` is `T`, so this copies the token the caller holds (pulp's tokens
+            // are zero-sized and exist only on CPUs with their features).
+            Some(unsafe { core::mem::transmute_copy::<S, T>(&simd) })
         } else {
             None
         }
