@@ -142,11 +142,13 @@ const FIXED_SPREAD: u32 = 16;
 /// This is a few dozen integer operations.
 fn orient3d_fixed(a: &P3, b: &P3, c: &P3, d: &P3) -> Option<f64> {
     // A finite f32 is `m 2^(e - 150)`, `m < 2^24` (subnormals: biased exponent 0 taken as 1).
-    let exponent = |x: f32| ((x.to_bits() >> 23) & 0xff).max(1);
+    let bits = [a, b, c, d].map(|p| p.map(f32::to_bits));
+    let exponent = |x: u32| ((x >> 23) & 0xff).max(1);
     let (mut lo, mut hi) = (u32::MAX, 0);
-    for x in [a, b, c, d].into_iter().flatten().filter(|x| **x != 0.0) {
-        let e = exponent(*x);
-        (lo, hi) = (lo.min(e), hi.max(e));
+    for &x in bits.as_flattened() {
+        if x & 0x7fff_ffff != 0 {
+            (lo, hi) = (lo.min(exponent(x)), hi.max(exponent(x)));
+        }
     }
     if lo == u32::MAX {
         return Some(0.0);
@@ -154,30 +156,30 @@ fn orient3d_fixed(a: &P3, b: &P3, c: &P3, d: &P3) -> Option<f64> {
     if hi == 0xff || hi - lo > FIXED_SPREAD {
         return None;
     }
-    // Each coordinate as an integer multiple of 2^(lo - 150).
-    let fixed = |x: f32| -> i64 {
-        let bits = x.to_bits();
-        let m = if (bits >> 23) & 0xff == 0 {
-            bits & 0x7f_ffff
-        } else {
-            (bits & 0x7f_ffff) | 0x80_0000
-        };
-        let v = i64::from(m) << (exponent(x).saturating_sub(lo));
-        if bits >> 31 == 0 {
-            v
-        } else {
-            -v
+    // Each coordinate as an integer multiple of 2^(lo - 150) (zero: 0).
+    let mut fixed = [[0i64; 3]; 4];
+    for (f, p) in fixed.iter_mut().zip(&bits) {
+        for (v, &x) in f.iter_mut().zip(p) {
+            let implicit = if x & 0x7f80_0000 == 0 { 0 } else { 0x80_0000 };
+            let m = i64::from((x & 0x7f_ffff) | implicit) << exponent(x).saturating_sub(lo);
+            *v = if x >> 31 == 0 { m } else { -m };
         }
-    };
-    let od = d.map(fixed);
-    let diff = |p: &P3| [0, 1, 2].map(|k| i128::from(fixed(p[k]) - od[k]));
-    let (ad, bd, cd) = (diff(a), diff(b), diff(c));
+    }
+    let [fa, fb, fc, fd] = fixed;
+    let mut e = [[0i128; 3]; 3];
+    for (e, p) in e.iter_mut().zip([fa, fb, fc]) {
+        for k in 0..3 {
+            e[k] = i128::from(p[k] - fd[k]);
+        }
+    }
+    let [ad, bd, cd] = e;
     let det = ad[2] * (bd[0] * cd[1] - cd[0] * bd[1])
         + bd[2] * (cd[0] * ad[1] - ad[0] * cd[1])
         + cd[2] * (ad[0] * bd[1] - bd[0] * ad[1]);
     // det * 2^(3 (lo - 150)): at least 2^-447 and at most 2^(126 + 312) in magnitude when
-    // nonzero, so the scaling neither underflows nor overflows.
-    let scale = 2f64.powi(3 * (lo as i32 - 150));
+    // nonzero, so the scaling neither underflows nor overflows (a normal f64 power of two,
+    // built from its bits).
+    let scale = f64::from_bits(((1023 + 3 * (i64::from(lo) - 150)) as u64) << 52);
     Some(det as f64 * scale)
 }
 
