@@ -141,7 +141,11 @@ pub(crate) fn intersects_given_boxes_overlap(a: &Tri, b: &Tri) -> bool {
         return false;
     }
     if sa.contains(&0) || sb.contains(&0) {
-        return tri_tri(a, b, &mut Decide);
+        // The general test from the signs already known (`Plane::side(x)` is the sign of
+        // `orient3d(x, t0, t1, t2) = -orient3d(t0, t1, t2, x)`): recomputing them cost
+        // coplanar pairs six more exact orientations.
+        let (da, db) = (sa.map(|s| -f64::from(s)), sb.map(|s| -f64::from(s)));
+        return tri_tri_full(a, &da, b, &db, &mut Decide);
     }
     // Rotate `a` so that its lone vertex comes first; if it is on the negative side, swap
     // `b`'s last two vertices (which flips the sign of `b`'s plane).
