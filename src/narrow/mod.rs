@@ -5,7 +5,9 @@
 //! adaptive `orient3d`/`orient2d` (the `robust` crate; its `orient3d` floating-point filter
 //! is inlined here, same formula and error bound) on the inputs widened to `f64`. That is
 //! exact for all finite `f32` coordinates: their products can neither overflow nor
-//! underflow in `f64`. Degenerate triangles (collinear corners, or all three corners equal)
+//! underflow in `f64`. An `orient3d` the filter leaves open is first tried in exact integer
+//! arithmetic (the points on their common binary grid, when it fits `i128`), the adaptive
+//! predicate only otherwise. Degenerate triangles (collinear corners, or all three corners equal)
 //! are tested exactly as the segment or point they are. Inputs are expected finite (a
 //! [`Mesh`](crate::Mesh) guarantees it); with NaN or infinite coordinates the answer is
 //! unspecified but nothing panics.

@@ -4,6 +4,8 @@
 //! `robust` crate) are exact for any `f64` input whose products neither overflow nor
 //! underflow, which holds for all finite `f32` coordinates (a degree-3 product of `f32`
 //! differences stays far inside the `f64` exponent range). Comparisons of `f32` are exact.
+//! Orientations the floating-point filter leaves open are computed in integers when the
+//! points' exponents allow (`orient3d_fixed`), which is exact by construction.
 
 use robust::{Coord, Coord3D};
 
