@@ -329,6 +329,11 @@ mod tests {
             if let Some(det) = orient3d_fixed(&a, &b, &c, &d) {
                 prop_assert_eq!(sign(det), robust_sign(&a, &b, &c, &d));
             }
+            if nudge == [0; 3] {
+                // Integers below 2^11 times a normal power of two: within the spread, and
+                // exactly coplanar.
+                prop_assert_eq!(orient3d_fixed(&a, &b, &c, &d), Some(0.0));
+            }
             // The same points, each coordinate scaled by its own power of two (mixed
             // exponents, some beyond the spread).
             let mixed: Vec<P3> = pts
@@ -383,12 +388,12 @@ mod tests {
         assert!(above != 0.0);
         // The largest magnitudes: no overflow.
         let m = f32::MAX;
-        let big = orient3d_fixed(
-            &[0.0, 0.0, 0.0],
-            &[m, 0.0, 0.0],
-            &[0.0, m, 0.0],
-            &[-m, -m, m],
+        let (o, x, y, d) = ([0.0, 0.0, 0.0], [m, 0.0, 0.0], [0.0, m, 0.0], [-m, -m, m]);
+        let big = orient3d_fixed(&o, &x, &y, &d).expect("one binade");
+        assert!(big.is_finite() && big != 0.0);
+        assert_eq!(
+            sign(big),
+            sign(robust::orient3d(c3(&o), c3(&x), c3(&y), c3(&d)))
         );
-        assert!(big.is_some_and(|x| x.is_finite() && x != 0.0));
     }
 }

@@ -117,7 +117,8 @@ fn extreme_corners(t: &Tri) -> (usize, usize) {
 /// first and lies on the positive side (swapping the other triangle's last two vertices when
 /// it does not), and two more orientations decide. With exact orientation signs that is exact.
 /// Every other case (a vertex on the other plane, coplanar or degenerate triangles) goes to
-/// [`tri_tri`], the general test, which is also the oracle the fast path is tested against.
+/// the general test ([`tri_tri`]'s body, from the six signs already known), which is also the
+/// oracle the fast path is tested against.
 #[inline]
 pub(crate) fn intersects(a: &Tri, b: &Tri) -> bool {
     aabb_overlap(a, b) && intersects_given_boxes_overlap(a, b)
