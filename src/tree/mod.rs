@@ -31,7 +31,7 @@ pub const PAPER_LEVELS: usize = 5;
 pub const MAX_CHILDREN: usize = 8;
 /// Default largest number of triangles in a leaf of an adaptive tree (chosen by
 /// measurement on real simulation frames: `docs/PERFORMANCE.md`).
-pub const DEFAULT_LEAF_SIZE: usize = 32;
+pub const DEFAULT_LEAF_SIZE: usize = 64;
 /// Largest accepted leaf size (larger leaves only make the narrow phase quadratic).
 pub const MAX_LEAF_SIZE: usize = 4096;
 /// Sibling groups (node bounds) and leaf triangle runs (narrow-phase caches) are stored
