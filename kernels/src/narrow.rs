@@ -689,11 +689,12 @@ fn filter<S: Simd>(
             hit_rows |= u64::from(bits != 0) << i;
         }
         let mut todo = hit_rows;
-        while todo != 0 {
-            let i = todo.trailing_zeros() as usize;
-            todo &= todo - 1;
-            let mut bits = box_hits[i];
-            if let Some(bv) = &bv {
+        if let Some(bv) = &bv {
+            // The shared-vertex pass, on the rows with box hits (again no branch per row).
+            let mut kept = 0u64;
+            while todo != 0 {
+                let i = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
                 let mut share = simd.equal_u32s(simd.splat_u32s(fa.vertex[0][i]), bv[0]);
                 for d in 0..3 {
                     let v = simd.splat_u32s(fa.vertex[d][i]);
@@ -703,11 +704,16 @@ fn filter<S: Simd>(
                         }
                     }
                 }
-                bits &= !u64::from(mask_bits(simd, share));
+                let bits = box_hits[i] & !u64::from(mask_bits(simd, share));
+                box_hits[i] = bits;
+                kept |= u64::from(bits != 0) << i;
             }
-            if bits == 0 {
-                continue;
-            }
+            todo = kept;
+        }
+        while todo != 0 {
+            let i = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            let mut bits = box_hits[i];
             let RowTri {
                 n: an,
                 m: am,
@@ -890,17 +896,21 @@ fn decide<S: Simd>(
     while base < nb {
         let end = (base + S::F32_LANES).min(len);
         let lanes = low_bits(S::F32_LANES) << base;
-        if out[..na].iter().all(|r| r.contact & lanes == 0) {
+        // The rows with decidable lanes in this vector, without a branch per row.
+        let mut todo = 0u64;
+        for (i, r) in out[..na].iter().enumerate() {
+            todo |= u64::from(r.contact & lanes != 0) << i;
+        }
+        if todo == 0 {
             base += S::F32_LANES;
             continue;
         }
         let bc = load_corners(simd, fb, base, end);
         let (bn, bm) = plane_simd(simd, &bc);
-        for i in 0..na {
+        while todo != 0 {
+            let i = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
             let decidable = (out[i].contact & lanes) >> base;
-            if decidable == 0 {
-                continue;
-            }
             let RowTri {
                 n: an,
                 m: am,
