@@ -508,7 +508,8 @@ fn check_leaf_contacts<S: Simd>(simd: S) {
     let mut rng = Rng::new(4);
     for scale in [1.0, 1e-30, 1e30, 3e-3] {
         for nb in block_sizes(S::F32_LANES, narrow::MAX_ROW) {
-            for na in [0, 1, 7, 9, 64] {
+            // More rows than MAX_ROW: the row masks go in chunks.
+            for na in [0, 1, 7, 9, 64, 65, 130] {
                 // Padded blocks, and corner indices that collide across the two blocks (the
                 // second block's indices overlap the first's) so that sharing happens.
                 let len_b = nb.next_multiple_of(8).min(narrow::MAX_ROW);
