@@ -592,6 +592,10 @@ pub fn leaf_contacts_with<S: Simd>(
     for row in out[..na].iter_mut() {
         *row = Row::default();
     }
+    // B is read in whole vectors: its fields over the lanes covering `nb` (padding allowed).
+    let len = nb.next_multiple_of(S::F32_LANES).min(b.len());
+    let fb = b.fields(len);
+    let k = Consts::new(simd);
     // The passes keep masks of rows in a `u64`: rows go in chunks of at most MAX_ROW. Rows
     // are independent of their index except for the one-block-with-itself pairing, whose
     // rows from `nb - 1` on allow nothing (`j > i`), so all of its work is in the first chunk.
@@ -602,29 +606,11 @@ pub fn leaf_contacts_with<S: Simd>(
     let mut a0 = 0;
     while a0 < rows {
         let n = (rows - a0).min(MAX_ROW);
-        leaf_rows(simd, a.skip(a0), n, b, nb, pairing, &mut out[a0..a0 + n]);
+        let (fa, out) = (a.skip(a0).fields(n), &mut out[a0..a0 + n]);
+        if filter(simd, k, &fa, n, &fb, nb, len, pairing, out) {
+            decide(simd, k, &fa, n, &fb, nb, len, out);
+        }
         a0 += n;
-    }
-}
-
-/// [`leaf_contacts_with`] on at most [`MAX_ROW`] rows, already reset.
-#[inline(always)]
-fn leaf_rows<S: Simd>(
-    simd: S,
-    a: TriSoa,
-    na: usize,
-    b: TriSoa,
-    nb: usize,
-    pairing: Pairing,
-    out: &mut [Row],
-) {
-    debug_assert!(na <= MAX_ROW);
-    // B is read in whole vectors: its fields over the lanes covering `nb` (padding allowed).
-    let len = nb.next_multiple_of(S::F32_LANES).min(b.len());
-    let (fa, fb) = (a.fields(na), b.fields(len));
-    let k = Consts::new(simd);
-    if filter(simd, k, &fa, na, &fb, nb, len, pairing, out) {
-        decide(simd, k, &fa, na, &fb, nb, len, out);
     }
 }
 
