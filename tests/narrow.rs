@@ -367,6 +367,44 @@ fn skew_edges_touch_at_a_point() {
     );
 }
 
+/// A wall standing on a's plane on one of its edges (the rim of a flat cap and the side of a
+/// cylinder): it meets a exactly where that edge meets a, wherever the rest of it is.
+#[test]
+fn wall_standing_on_the_plane() {
+    // The edge crosses a's boundary.
+    check(
+        A,
+        [[-1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 2.0]],
+        true,
+    );
+    // The edge ends on a's hypotenuse.
+    check(A, [[3.0, 1.0, 0.0], [5.0, 1.0, 0.0], [4.0, 1.0, 2.0]], true);
+    // The edge stops just short of a (the wall's apex leans over a: no touch).
+    check(
+        A,
+        [[-3.0, 1.0, 0.0], [-0.25, 1.0, 0.0], [2.0, 1.0, 2.0]],
+        false,
+    );
+    // Edge beside a along its leg, wall leaning away or over it.
+    check(
+        A,
+        [[-0.25, 0.0, 0.0], [-0.25, 4.0, 0.0], [-2.0, 2.0, 2.0]],
+        false,
+    );
+    check(
+        A,
+        [[-0.25, 0.0, 0.0], [-0.25, 4.0, 0.0], [2.0, 2.0, 2.0]],
+        false,
+    );
+    // Degenerate walls: a segment standing on its lower end, and a point.
+    check(A, [[1.0, 1.0, 0.0], [1.0, 1.0, 2.0], [1.0, 1.0, 1.0]], true);
+    check(
+        A,
+        [[5.0, 1.0, 0.0], [1.0, 1.0, 2.0], [3.0, 1.0, 1.0]],
+        false,
+    );
+}
+
 #[test]
 fn shared_vertex_and_shared_edge() {
     // Shared vertex position, fanning out of the plane.

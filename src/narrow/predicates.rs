@@ -93,6 +93,14 @@ impl<'a> Plane<'a> {
         }
     }
 
+    /// Whether the triangle certainly spans a plane (is not degenerate): some component of
+    /// the normal exceeds its rounding error (the differences, the products and the component
+    /// each round once: at most about `3 eps M_k + eps |N_k|`, below `8 eps M_k`).
+    #[inline(always)]
+    pub(crate) fn spans(&self) -> bool {
+        (0..3).any(|k| self.normal[k].abs() > PLANE_ERRBOUND * self.magnitude[k])
+    }
+
     /// The exact sign of `orient3d(d, t0, t1, t2)`.
     #[inline(always)]
     pub(crate) fn side(&self, d: &P3) -> i32 {
@@ -109,8 +117,16 @@ impl<'a> Plane<'a> {
             1
         } else if s < -bound {
             -1
+        } else if p == 0.0 {
+            // Exactly zero (PERF: a corner on an axis-aligned plane, flat cloth or the cap of
+            // an axis-aligned cylinder, skips the exact predicate). The terms of `P` are nonnegative, so
+            // each is zero: `e_k = 0` or both products of `M_k` are zero. A computed difference
+            // is zero only for equal inputs, and a product of two nonzero differences of `f32`
+            // values cannot underflow in `f64`, so each zero is exact, and so is
+            // `s = sum e_k N_k` with `|N_k| <= M_k`.
+            0
         } else {
-            sign(orient3d_exact(d, &self.t[0], &self.t[1], &self.t[2]))
+            orient3d_sign_exact(d, &self.t[0], &self.t[1], &self.t[2])
         }
     }
 }
@@ -125,7 +141,21 @@ const PLANE_ERRBOUND: f64 = 8.0 * EPS;
 #[cold]
 #[inline(never)]
 fn orient3d_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
-    orient3d_fixed(a, b, c, d).unwrap_or_else(|| robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+    match orient3d_fixed(a, b, c, d) {
+        Some(fixed) => fixed.value(),
+        None => robust::orient3d(c3(a), c3(b), c3(c), c3(d)),
+    }
+}
+
+/// The sign of [`orient3d_exact`] (PERF: without converting the integer determinant to
+/// `f64`, a library call that was a quarter of the integer path).
+#[cold]
+#[inline(never)]
+fn orient3d_sign_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> i32 {
+    match orient3d_fixed(a, b, c, d) {
+        Some(Fixed { det, .. }) => det.signum() as i32,
+        None => sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d))),
+    }
 }
 
 /// Largest spread of the (nonzero) coordinates' binary exponents that [`orient3d_fixed`]
@@ -134,15 +164,33 @@ fn orient3d_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
 /// `3 * 2^124 < 2^126`: inside `i128`.
 const FIXED_SPREAD: u32 = 16;
 
+/// `orient3d(a, b, c, d)` on the common binary grid of `f32` coordinates: the determinant
+/// `det * 2^(3 (lo - 150))`, `det` exact in `i128`.
+struct Fixed {
+    det: i128,
+    lo: u32,
+}
+
+impl Fixed {
+    /// The determinant rounded to `f64` (its sign exact, and so a zero). `det * 2^(3 (lo -
+    /// 150))` is at least 2^-447 and at most 2^(126 + 312) in magnitude when nonzero, so the
+    /// scaling neither underflows nor overflows (a normal f64 power of two, built from its
+    /// bits).
+    fn value(&self) -> f64 {
+        let scale = f64::from_bits(((1023 + 3 * (i64::from(self.lo) - 150)) as u64) << 52);
+        self.det as f64 * scale
+    }
+}
+
 /// `orient3d(a, b, c, d)` exactly, by integer arithmetic on the `f32` inputs' common binary
-/// grid, rounded to `f64` (so its sign is exact, and so is a zero); `None` when the nonzero
-/// coordinates' exponents span more than [`FIXED_SPREAD`] binades, or one is not finite.
+/// grid; `None` when the nonzero coordinates' exponents span more than [`FIXED_SPREAD`]
+/// binades, or one is not finite.
 ///
 /// PERF: the pairs the filter leaves are mostly exactly coplanar (flat parts of a mesh, and
 /// corners exactly on a neighbour's plane), where Shewchuk's adaptive predicate runs its
 /// expansion arithmetic to the end: that was a third of a step on the armadillo frames.
 /// This is a few dozen integer operations.
-fn orient3d_fixed(a: &P3, b: &P3, c: &P3, d: &P3) -> Option<f64> {
+fn orient3d_fixed(a: &P3, b: &P3, c: &P3, d: &P3) -> Option<Fixed> {
     // A finite f32 is `m 2^(e - 150)`, `m < 2^24` (subnormals: biased exponent 0 taken as 1).
     let bits = [a, b, c, d].map(|p| p.map(f32::to_bits));
     let exponent = |x: u32| ((x >> 23) & 0xff).max(1);
@@ -153,7 +201,7 @@ fn orient3d_fixed(a: &P3, b: &P3, c: &P3, d: &P3) -> Option<f64> {
         }
     }
     if lo == u32::MAX {
-        return Some(0.0);
+        return Some(Fixed { det: 0, lo: 1 });
     }
     if hi == 0xff || hi - lo > FIXED_SPREAD {
         return None;
@@ -168,21 +216,15 @@ fn orient3d_fixed(a: &P3, b: &P3, c: &P3, d: &P3) -> Option<f64> {
         }
     }
     let [fa, fb, fc, fd] = fixed;
-    let mut e = [[0i128; 3]; 3];
-    for (e, p) in e.iter_mut().zip([fa, fb, fc]) {
-        for k in 0..3 {
-            e[k] = i128::from(p[k] - fd[k]);
-        }
-    }
-    let [ad, bd, cd] = e;
-    let det = ad[2] * (bd[0] * cd[1] - cd[0] * bd[1])
-        + bd[2] * (cd[0] * ad[1] - ad[0] * cd[1])
-        + cd[2] * (ad[0] * bd[1] - bd[0] * ad[1]);
-    // det * 2^(3 (lo - 150)): at least 2^-447 and at most 2^(126 + 312) in magnitude when
-    // nonzero, so the scaling neither underflows nor overflows (a normal f64 power of two,
-    // built from its bits).
-    let scale = f64::from_bits(((1023 + 3 * (i64::from(lo) - 150)) as u64) << 52);
-    Some(det as f64 * scale)
+    let [ad, bd, cd] = [fa, fb, fc].map(|p| [p[0] - fd[0], p[1] - fd[1], p[2] - fd[2]]);
+    // Differences of 41 bits: each 2x2 minor from two widening 64 x 64 -> 128 products.
+    let minor = |a: i64, b: i64, c: i64, d: i64| {
+        i128::from(a) * i128::from(b) - i128::from(c) * i128::from(d)
+    };
+    let det = i128::from(ad[2]) * minor(bd[0], cd[1], cd[0], bd[1])
+        + i128::from(bd[2]) * minor(cd[0], ad[1], ad[0], cd[1])
+        + i128::from(cd[2]) * minor(ad[0], bd[1], bd[0], ad[1]);
+    Some(Fixed { det, lo })
 }
 
 /// The two axes kept when projecting along axis `k` (cyclic, so orientation is consistent).
@@ -264,12 +306,34 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// The integer path's value, as `orient3d_exact` returns it.
+    fn fixed_value(a: &P3, b: &P3, c: &P3, d: &P3) -> Option<f64> {
+        orient3d_fixed(a, b, c, d).map(|f| f.value())
+    }
+
     fn robust_sign(a: &P3, b: &P3, c: &P3, d: &P3) -> i32 {
         sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
     }
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(5000))]
+
+        /// `Plane::spans` only certifies triangles that are not degenerate, and certifies
+        /// every one on a coarse grid (collinear and repeated corners are common there), also
+        /// scaled to tiny and huge magnitudes.
+        #[test]
+        fn spans_certifies_exactly_the_proper_triangles(
+            t in prop::array::uniform3(prop::array::uniform3(-3i32..=3)),
+            exp in -140i32..120,
+        ) {
+            let unit = 2f32.powi(exp.max(-149));
+            let t: Tri = t.map(|p| p.map(|c| c as f32 * unit));
+            let proper = projection_axis(&t[0], &t[1], &t[2]).is_some();
+            prop_assert!(!Plane::new(&t).spans() || proper);
+            if exp > -120 {
+                prop_assert_eq!(Plane::new(&t).spans(), proper);
+            }
+        }
 
         /// The inlined filter returns robust's sign, also for nearly coplanar `d` (an affine
         /// combination of `a, b, c` rounded to f32, nudged by a few ulps).
@@ -326,13 +390,13 @@ mod tests {
                 d[k] = x;
             }
             let pts = [a, b, c, d];
-            if let Some(det) = orient3d_fixed(&a, &b, &c, &d) {
+            if let Some(det) = fixed_value(&a, &b, &c, &d) {
                 prop_assert_eq!(sign(det), robust_sign(&a, &b, &c, &d));
             }
             if nudge == [0; 3] {
                 // Integers below 2^11 times a normal power of two: within the spread, and
                 // exactly coplanar.
-                prop_assert_eq!(orient3d_fixed(&a, &b, &c, &d), Some(0.0));
+                prop_assert_eq!(fixed_value(&a, &b, &c, &d), Some(0.0));
             }
             // The same points, each coordinate scaled by its own power of two (mixed
             // exponents, some beyond the spread).
@@ -342,11 +406,12 @@ mod tests {
                 .map(|(q, e)| q.map(|x| x * 2f32.powi(e - 12)))
                 .collect();
             let (a, b, c, d) = (&mixed[0], &mixed[1], &mixed[2], &mixed[3]);
-            let got = orient3d_fixed(a, b, c, d);
+            let got = fixed_value(a, b, c, d);
             if let Some(det) = got {
                 prop_assert_eq!(sign(det), robust_sign(a, b, c, d));
             }
             prop_assert_eq!(sign(orient3d(a, b, c, d)), robust_sign(a, b, c, d));
+            prop_assert_eq!(orient3d_sign_exact(a, b, c, d), robust_sign(a, b, c, d));
         }
     }
 
@@ -354,28 +419,25 @@ mod tests {
     fn fixed_orient3d_answers_within_its_spread_and_not_beyond() {
         let (a, b, c) = ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
         // Coplanar: exactly zero.
-        assert_eq!(orient3d_fixed(&a, &b, &c, &[0.25, 0.75, 0.0]), Some(0.0));
+        assert_eq!(fixed_value(&a, &b, &c, &[0.25, 0.75, 0.0]), Some(0.0));
         // Exponents 2^-16 .. 2^0: answered, exact value (det of unit edges and height h).
         let h = 2f32.powi(-16);
+        assert_eq!(fixed_value(&a, &b, &c, &[0.5, 0.5, h]), Some(-f64::from(h)));
         assert_eq!(
-            orient3d_fixed(&a, &b, &c, &[0.5, 0.5, h]),
-            Some(-f64::from(h))
-        );
-        assert_eq!(
-            sign(orient3d_fixed(&a, &b, &c, &[0.5, 0.5, h]).unwrap()),
+            sign(fixed_value(&a, &b, &c, &[0.5, 0.5, h]).unwrap()),
             sign(robust::orient3d(c3(&a), c3(&b), c3(&c), c3(&[0.5, 0.5, h])))
         );
         // One binade more: left to the adaptive predicate.
-        assert_eq!(orient3d_fixed(&a, &b, &c, &[0.5, 0.5, h / 2.0]), None);
+        assert_eq!(fixed_value(&a, &b, &c, &[0.5, 0.5, h / 2.0]), None);
         // Not finite: left to the adaptive predicate (whose answer is unspecified).
-        assert_eq!(orient3d_fixed(&a, &b, &c, &[0.5, 0.5, f32::INFINITY]), None);
-        assert_eq!(orient3d_fixed(&a, &b, &c, &[0.5, f32::NAN, 0.0]), None);
+        assert_eq!(fixed_value(&a, &b, &c, &[0.5, 0.5, f32::INFINITY]), None);
+        assert_eq!(fixed_value(&a, &b, &c, &[0.5, f32::NAN, 0.0]), None);
         // All zero.
-        assert_eq!(orient3d_fixed(&a, &a, &a, &a), Some(0.0));
+        assert_eq!(fixed_value(&a, &a, &a, &a), Some(0.0));
         // Subnormals alone: exact.
         let s = f32::from_bits(1);
         let (sa, sb, sc) = ([0.0, 0.0, 0.0], [s, 0.0, 0.0], [0.0, s, 0.0]);
-        let above = orient3d_fixed(&sa, &sb, &sc, &[0.0, 0.0, s]).unwrap();
+        let above = fixed_value(&sa, &sb, &sc, &[0.0, 0.0, s]).unwrap();
         assert_eq!(
             sign(above),
             sign(robust::orient3d(
@@ -389,7 +451,7 @@ mod tests {
         // The largest magnitudes: no overflow.
         let m = f32::MAX;
         let (o, x, y, d) = ([0.0, 0.0, 0.0], [m, 0.0, 0.0], [0.0, m, 0.0], [-m, -m, m]);
-        let big = orient3d_fixed(&o, &x, &y, &d).expect("one binade");
+        let big = fixed_value(&o, &x, &y, &d).expect("one binade");
         assert!(big.is_finite() && big != 0.0);
         assert_eq!(
             sign(big),

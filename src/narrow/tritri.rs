@@ -137,11 +137,23 @@ pub(crate) fn intersects_given_boxes_overlap(a: &Tri, b: &Tri) -> bool {
         return false;
     }
     let pa = Plane::new(a);
-    let sb = [pa.side(&b[0]), pa.side(&b[1]), pa.side(&b[2])];
+    let sb = if sa == [0; 3] && pb.spans() {
+        // `a` lies in the plane `b` spans, so `b` lies in `a`'s (the same plane, or none when
+        // `a` is degenerate): three exact zeros not recomputed (PERF: coplanar pairs).
+        [0; 3]
+    } else {
+        [pa.side(&b[0]), pa.side(&b[1]), pa.side(&b[2])]
+    };
     if sb[0] * sb[1] > 0 && sb[0] * sb[2] > 0 {
         return false;
     }
     if sa.contains(&0) || sb.contains(&0) {
+        // A triangle that only touches the other's plane (PERF: corners of a mesh exactly on
+        // a neighbour's plane, e.g. the rim of a flat cap, were most of these pairs on the
+        // armadillo frames, and the general test pays six edge tests for them).
+        if let Some(hit) = touching(a, sa, b).or_else(|| touching(b, sb, a)) {
+            return hit;
+        }
         // The general test from the signs already known (`Plane::side(x)` is the sign of
         // `orient3d(x, t0, t1, t2) = -orient3d(t0, t1, t2, x)`): recomputing them cost
         // coplanar pairs six more exact orientations.
@@ -169,6 +181,39 @@ pub(crate) fn intersects_given_boxes_overlap(a: &Tri, b: &Tri) -> bool {
     // triangles' intervals on the planes' common line overlap:
     // (q2 - q1) . ((p2 - q1) x (p1 - q1)) <= 0 and (r2 - p1) . ((p2 - p1) x (r1 - p1)) <= 0.
     sign(orient3d(q2, p2, p1, q1)) <= 0 && sign(orient3d(r2, p2, r1, p1)) <= 0
+}
+
+/// Whether `s` meets `t`, when `s` only touches `t`'s plane: some corner of `s` on it (`ds`,
+/// the corners' exact sides of that plane) and the others strictly on one side. `None`
+/// otherwise (`s` crosses the plane, lies in it, or misses it).
+///
+/// The side of the plane is an affine function, nonnegative (say) on the corners of `s` and
+/// zero exactly on those in the plane, so `s` meets the plane exactly in the convex hull of
+/// those corners (a point or a segment; `s` may be degenerate), and `s` meets `t` iff that
+/// hull meets `t`: a 2D test in the plane. `t` is not degenerate, since some corner of `s` is
+/// strictly off its plane.
+#[inline]
+fn touching(s: &Tri, ds: [i32; 3], t: &Tri) -> Option<bool> {
+    let zeros = ds.iter().filter(|&&d| d == 0).count();
+    let side = ds.iter().sum::<i32>();
+    // One or two zeros and the other signs equal: |sum| = number of nonzero signs.
+    if zeros == 0 || zeros == 3 || side.unsigned_abs() as usize != 3 - zeros {
+        return None;
+    }
+    let k = projection_axis(&t[0], &t[1], &t[2])?;
+    let on: [usize; 2] = match ds {
+        [0, 0, _] => [0, 1],
+        [0, _, 0] => [0, 2],
+        [_, 0, 0] => [1, 2],
+        [0, _, _] => [0, 0],
+        [_, 0, _] => [1, 1],
+        _ => [2, 2],
+    };
+    Some(if on[0] == on[1] {
+        point_in_tri_2d(k, &s[on[0]], t)
+    } else {
+        coplanar_seg_tri(&s[on[0]], &s[on[1]], t, k, &mut Decide)
+    })
 }
 
 /// The index of the one sign that differs from the other two (all nonzero, not all equal).
