@@ -174,6 +174,51 @@ fn leaves_hold_at_most_leaf_size_triangles() {
     }
 }
 
+/// Each leaf lists its triangles in compact groups of the narrow kernel's lanes (16, and 8
+/// within them), so a vector of lanes is a small region. Criterion, on a long strip of
+/// cells (a leaf is then a run of the strip, cut along its length): within every leaf the
+/// aligned groups of 16 and of 8 triangles occupy disjoint, increasing or decreasing ranges
+/// of x (no two groups interleave).
+#[test]
+fn leaves_list_their_triangles_in_compact_lane_groups() {
+    let strip = grid(2000, 1, 1.0, [0.0; 3]);
+    for leaf_size in [64, 40, 17, 200] {
+        let tree = RegionTree::build(&strip, TreeShape::Adaptive { leaf_size }).unwrap();
+        tree.check_topology(&strip).unwrap();
+        let centroid_x = |t: u32| {
+            let c = strip.corners(t as usize);
+            (c[0][0] + c[1][0] + c[2][0]) / 3.0
+        };
+        let mut groups_checked = 0;
+        for n in tree.leaves() {
+            let tris = &tree.tri_order()[tree.tri_range(n)];
+            for unit in [16, 8] {
+                let ranges: Vec<(f32, f32)> = tris
+                    .chunks(unit)
+                    .map(|g| {
+                        let xs = g.iter().map(|&t| centroid_x(t));
+                        (
+                            xs.clone().fold(f32::MAX, f32::min),
+                            xs.fold(f32::MIN, f32::max),
+                        )
+                    })
+                    .collect();
+                for (i, a) in ranges.iter().enumerate() {
+                    for b in &ranges[i + 1..] {
+                        assert!(
+                            a.1 < b.0 || b.1 < a.0,
+                            "leaf size {leaf_size}, leaf {n}: groups of {unit} interleave: \
+                             {a:?} {b:?}"
+                        );
+                    }
+                }
+                groups_checked += ranges.len();
+            }
+        }
+        assert!(groups_checked >= strip.triangle_count() / 16);
+    }
+}
+
 /// `levels = Some(n)` (the paper's fixed depth): exactly `n` levels when the mesh has enough
 /// triangles, every node of two or more triangles above the last level split, leaves above
 /// it holding a single triangle; on a small mesh the tree stops at single triangles.
