@@ -607,15 +607,28 @@ pub fn leaf_contacts_with<S: Simd>(
     while a0 < rows {
         let n = (rows - a0).min(MAX_ROW);
         let (fa, out) = (a.skip(a0).fields(n), &mut out[a0..a0 + n]);
-        if filter(simd, k, &fa, n, &fb, nb, len, pairing, out) {
-            decide(simd, k, &fa, n, &fb, nb, len, out);
+        let mut decidable_rows = [0u64; MAX_ROW];
+        if filter(
+            simd,
+            k,
+            &fa,
+            n,
+            &fb,
+            nb,
+            len,
+            pairing,
+            out,
+            &mut decidable_rows,
+        ) {
+            decide(simd, k, &fa, n, &fb, nb, len, out, &decidable_rows);
         }
         a0 += n;
     }
 }
 
-/// The filter pass of [`leaf_contacts_with`]: the candidates in `undecided`. Returns whether
-/// there is any.
+/// The filter pass of [`leaf_contacts_with`]: the candidates in `undecided`, and per lane
+/// vector of B (`base / F32_LANES`) the rows with candidates the decision pass may certify.
+/// Returns whether there is any.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn filter<S: Simd>(
@@ -628,6 +641,7 @@ fn filter<S: Simd>(
     len: usize,
     pairing: Pairing,
     out: &mut [Row],
+    decidable_rows: &mut [u64; MAX_ROW],
 ) -> bool {
     let mut any = 0;
     // Rows of A that meet B's union box, lanes of B that meet A's: the others cannot meet
@@ -755,6 +769,7 @@ fn filter<S: Simd>(
             // `contact` holds the decidable candidates until the decision pass.
             out[i].contact |= decidable << base;
             out[i].undecided |= bits << base;
+            decidable_rows[base / S::F32_LANES] |= u64::from(decidable != 0) << i;
             any |= decidable;
         }
         base += S::F32_LANES;
@@ -904,16 +919,15 @@ fn decide<S: Simd>(
     nb: usize,
     len: usize,
     out: &mut [Row],
+    decidable_rows: &[u64; MAX_ROW],
 ) {
+    debug_assert!(na <= MAX_ROW);
     let mut base = 0;
     while base < nb {
         let end = (base + S::F32_LANES).min(len);
         let lanes = low_bits(S::F32_LANES) << base;
-        // The rows with decidable lanes in this vector, without a branch per row.
-        let mut todo = 0u64;
-        for (i, r) in out[..na].iter().enumerate() {
-            todo |= u64::from(r.contact & lanes != 0) << i;
-        }
+        // The rows with decidable lanes in this vector (the filter's list).
+        let mut todo = decidable_rows[base / S::F32_LANES];
         if todo == 0 {
             base += S::F32_LANES;
             continue;
