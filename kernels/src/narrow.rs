@@ -620,7 +620,7 @@ pub fn leaf_contacts_with<S: Simd>(
             out,
             &mut decidable_rows,
         ) {
-            decide(simd, k, &fa, n, &fb, nb, len, out, &decidable_rows);
+            decide(simd, k, &fa, &fb, nb, len, out, &decidable_rows);
         }
         a0 += n;
     }
@@ -914,14 +914,12 @@ fn decide<S: Simd>(
     simd: S,
     k: Consts<S>,
     fa: &Fields,
-    na: usize,
     fb: &Fields,
     nb: usize,
     len: usize,
     out: &mut [Row],
     decidable_rows: &[u64; MAX_ROW],
 ) {
-    debug_assert!(na <= MAX_ROW);
     let mut base = 0;
     while base < nb {
         let end = (base + S::F32_LANES).min(len);

@@ -119,11 +119,11 @@ impl<'a> Plane<'a> {
             -1
         } else if p == 0.0 {
             // Exactly zero (PERF: a corner on an axis-aligned plane, flat cloth or the cap of
-            // an axis-aligned cylinder, skips the exact predicate). The terms of `P` are nonnegative, so
-            // each is zero: `e_k = 0` or both products of `M_k` are zero. A computed difference
-            // is zero only for equal inputs, and a product of two nonzero differences of `f32`
-            // values cannot underflow in `f64`, so each zero is exact, and so is
-            // `s = sum e_k N_k` with `|N_k| <= M_k`.
+            // an axis-aligned cylinder, skips the exact predicate). The terms of `P` are
+            // nonnegative, so each is zero: `e_k = 0` or both products of `M_k` are zero. A
+            // computed difference is zero only for equal inputs, and a product of two nonzero
+            // differences of `f32` values cannot underflow in `f64`, so each zero is exact,
+            // and so is `s = sum e_k N_k` with `|N_k| <= M_k`.
             0
         } else {
             orient3d_sign_exact(d, &self.t[0], &self.t[1], &self.t[2])
