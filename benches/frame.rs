@@ -398,8 +398,8 @@ fn frame(c: &mut Criterion) {
             })
         });
         if scene.pairs.len() > 1 {
-            // Many objects: the Scene API runs the object pairs in parallel (batches in which
-            // no object appears twice), the way a user with eight objects would.
+            // Many objects: the Scene API runs the object pairs in parallel (all at once, on
+            // the shared hierarchies), the way a user with eight objects would.
             bench_scene(c, scene, "dhcd-dh-t1", Par::Rayon(1));
             bench_scene(c, scene, "dhcd-dh-t2", Par::Rayon(2));
         }

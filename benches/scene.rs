@@ -1,5 +1,6 @@
 //! A scene step (update every object, then all contacts) with the scene's parallel schedule
-//! (batches of disjoint object pairs run on rayon, each query splitting its own frontier),
+//! (every object pair at once on rayon over the shared hierarchies, each query splitting its
+//! own frontier),
 //! against the sequential step and against the alternative of running the same object
 //! pairs one after the other, each query parallel inside only.
 //!

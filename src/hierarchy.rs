@@ -1,6 +1,7 @@
 //! A bounding-volume hierarchy of one deformable mesh: the shared region tree, the live
 //! vertex positions (internal order), the node buffers of one kind, and the lazy-refit state.
 
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use crate::bv::{BvKind, Method};
@@ -167,6 +168,53 @@ pub struct Hierarchy<K: BvKind> {
     updates: u64,
     /// Triangle corners and boxes in the current pose, refreshed lazily per leaf.
     tris: TriCache,
+    /// Which scene job first needed each sibling group this step (see [`JobClaims`]).
+    claims: JobClaims,
+}
+
+/// Per sibling group: the first *job* (in the scene's job order) that needed it since the
+/// last drain, and whether a query fitted it (lazy refit). A [`crate::scene::Scene`] runs
+/// all its object-pair queries at once on shared hierarchies, so which query happens to fit
+/// a group depends on timing; crediting each fit to the first job in job order that needed
+/// the group instead gives every job the `bv_updates` it would have in a sequential run in
+/// that order, whatever the thread count. Atomics with relaxed order: the drain runs after
+/// the parallel region has joined.
+#[derive(Debug)]
+struct JobClaims {
+    first: Box<[AtomicUsize]>,
+    fitted: Box<[AtomicBool]>,
+}
+
+/// No job has claimed the group.
+const UNCLAIMED: usize = usize::MAX;
+
+impl JobClaims {
+    fn new(groups: usize) -> Self {
+        Self {
+            first: (0..groups).map(|_| AtomicUsize::new(UNCLAIMED)).collect(),
+            fitted: (0..groups).map(|_| AtomicBool::new(false)).collect(),
+        }
+    }
+
+    /// Job `job` needed group `g` (and fitted it, if `fitted`).
+    #[inline]
+    fn touch(&self, g: usize, job: usize, fitted: bool) {
+        if fitted {
+            self.fitted[g].store(true, Ordering::Relaxed);
+        }
+        let first = &self.first[g];
+        // A load first: most touches come from a job that already holds the claim.
+        if first.load(Ordering::Relaxed) > job {
+            first.fetch_min(job, Ordering::Relaxed);
+        }
+    }
+}
+
+impl Clone for JobClaims {
+    /// A clone starts unclaimed: claims belong to the step of one hierarchy.
+    fn clone(&self) -> Self {
+        Self::new(self.first.len())
+    }
 }
 
 /// Every triangle's corners and closed box in the current pose, refreshed lazily one leaf at
@@ -306,6 +354,7 @@ impl<K: BvKind> Hierarchy<K> {
         let nodes = K::build(&tree, &points, &options);
         Ok(Self {
             tris: TriCache::new(&tree),
+            claims: JobClaims::new(tree.group_count()),
             tree,
             points,
             nodes,
@@ -392,6 +441,28 @@ impl<K: BvKind> Hierarchy<K> {
     #[inline]
     pub(crate) fn group(&self, g: usize) -> (K::Block<'_>, bool) {
         K::group(&self.nodes, &self.tree, &self.points, g)
+    }
+
+    /// Sibling group `g`'s block for scene job `job`, fitted first if stale; records the
+    /// claim ([`JobClaims`]) instead of returning whether this call fitted it.
+    #[inline]
+    pub(crate) fn group_for_job(&self, g: usize, job: usize) -> K::Block<'_> {
+        let (block, fitted) = self.group(g);
+        self.claims.touch(g, job, fitted);
+        block
+    }
+
+    /// Credits each group a query fitted since the last drain to the first job that needed
+    /// it (`credit(job, nodes fitted)`), and clears every claim.
+    pub(crate) fn drain_claims(&mut self, mut credit: impl FnMut(usize, u64)) {
+        let JobClaims { first, fitted } = &mut self.claims;
+        for (g, (first, fitted)) in first.iter_mut().zip(fitted.iter_mut()).enumerate() {
+            let job = std::mem::replace(first.get_mut(), UNCLAIMED);
+            if std::mem::take(fitted.get_mut()) {
+                debug_assert_ne!(job, UNCLAIMED, "a fitting job claims the group");
+                credit(job, self.tree.group_nodes(g).len() as u64);
+            }
+        }
     }
 
     /// Leaf `leaf`'s triangles in the current pose, gathered first if stale.

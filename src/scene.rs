@@ -6,19 +6,16 @@
 //! 1. **Broad phase**: each object's root box (min/max of its live vertex positions,
 //!    recomputed on every update) goes through sweep-and-prune along x; only object pairs
 //!    whose closed boxes overlap are kept. Far-apart objects cost a box comparison.
-//! 2. **Schedule**: the kept pairs, and the objects with self-collision on, are *jobs*,
-//!    sorted by object. Each job needs `&mut` access to its objects (lazy refit), so the
-//!    jobs are cut into batches in which no object appears twice: each job, in order, goes
-//!    into the first batch where both its objects are free (first-fit edge colouring;
-//!    independent of the thread count).
-//! 3. **Narrow**: the jobs of a batch run in parallel (rayon), each a two-object query
-//!    ([`collide_with`](crate::collide_with())) or a self query
-//!    ([`self_collide_with`](crate::self_collide_with())) that may itself split its frontier
-//!    across the pool. Batches run one after the other.
+//! 2. **Jobs**: the kept pairs, and the objects with self-collision on, sorted by object.
+//! 3. **Narrow**: every job at once (rayon), each a two-object or a self query on the
+//!    shared hierarchies, which may itself split its frontier across the pool. The lazy
+//!    refit fits each sibling group once, for whichever query needs it first.
 //!
-//! Output is deterministic: contacts are sorted, per-pair counters are listed in job order,
-//! and the schedule does not depend on the thread count, so the lazy refits (and the
-//! `bv_updates` attributed to each pair) are the same for every `Par`.
+//! Output is deterministic: contacts are sorted and per-pair counters listed in job order.
+//! A group's refit is credited to the first job *in job order* that needed it (not to the
+//! query that happened to fit it), and an object's eager refits to its first job, so every
+//! pair's `bv_updates` is what a sequential run of the jobs in that order counts, for every
+//! `Par`.
 
 use rayon::prelude::*;
 
@@ -30,7 +27,7 @@ use crate::hierarchy::{Hierarchy, Options};
 use crate::kinds::{kinds, match_kind, with_kind};
 use crate::mesh::Mesh;
 use crate::par::Par;
-use crate::traverse::{collide_with, self_collide_with, Contacts, Workspace};
+use crate::traverse::{scene_query, Contacts, Workspace};
 
 /// Identifies an object of a [`Scene`]. Ids are handed out in increasing order from 0 and
 /// are **never reused**, even after [`Scene::remove`]: a stale id is always an
@@ -67,9 +64,6 @@ pub struct SceneContacts {
     pub counters: Counters,
     /// Object pairs whose root boxes were compared in the broad phase.
     pub broad_phase_tests: u64,
-    /// Batches of the parallel schedule (jobs in one batch share no object and run
-    /// concurrently; batches run one after the other).
-    pub batches: usize,
 }
 
 /// One object of the scene.
@@ -306,36 +300,6 @@ fn broad_phase(bounds: &[[[f32; 3]; 2]]) -> (Vec<(usize, usize)>, u64) {
     (out, tests)
 }
 
-/// The objects a job needs exclusively: two distinct ones, or one (self-collision).
-enum Work<'a, K: BvKind> {
-    Pair(usize, &'a mut Object<K>, usize, &'a mut Object<K>),
-    Myself(usize, &'a mut Object<K>),
-}
-
-fn take<'a, K: BvKind>(slots: &mut [Option<&'a mut Object<K>>], i: usize) -> &'a mut Object<K> {
-    slots[i]
-        .take()
-        .expect("the schedule puts an object at most once in a batch")
-}
-
-/// Runs one job; hands the objects back with its contacts.
-fn run_job<'a, K: BvKind>(
-    ws: &mut Workspace,
-    w: Work<'a, K>,
-    inner: Par,
-) -> (Contacts, Work<'a, K>) {
-    match w {
-        Work::Pair(ia, a, ib, b) => {
-            let c = collide_with(&mut a.h, &mut b.h, ws, inner);
-            (c, Work::Pair(ia, a, ib, b))
-        }
-        Work::Myself(i, a) => {
-            let c = self_collide_with(&mut a.h, ws, inner);
-            (c, Work::Myself(i, a))
-        }
-    }
-}
-
 fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
     let bounds: Vec<_> = objects.iter().map(|o| o.bounds).collect();
     let (candidates, broad_phase_tests) = broad_phase(&bounds);
@@ -350,79 +314,39 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
     );
     jobs.sort_unstable();
 
-    // Batches in which no object appears twice: first fit, in job order (a greedy edge
-    // colouring: at most 2 * max_degree - 1 batches). `used[b][i]`: object `i` is in batch `b`.
-    let mut batches: Vec<Vec<usize>> = Vec::new();
-    let mut used: Vec<Vec<bool>> = Vec::new();
-    for (k, &(a, b)) in jobs.iter().enumerate() {
-        let batch = match used.iter().position(|u| !u[a] && !u[b]) {
-            Some(batch) => batch,
-            None => {
-                used.push(vec![false; objects.len()]);
-                batches.push(Vec::new());
-                used.len() - 1
-            }
-        };
-        used[batch][a] = true;
-        used[batch][b] = true;
-        batches[batch].push(k);
-    }
-
-    // Inner queries split their frontiers on the current pool too (nested rayon).
+    // Every job at once on shared hierarchies (the lazy refit fits each group once, whoever
+    // needs it first); each query may also split its own frontier on the same pool.
     let inner = if parallel { Par::Rayon(0) } else { Par::Seq };
-
-    let mut results: Vec<Option<Contacts>> = (0..jobs.len()).map(|_| None).collect();
-    let mut slots: Vec<Option<&mut Object<K>>> = objects.iter_mut().map(Some).collect();
-    let mut ws = Workspace::default();
-    for batch in &batches {
-        let work: Vec<(usize, Work<'_, K>)> = batch
-            .iter()
-            .map(|&k| {
-                let (a, b) = jobs[k];
-                let w = if a == b {
-                    Work::Myself(a, take(&mut slots, a))
-                } else {
-                    let oa = take(&mut slots, a);
-                    Work::Pair(a, oa, b, take(&mut slots, b))
-                };
-                (k, w)
-            })
-            .collect();
-        let done: Vec<(usize, Contacts, Work<'_, K>)> = if parallel && work.len() > 1 {
-            work.into_par_iter()
-                .map_init(Workspace::default, |ws, (k, w)| {
-                    let (c, w) = run_job(ws, w, inner);
-                    (k, c, w)
-                })
-                .collect()
-        } else {
-            work.into_iter()
-                .map(|(k, w)| {
-                    let (c, w) = run_job(&mut ws, w, inner);
-                    (k, c, w)
-                })
-                .collect()
-        };
-        for (k, c, w) in done {
-            results[k] = Some(c);
-            match w {
-                Work::Pair(ia, a, ib, b) => {
-                    slots[ia] = Some(a);
-                    slots[ib] = Some(b);
-                }
-                Work::Myself(i, a) => slots[i] = Some(a),
-            }
+    let shared: &[Object<K>] = objects;
+    let run = |ws: &mut Workspace, k: usize, (a, b): (usize, usize)| {
+        scene_query(&shared[a].h, &shared[b].h, a == b, k, ws, inner)
+    };
+    let mut results: Vec<Contacts> = if parallel && jobs.len() > 1 {
+        jobs.par_iter()
+            .enumerate()
+            .map_init(Workspace::default, |ws, (k, &job)| run(ws, k, job))
+            .collect()
+    } else {
+        let mut ws = Workspace::default();
+        jobs.iter()
+            .enumerate()
+            .map(|(k, &job)| run(&mut ws, k, job))
+            .collect()
+    };
+    // The refits as a sequential run in job order would count them: each lazily fitted group
+    // to the first job that needed it, each object's eager refits to its first job.
+    for (i, o) in objects.iter_mut().enumerate() {
+        o.h.drain_claims(|k, nodes| results[k].counters.bv_updates += nodes);
+        if let Some(k) = jobs.iter().position(|&(a, b)| a == i || b == i) {
+            results[k].counters.bv_updates += o.h.take_updates();
         }
     }
-    drop(slots);
 
     let mut out = SceneContacts {
         broad_phase_tests,
-        batches: batches.len(),
         ..SceneContacts::default()
     };
     for (&(a, b), c) in jobs.iter().zip(results) {
-        let c = c.expect("every job ran in some batch");
         let (ida, idb) = (objects[a].id, objects[b].id);
         out.pairs.extend(
             c.pairs

@@ -102,6 +102,7 @@ pub fn collide_with<K: BvKind>(
         b,
         self_query: false,
         narrow: true,
+        job: None,
     };
     let mut c = par.install(|| walk.run(ws, par.is_parallel()));
     c.counters.bv_updates += updates;
@@ -147,10 +148,33 @@ pub fn self_collide_with<K: BvKind>(
         b: h,
         self_query: true,
         narrow: true,
+        job: None,
     };
     let mut c = par.install(|| walk.run(ws, par.is_parallel()));
     c.counters.bv_updates += updates;
     c
+}
+
+/// One query of a scene's step on shared hierarchies: `a` against `b`, or `a` against
+/// itself when `self_query` (then `b` is `a`). Fitted groups are claimed for `job` instead of
+/// counted: the scene credits them ([`Hierarchy::drain_claims`]), and the eager refits
+/// ([`Hierarchy::take_updates`]) too, once the step's queries are done.
+pub(crate) fn scene_query<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    self_query: bool,
+    job: usize,
+    ws: &mut Workspace,
+    par: Par,
+) -> Contacts {
+    let walk = Walk {
+        a,
+        b,
+        self_query,
+        narrow: true,
+        job: Some(job),
+    };
+    par.install(|| walk.run(ws, par.is_parallel()))
 }
 
 /// The broad phase alone: lazy refit and traversal down to the overlapping leaf pairs, which
@@ -171,6 +195,7 @@ pub fn broad_phase<K: BvKind>(
         b,
         self_query: false,
         narrow: false,
+        job: None,
     }
     .broad(ws, par, updates)
 }
@@ -188,6 +213,7 @@ pub fn self_broad_phase<K: BvKind>(h: &mut Hierarchy<K>, ws: &mut Workspace, par
         b: h,
         self_query: true,
         narrow: false,
+        job: None,
     }
     .broad(ws, par, updates)
 }
@@ -220,6 +246,7 @@ pub fn narrow_phase<K: BvKind>(
         b,
         self_query: false,
         narrow: true,
+        job: None,
     };
     let run = |chunk: &[[u32; 2]]| {
         let mut out = Output::default();
@@ -251,6 +278,9 @@ struct Walk<'h, K: BvKind> {
     self_query: bool,
     /// Run the narrow phase on overlapping leaf pairs (else collect them).
     narrow: bool,
+    /// A scene job's index: fitted groups are claimed for it ([`Hierarchy::group_for_job`])
+    /// and credited by the scene, not counted here.
+    job: Option<usize>,
 }
 
 /// What a walk produces: contacts, counters, and (broad phase only) leaf pairs; with the
@@ -349,15 +379,29 @@ impl<'h, K: BvKind> Walk<'h, K> {
         out.finish()
     }
 
+    /// Sibling group `g` of `h` (one of this walk's two hierarchies), fitted first if stale:
+    /// the fitted nodes counted in `bv_updates`, or claimed for the scene job.
+    #[inline(always)]
+    fn group(&self, h: &'h Hierarchy<K>, g: usize, out: &mut Output<'h>) -> K::Block<'h> {
+        match self.job {
+            Some(job) => h.group_for_job(g, job),
+            None => {
+                let (block, fitted) = h.group(g);
+                if fitted {
+                    out.counters.bv_updates += h.tree().group_nodes(g).len() as u64;
+                }
+                block
+            }
+        }
+    }
+
     /// The root entry: the roots' test (two objects) or the root self pair.
     #[inline(always)]
     fn root<S: Simd>(&self, simd: S, out: &mut Output<'h>) -> Option<[u32; 2]> {
         if self.self_query {
             return Some([0, 0]);
         }
-        let (ba, fa) = self.a.group(0);
-        let (bb, fb) = self.b.group(0);
-        out.counters.bv_updates += fa as u64 + fb as u64;
+        let (ba, bb) = (self.group(self.a, 0, out), self.group(self.b, 0, out));
         out.counters.bv_tests += 1;
         (K::test(simd, ba, 0, bb, 1) != 0).then_some([0, 0])
     }
@@ -378,11 +422,8 @@ impl<'h, K: BvKind> Walk<'h, K> {
             let Some(g) = ta.child_group(x) else {
                 return self.leaves(simd, x, y, out);
             };
-            let (block, fitted) = self.a.group(g);
+            let block = self.group(self.a, g, out);
             let nodes = ta.group_nodes(g);
-            if fitted {
-                out.counters.bv_updates += nodes.len() as u64;
-            }
             let m = nodes.len();
             for i in 0..m {
                 let ci = (nodes.start + i) as u32;
@@ -412,11 +453,8 @@ impl<'h, K: BvKind> Walk<'h, K> {
         };
         if descend_x {
             let g = ta.child_group(x).unwrap_or_default();
-            let (children, fitted) = self.a.group(g);
+            let children = self.group(self.a, g, out);
             let nodes = ta.group_nodes(g);
-            if fitted {
-                out.counters.bv_updates += nodes.len() as u64;
-            }
             out.counters.bv_tests += nodes.len() as u64;
             let mut bits = K::test(simd, by, iy, children, nodes.len());
             while bits != 0 {
@@ -426,11 +464,8 @@ impl<'h, K: BvKind> Walk<'h, K> {
             }
         } else {
             let g = tb.child_group(y).unwrap_or_default();
-            let (children, fitted) = self.b.group(g);
+            let children = self.group(self.b, g, out);
             let nodes = tb.group_nodes(g);
-            if fitted {
-                out.counters.bv_updates += nodes.len() as u64;
-            }
             out.counters.bv_tests += nodes.len() as u64;
             let mut bits = K::test(simd, bx, ix, children, nodes.len());
             while bits != 0 {
