@@ -334,10 +334,16 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
             .collect()
     };
     // The refits as a sequential run in job order would count them: each lazily fitted group
-    // to the first job that needed it, each object's eager refits to its first job.
-    for (i, o) in objects.iter_mut().enumerate() {
-        o.h.drain_claims(|k, nodes| results[k].counters.bv_updates += nodes);
-        if let Some(k) = jobs.iter().position(|&(a, b)| a == i || b == i) {
+    // to the first job that needed it, each object's eager refits to its first job. Objects
+    // in no job were not touched (their claims are clear, their eager refits wait).
+    let mut first_job = vec![None; objects.len()];
+    for (k, &(a, b)) in jobs.iter().enumerate().rev() {
+        first_job[a] = Some(k);
+        first_job[b] = Some(k);
+    }
+    for (o, first) in objects.iter_mut().zip(first_job) {
+        if let Some(k) = first {
+            o.h.drain_claims(|k, nodes| results[k].counters.bv_updates += nodes);
             results[k].counters.bv_updates += o.h.take_updates();
         }
     }
