@@ -25,7 +25,7 @@ use std::time::{Duration, Instant};
 use criterion::{criterion_group, criterion_main, Criterion};
 use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
 use dhcd::traverse::{broad_phase, narrow_phase};
-use dhcd::{collide_with, Counters, Hierarchy, Mesh, Method, Options, Par, Workspace};
+use dhcd::{collide_with, Counters, Hierarchy, Mesh, Method, ObjectId, Options, Par, Workspace};
 use parry3d::bounding_volume::Aabb as PAabb;
 use parry3d::math::{Pose, Vector};
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
@@ -369,9 +369,12 @@ fn bench_scene(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
     c.bench_function(&format!("frame/{}/{id}", scene.name), |b| {
         b.iter(|| {
             f = (f + 1) % FRAMES;
-            for (&id, p) in ids.iter().zip(&scene.frames[f]) {
-                world.update_positions(id, p).expect("valid positions");
-            }
+            let updates: Vec<(ObjectId, &[[f32; 3]])> = ids
+                .iter()
+                .zip(&scene.frames[f])
+                .map(|(&id, p)| (id, &p[..]))
+                .collect();
+            world.update_many(&updates, par).expect("valid positions");
             black_box(world.contacts(par).pairs.len())
         })
     });

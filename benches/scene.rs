@@ -50,9 +50,12 @@ fn bench(c: &mut Criterion) {
         g.bench_function(name, |b| {
             b.iter(|| {
                 frame = (frame + 1) % POSES;
-                for (k, pos) in poses[frame].iter().enumerate() {
-                    scene.update_positions(ObjectId(k as u64), pos).unwrap();
-                }
+                let updates: Vec<(ObjectId, &[[f32; 3]])> = poses[frame]
+                    .iter()
+                    .enumerate()
+                    .map(|(k, pos)| (ObjectId(k as u64), &pos[..]))
+                    .collect();
+                scene.update_many(&updates, par).unwrap();
                 scene.contacts(par).pairs.len()
             })
         });

@@ -47,6 +47,8 @@ pub enum Error {
     },
     #[error("no object with id {0} in the scene")]
     UnknownObject(u64),
+    #[error("object {0} is given more than once in one update")]
+    RepeatedObject(u64),
     #[error("unknown method {0:?} (expected one of {names})", names = crate::kinds::Method::names())]
     UnknownMethod(String),
     #[error("unknown refit mode {0:?} (expected lazy, eager or bottom-up)")]

@@ -368,6 +368,14 @@ impl<K: BvKind> Hierarchy<K> {
     /// refitted when first tested, otherwise all are refitted now. On error nothing changes.
     pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {
         check_positions(positions, self.tree.vertex_total())?;
+        self.apply_positions(positions);
+        Ok(())
+    }
+
+    /// [`Hierarchy::update_positions`] of positions the caller has checked
+    /// ([`check_positions`] against [`RegionTree::vertex_total`]).
+    pub(crate) fn apply_positions(&mut self, positions: &[[f32; 3]]) {
+        debug_assert!(check_positions(positions, self.tree.vertex_total()).is_ok());
         self.points.gather_from(positions, self.tree.vert_order());
         self.invalidate();
         match self.refit {
@@ -375,7 +383,6 @@ impl<K: BvKind> Hierarchy<K> {
             Refit::Eager => self.refit_all(),
             Refit::EagerBottomUp => self.refit_bottom_up(),
         }
-        Ok(())
     }
 
     /// Marks every bounding volume stale without moving anything (the next query refits

@@ -25,7 +25,7 @@ use crate::detail::{segment, OriginalCorners, Segment};
 use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, Options};
 use crate::kinds::{kinds, match_kind, with_kind};
-use crate::mesh::Mesh;
+use crate::mesh::{check_positions, Mesh};
 use crate::par::Par;
 use crate::traverse::{scene_query, Contacts, Workspace};
 
@@ -202,6 +202,46 @@ impl Scene {
         each!(&mut self.objects, v => {
             v[i].h.update_positions(positions)?;
             v[i].refresh_bounds();
+        });
+        Ok(())
+    }
+
+    /// New positions for several objects at once (each id at most once; each its mesh's
+    /// vertex order and count, finite), applied in parallel with `par`. Every update is
+    /// checked before any is applied: on error (an unknown or repeated id, a wrong count, a
+    /// non-finite position) nothing changes. The result is the same as one
+    /// [`Scene::update_positions`] per object, for every `par`.
+    pub fn update_many(&mut self, updates: &[(ObjectId, &[[f32; 3]])], par: Par) -> Result<()> {
+        let mut slot: Vec<Option<&[[f32; 3]]>> = vec![None; self.len()];
+        for &(id, positions) in updates {
+            let i = self.index(id)?;
+            if slot[i].replace(positions).is_some() {
+                return Err(Error::RepeatedObject(id.0));
+            }
+        }
+        each!(&mut self.objects, v => {
+            // The first failing object in scene order, whatever `par`.
+            let check = |(o, p): (&Object<_>, &Option<&[[f32; 3]]>)| match p {
+                Some(p) => check_positions(p, o.h.tree().vertex_total()),
+                None => Ok(()),
+            };
+            let checks: Vec<Result<()>> = if par.is_parallel() {
+                par.install(|| v.par_iter().zip(&slot).with_max_len(1).map(check).collect())
+            } else {
+                v.iter().zip(&slot).map(check).collect()
+            };
+            checks.into_iter().collect::<Result<()>>()?;
+            let apply = |(o, p): (&mut Object<_>, &Option<&[[f32; 3]]>)| {
+                if let Some(p) = p {
+                    o.h.apply_positions(p);
+                    o.refresh_bounds();
+                }
+            };
+            if par.is_parallel() {
+                par.install(|| v.par_iter_mut().zip(&slot).with_max_len(1).for_each(apply));
+            } else {
+                v.iter_mut().zip(&slot).for_each(apply);
+            }
         });
         Ok(())
     }

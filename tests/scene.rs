@@ -356,3 +356,113 @@ fn per_pair_counters_are_those_of_sequential_queries_in_job_order() {
         }
     }
 }
+
+/// `update_many` is one `update_positions` per object, for every thread count: same
+/// contacts, same counters, same root boxes.
+#[test]
+fn update_many_equals_one_update_per_object() {
+    let ball = icosphere(2, 1.0, [0.0; 3]);
+    let n = 6;
+    let build = || {
+        let mut scene = Scene::new(Method::Dh, Options::default());
+        let ids: Vec<ObjectId> = (0..n).map(|_| scene.add(&ball).unwrap()).collect();
+        scene.set_self_collision(ids[0], true).unwrap();
+        (scene, ids)
+    };
+    let (mut one_by_one, ids) = build();
+    let mut batched: Vec<(Scene, Par)> = [Par::Seq, Par::Rayon(2), Par::Rayon(3)]
+        .into_iter()
+        .map(|par| (build().0, par))
+        .collect();
+    for step in 0..3 {
+        let poses: Vec<Mesh> = (0..n)
+            .map(|k| {
+                posed(
+                    &ball,
+                    step as f32 + k as f32,
+                    0.3,
+                    [1.7 * k as f32, 0.0, 0.0],
+                )
+            })
+            .collect();
+        for (&id, p) in ids.iter().zip(&poses) {
+            one_by_one.update_positions(id, p.positions()).unwrap();
+        }
+        let reference = one_by_one.contacts(Par::Seq);
+        assert!(!reference.pairs.is_empty());
+        // Every other step, only some objects move.
+        let moved = if step == 1 { 0..3 } else { 0..n };
+        for (scene, par) in &mut batched {
+            let updates: Vec<(ObjectId, &[[f32; 3]])> = moved
+                .clone()
+                .map(|k| (ids[k], poses[k].positions()))
+                .collect();
+            scene.update_many(&updates, *par).unwrap();
+            if step == 1 {
+                for k in 3..n {
+                    scene
+                        .update_positions(ids[k], poses[k].positions())
+                        .unwrap();
+                }
+            }
+            for &id in &ids {
+                assert_eq!(scene.bounds(id), one_by_one.bounds(id));
+            }
+            assert_eq!(scene.contacts(Par::Seq).pairs, reference.pairs, "{par:?}");
+        }
+    }
+}
+
+/// A bad entry anywhere in an `update_many` is a typed error and no object moves.
+#[test]
+fn update_many_checks_everything_before_changing_anything() {
+    let ball = icosphere(1, 1.0, [0.0; 3]);
+    let mut scene = Scene::new(Method::Aabb, Options::default());
+    let a = scene.add(&ball).unwrap();
+    let b = scene.add(&ball).unwrap();
+    let moved = dhcd::shapes::translated(ball.positions(), [1.5, 0.0, 0.0]);
+    let mut nan = moved.clone();
+    nan[3][1] = f32::NAN;
+    let short = &moved[..moved.len() - 1];
+    let before = (scene.bounds(a).unwrap(), scene.bounds(b).unwrap());
+    for par in [Par::Seq, Par::Rayon(2)] {
+        type Update<'a> = (ObjectId, &'a [[f32; 3]]);
+        let cases: [(&[Update], Error); 4] = [
+            (
+                &[(a, &moved), (ObjectId(9), &moved)],
+                Error::UnknownObject(9),
+            ),
+            (
+                &[(b, &moved), (a, &moved), (b, &moved)],
+                Error::RepeatedObject(1),
+            ),
+            (
+                &[(a, &moved), (b, short)],
+                Error::WrongVertexCount {
+                    expected: moved.len(),
+                    got: moved.len() - 1,
+                },
+            ),
+            (
+                &[(a, &moved), (b, &nan)],
+                Error::NonFinite {
+                    vertex: 3,
+                    position: nan[3],
+                },
+            ),
+        ];
+        for (updates, error) in cases {
+            let got = scene.update_many(updates, par).unwrap_err();
+            // NaN != NaN: compare the messages.
+            assert_eq!(got.to_string(), error.to_string(), "{par:?}");
+            assert_eq!(
+                (scene.bounds(a).unwrap(), scene.bounds(b).unwrap()),
+                before,
+                "nothing moved ({par:?}, {error})"
+            );
+        }
+    }
+    scene.update_many(&[(b, &moved)], Par::Rayon(2)).unwrap();
+    assert_ne!(scene.bounds(b).unwrap(), before.1);
+    assert!(!scene.contacts(Par::Seq).pairs.is_empty());
+}
