@@ -83,6 +83,11 @@
 #define DHCD_ERR_PANIC -8
 
 /**
+ * The same object id given more than once in one `dhcd_scene_update_many`.
+ */
+#define DHCD_ERR_REPEATED_OBJECT -9
+
+/**
  * Opaque: one object's hierarchy (and its query scratch).
  */
 typedef struct DhcdHierarchy DhcdHierarchy;
@@ -275,6 +280,27 @@ int dhcd_scene_update_positions(struct DhcdScene *s,
                                 uint64_t id,
                                 const float *positions,
                                 size_t vertex_count);
+
+/**
+ * New positions of several objects in one call: entry `k` gives object `ids[k]` the
+ * `3 * vertex_counts[k]` floats at `positions[k]` (as in `dhcd_scene_update_positions`).
+ * `ids`, `positions` and `vertex_counts` hold `count` elements each; each id at most once.
+ * Every entry is checked before any is applied: on error (a null or misaligned array, an
+ * unknown id, an id given twice (`DHCD_ERR_REPEATED_OBJECT`), a wrong vertex count, a
+ * non-finite coordinate) no object changes. The result equals one
+ * `dhcd_scene_update_positions` per entry, for every `threads`. With `count == 0` it does
+ * nothing and the arrays may be NULL.
+ *
+ * # Safety
+ * `s` null or a live handle; `ids`, `positions` and `vertex_counts` hold `count` elements
+ * each, and each non-null `positions[k]` holds `3 * vertex_counts[k]` floats.
+ */
+int dhcd_scene_update_many(struct DhcdScene *s,
+                           const uint64_t *ids,
+                           const float *const *positions,
+                           const size_t *vertex_counts,
+                           size_t count,
+                           uint32_t threads);
 
 /**
  * Turns an object's self-collision on (non-zero) or off.

@@ -55,6 +55,8 @@ pub const DHCD_ERR_UNKNOWN_OBJECT: c_int = -6;
 pub const DHCD_ERR_STALE_CONTACT: c_int = -7;
 /// A bug in dhcd (a caught panic).
 pub const DHCD_ERR_PANIC: c_int = -8;
+/// The same object id given more than once in one `dhcd_scene_update_many`.
+pub const DHCD_ERR_REPEATED_OBJECT: c_int = -9;
 
 // The kinds' numbers (`DHCD_METHOD_DH` = 0, ...) are not constants here: they are
 // `Method::code()`, from the library's table of kinds, and the header's `DHCD_METHOD_*`
@@ -132,6 +134,7 @@ impl From<Error> for Fail {
             Error::WrongVertexCount { .. } => DHCD_ERR_LENGTH_MISMATCH,
             Error::MethodMismatch { .. } => DHCD_ERR_WRONG_KIND,
             Error::UnknownObject(_) => DHCD_ERR_UNKNOWN_OBJECT,
+            Error::RepeatedObject(_) => DHCD_ERR_REPEATED_OBJECT,
             Error::StaleContact { .. } => DHCD_ERR_STALE_CONTACT,
             Error::InvalidLevels { .. }
             | Error::UnknownMethod(_)
@@ -630,6 +633,58 @@ pub unsafe extern "C" fn dhcd_scene_update_positions(
             )
         };
         Ok(s.scene.update_positions(ObjectId(id), p)?)
+    })
+}
+
+/// New positions of several objects in one call: entry `k` gives object `ids[k]` the
+/// `3 * vertex_counts[k]` floats at `positions[k]` (as in `dhcd_scene_update_positions`).
+/// `ids`, `positions` and `vertex_counts` hold `count` elements each; each id at most once.
+/// Every entry is checked before any is applied: on error (a null or misaligned array, an
+/// unknown id, an id given twice (`DHCD_ERR_REPEATED_OBJECT`), a wrong vertex count, a
+/// non-finite coordinate) no object changes. The result equals one
+/// `dhcd_scene_update_positions` per entry, for every `threads`. With `count == 0` it does
+/// nothing and the arrays may be NULL.
+///
+/// # Safety
+/// `s` null or a live handle; `ids`, `positions` and `vertex_counts` hold `count` elements
+/// each, and each non-null `positions[k]` holds `3 * vertex_counts[k]` floats.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_update_many(
+    s: *mut DhcdScene,
+    ids: *const u64,
+    positions: *const *const f32,
+    vertex_counts: *const usize,
+    count: usize,
+    threads: u32,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract.
+        let s = unsafe { handle(s, "scene")? };
+        let par = par(threads)?;
+        if count == 0 {
+            return Ok(());
+        }
+        // SAFETY: the three arrays hold `count` elements (caller's contract).
+        let (ids, ptrs, counts) = unsafe {
+            (
+                slice(ids, count, "ids")?,
+                slice(positions, count, "positions")?,
+                slice(vertex_counts, count, "vertex_counts")?,
+            )
+        };
+        let updates = ids
+            .iter()
+            .zip(ptrs.iter().zip(counts))
+            .enumerate()
+            .map(|(k, (&id, (&p, &n)))| {
+                // SAFETY: `positions[k]` holds `3 * vertex_counts[k]` floats (caller's
+                // contract).
+                let p = unsafe { self::positions(p, n) }
+                    .map_err(|Fail(code, msg)| Fail(code, format!("update {k}: {msg}")))?;
+                Ok((ObjectId(id), p))
+            })
+            .collect::<Result<Vec<_>, Fail>>()?;
+        Ok(s.scene.update_many(&updates, par)?)
     })
 }
 

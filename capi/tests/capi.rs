@@ -213,6 +213,284 @@ fn scene_equals_rust_scene() {
     }
 }
 
+/// A scene's contacts: its sorted quadruples and counters.
+///
+/// # Safety
+/// `s` a live scene handle.
+unsafe fn scene_contacts(s: *mut DhcdScene) -> (Vec<[u64; 4]>, DhcdCounters) {
+    let mut c = DhcdSceneContacts {
+        pairs: null_mut(),
+        count: 0,
+        counters: DhcdCounters::default(),
+    };
+    // SAFETY: live handle (caller's contract), writable output.
+    unsafe {
+        assert_eq!(
+            dhcd_scene_contacts(s, 1, &mut c),
+            DHCD_OK,
+            "{}",
+            last_error()
+        );
+        let pairs = if c.count == 0 {
+            Vec::new()
+        } else {
+            std::slice::from_raw_parts(c.pairs, 4 * c.count)
+                .chunks(4)
+                .map(|q| [q[0], q[1], q[2], q[3]])
+                .collect()
+        };
+        let counters = c.counters;
+        dhcd_scene_contacts_free(&mut c);
+        (pairs, counters)
+    }
+}
+
+/// A new scene of `n` copies of `m` (self-collision on for the first); their ids.
+fn scene_of(m: &Mesh, n: usize) -> (*mut DhcdScene, Vec<u64>) {
+    let (p, t) = flat(m);
+    let mut s = null_mut();
+    // SAFETY: arrays of the stated lengths, writable outputs.
+    unsafe {
+        assert_eq!(dhcd_scene_new(DHCD_METHOD_DH, 4, &mut s), DHCD_OK);
+        let ids = (0..n)
+            .map(|k| {
+                let mut id = u64::MAX;
+                let rc = dhcd_scene_add(
+                    s,
+                    p.as_ptr(),
+                    m.vertex_count(),
+                    t.as_ptr(),
+                    m.triangle_count(),
+                    (k == 0) as i32,
+                    &mut id,
+                );
+                assert_eq!(rc, DHCD_OK, "{}", last_error());
+                id
+            })
+            .collect();
+        (s, ids)
+    }
+}
+
+/// `dhcd_scene_update_many` is one `dhcd_scene_update_positions` per entry, for every
+/// thread count and entry order: same contacts, same counters.
+#[test]
+fn scene_update_many_equals_one_update_per_object() {
+    let ball = icosphere(2, 1.0, [0.0; 3]);
+    let n = 5;
+    let (one_by_one, ids) = scene_of(&ball, n);
+    let batched: Vec<(*mut DhcdScene, u32)> = [1, 2, 0]
+        .into_iter()
+        .map(|t| (scene_of(&ball, n).0, t))
+        .collect();
+    for step in 0..3 {
+        let poses: Vec<Vec<f32>> = (0..n)
+            .map(|k| {
+                let p = wave(
+                    ball.positions(),
+                    step as f32 + k as f32,
+                    0.3,
+                    [1.7 * k as f32, 0.0, 0.0],
+                );
+                p.into_iter().flatten().collect()
+            })
+            .collect();
+        // SAFETY: live handles; every array holds the stated number of elements.
+        unsafe {
+            for (&id, p) in ids.iter().zip(&poses) {
+                let rc =
+                    dhcd_scene_update_positions(one_by_one, id, p.as_ptr(), ball.vertex_count());
+                assert_eq!(rc, DHCD_OK, "{}", last_error());
+            }
+            let reference = scene_contacts(one_by_one);
+            assert!(!reference.0.is_empty());
+            // Step 1 moves only some objects (the others by single updates), given in
+            // reverse order; the other steps move all of them in id order.
+            let moved: Vec<usize> = if step == 1 {
+                vec![3, 1, 0]
+            } else {
+                (0..n).collect()
+            };
+            let entry_ids: Vec<u64> = moved.iter().map(|&k| ids[k]).collect();
+            let entry_ptrs: Vec<*const f32> = moved.iter().map(|&k| poses[k].as_ptr()).collect();
+            let entry_counts = vec![ball.vertex_count(); moved.len()];
+            for &(s, threads) in &batched {
+                let rc = dhcd_scene_update_many(
+                    s,
+                    entry_ids.as_ptr(),
+                    entry_ptrs.as_ptr(),
+                    entry_counts.as_ptr(),
+                    moved.len(),
+                    threads,
+                );
+                assert_eq!(rc, DHCD_OK, "{}", last_error());
+                for k in (0..n).filter(|k| !moved.contains(k)) {
+                    let rc = dhcd_scene_update_positions(
+                        s,
+                        ids[k],
+                        poses[k].as_ptr(),
+                        ball.vertex_count(),
+                    );
+                    assert_eq!(rc, DHCD_OK, "{}", last_error());
+                }
+                assert_eq!(
+                    scene_contacts(s),
+                    reference,
+                    "step {step}, threads {threads}"
+                );
+            }
+        }
+    }
+    // SAFETY: live handles, released once.
+    unsafe {
+        dhcd_scene_free(one_by_one);
+        for (s, _) in batched {
+            dhcd_scene_free(s);
+        }
+    }
+}
+
+/// A bad entry anywhere in a `dhcd_scene_update_many`, or a bad argument, is its error
+/// code and no object moves; `count == 0` is a no-op, whatever the arrays.
+#[test]
+fn scene_update_many_bad_entry_changes_nothing() {
+    let ball = icosphere(1, 1.0, [0.0; 3]);
+    let nv = ball.vertex_count();
+    let (s, ids) = scene_of(&ball, 2);
+    let (a, b) = (ids[0], ids[1]);
+    // Moving either object this far ends every contact between them.
+    let far: Vec<f32> = translated(ball.positions(), [10.0, 0.0, 0.0])
+        .into_iter()
+        .flatten()
+        .collect();
+    let mut nan = far.clone();
+    nan[3 * 5 + 1] = f32::NAN;
+    let bytes = [0u8; 64];
+    // SAFETY: live handle; arrays hold the stated number of elements or are null (or, for
+    // the misaligned one, are rejected before being read).
+    unsafe {
+        let before = scene_contacts(s);
+        assert!(before.0.iter().any(|q| q[0] == a && q[2] == b));
+        let odd = bytes.as_ptr().add(1).cast::<f32>();
+        type Entry = (u64, *const f32, usize);
+        let f = far.as_ptr();
+        let cases: [(&[Entry], u32, i32, &str); 9] = [
+            (
+                &[(a, f, nv), (9, f, nv)],
+                1,
+                DHCD_ERR_UNKNOWN_OBJECT,
+                "no object with id 9",
+            ),
+            (
+                &[(b, f, nv), (a, f, nv), (b, f, nv)],
+                2,
+                DHCD_ERR_REPEATED_OBJECT,
+                "object 1 is given more than once",
+            ),
+            (
+                &[(a, f, nv), (b, f, nv - 1)],
+                1,
+                DHCD_ERR_LENGTH_MISMATCH,
+                "vertices",
+            ),
+            (
+                &[(a, f, nv), (b, nan.as_ptr(), nv)],
+                2,
+                DHCD_ERR_INVALID_MESH,
+                "non-finite",
+            ),
+            (
+                &[(a, f, nv), (b, null(), nv)],
+                1,
+                DHCD_ERR_NULL,
+                "update 1: positions",
+            ),
+            (
+                &[(a, f, nv), (b, odd, 1)],
+                1,
+                DHCD_ERR_INVALID_ARGUMENT,
+                "aligned",
+            ),
+            (
+                &[(a, f, nv), (b, f, usize::MAX / 2)],
+                1,
+                DHCD_ERR_INVALID_ARGUMENT,
+                "too many",
+            ),
+            (
+                &[(a, f, nv)],
+                u32::MAX,
+                DHCD_ERR_INVALID_ARGUMENT,
+                "thread count",
+            ),
+            (
+                &[(a, f, nv), (a, nan.as_ptr(), nv - 1)],
+                1,
+                DHCD_ERR_REPEATED_OBJECT,
+                "object 0",
+            ),
+        ];
+        for (entries, threads, code, message) in cases {
+            let ids: Vec<u64> = entries.iter().map(|e| e.0).collect();
+            let ptrs: Vec<*const f32> = entries.iter().map(|e| e.1).collect();
+            let counts: Vec<usize> = entries.iter().map(|e| e.2).collect();
+            let rc = dhcd_scene_update_many(
+                s,
+                ids.as_ptr(),
+                ptrs.as_ptr(),
+                counts.as_ptr(),
+                entries.len(),
+                threads,
+            );
+            assert_eq!(rc, code, "{message}: {}", last_error());
+            assert!(
+                last_error().contains(message),
+                "{message}: {}",
+                last_error()
+            );
+            assert_eq!(scene_contacts(s).0, before.0, "nothing moved ({message})");
+        }
+        // Null arrays with entries, a null scene.
+        let (id, ptr, count) = ([a], [far.as_ptr()], [nv]);
+        for (ids, ptrs, counts, what) in [
+            (null(), ptr.as_ptr(), count.as_ptr(), "ids"),
+            (id.as_ptr(), null(), count.as_ptr(), "positions"),
+            (id.as_ptr(), ptr.as_ptr(), null(), "vertex_counts"),
+        ] {
+            assert_eq!(
+                dhcd_scene_update_many(s, ids, ptrs, counts, 1, 1),
+                DHCD_ERR_NULL
+            );
+            assert!(last_error().starts_with(what), "{}", last_error());
+        }
+        assert_eq!(
+            dhcd_scene_update_many(null_mut(), id.as_ptr(), ptr.as_ptr(), count.as_ptr(), 1, 1),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(scene_contacts(s).0, before.0, "nothing moved");
+        // No entries: nothing to do, whatever the arrays.
+        assert_eq!(
+            dhcd_scene_update_many(s, null(), null(), null(), 0, 2),
+            DHCD_OK
+        );
+        assert_eq!(
+            dhcd_scene_update_many(null_mut(), null(), null(), null(), 0, 1),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(scene_contacts(s).0, before.0);
+        // A good call still works after the errors.
+        assert_eq!(
+            dhcd_scene_update_many(s, id.as_ptr(), ptr.as_ptr(), count.as_ptr(), 1, 2),
+            DHCD_OK
+        );
+        assert!(
+            scene_contacts(s).0.iter().all(|q| q[0] == q[2]),
+            "a moved away"
+        );
+        dhcd_scene_free(s);
+    }
+}
+
 #[test]
 fn bad_arguments_are_error_codes() {
     let m = icosphere(1, 1.0, [0.0; 3]);

@@ -19,7 +19,18 @@ n threads; results never depend on it.
 """
 
 import os
-from typing import Any, Dict, Literal, Optional, Set, Tuple, Union, overload
+from typing import (
+    Any,
+    Dict,
+    Iterable,
+    Literal,
+    Mapping,
+    Optional,
+    Set,
+    Tuple,
+    Union,
+    overload,
+)
 
 import numpy as np
 import numpy.typing as npt
@@ -118,6 +129,19 @@ class Scene:
         """Adds an object (self-collision off); returns its id."""
     def update(self, id: Union[int, str], vertices: Vertices) -> None:
         """New vertex positions of an object; on error nothing changes."""
+    def update_many(
+        self,
+        updates: Union[
+            Mapping[Union[int, str], Vertices], Iterable[Tuple[Union[int, str], Vertices]]
+        ],
+        threads: int = 1,
+    ) -> None:
+        """New vertex positions of several objects in one call: ``{id: vertices}`` or
+        ``[(id, vertices), ...]`` (ids or names, each object at most once; vertices as in
+        ``update``), applied in parallel with ``threads``. Every entry is checked before
+        any is applied: an unknown id, an object given twice, a wrong shape or vertex count,
+        a non-finite coordinate raise ``ValueError`` and nothing changes (an entry that is
+        not a pair raises ``TypeError``). The result equals one ``update`` per entry."""
     def remove(self, id: Union[int, str]) -> None: ...
     def set_self_collision(self, id: Union[int, str], on: bool) -> None:
         """With ``on``, ``contacts`` also reports the object's own intersecting faces."""

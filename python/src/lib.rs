@@ -14,9 +14,9 @@ use std::path::PathBuf;
 use dhcd::{AnyHierarchy, Counters, Error, Mesh, Method, ObjectId, Options, Par, Workspace};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyDict, PyList, PyMapping, PyString, PyTuple};
 
 /// A library error as a Python exception: `OSError` (`FileNotFoundError` for a missing file)
 /// when a file cannot be read (or is not a regular file, or is over the size limit),
@@ -447,6 +447,30 @@ impl Scene {
     }
 }
 
+/// Entry `k` of `Scene.update_many`: an `(id or name, vertices)` tuple or list.
+fn update_pair<'py>(
+    entry: &Bound<'py, PyAny>,
+    k: usize,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let items = if let Ok(t) = entry.cast::<PyTuple>() {
+        t.as_sequence().clone()
+    } else if let Ok(l) = entry.cast::<PyList>() {
+        l.as_sequence().clone()
+    } else {
+        let kind = entry.get_type().name()?;
+        return Err(PyTypeError::new_err(format!(
+            "update {k} must be an (id, vertices) pair, got {kind}"
+        )));
+    };
+    if items.len()? != 2 {
+        return Err(value_error(format!(
+            "update {k} must be an (id, vertices) pair, got {} items",
+            items.len()?
+        )));
+    }
+    Ok((items.get_item(0)?, items.get_item(1)?))
+}
+
 #[pymethods]
 impl Scene {
     #[new]
@@ -499,6 +523,41 @@ impl Scene {
         let positions = v.as_slice()?;
         let scene = &mut self.scene;
         py.detach(|| scene.update_positions(id, positions))
+            .map_err(to_py)
+    }
+
+    /// New vertex positions of several objects at once: `updates` a mapping
+    /// `{id or name: vertices}` or an iterable of `(id or name, vertices)` pairs.
+    #[pyo3(
+        signature = (updates, threads = None),
+        text_signature = "(self, updates, threads=1)"
+    )]
+    fn update_many(
+        &mut self,
+        py: Python<'_>,
+        updates: &Bound<'_, PyAny>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let par = par(threads)?;
+        let entries = match updates.cast::<PyMapping>() {
+            Ok(m) => m.items()?.into_any(),
+            Err(_) => updates.clone(),
+        };
+        // The vertex arrays stay borrowed (alive, read-only) until the update is done.
+        let mut ids = Vec::new();
+        let mut vertices = Vec::new();
+        for (k, entry) in entries.try_iter()?.enumerate() {
+            let (id, v) = update_pair(&entry?, k)?;
+            ids.push(self.object(&id)?);
+            vertices.push(Vertices::new(&v)?);
+        }
+        let updates = ids
+            .into_iter()
+            .zip(&vertices)
+            .map(|(id, v)| Ok((id, v.as_slice()?)))
+            .collect::<PyResult<Vec<_>>>()?;
+        let scene = &mut self.scene;
+        py.detach(|| scene.update_many(&updates, par))
             .map_err(to_py)
     }
 

@@ -88,6 +88,8 @@ def test_bad_threads(threads):
         a.self_collide(threads=threads)
     with pytest.raises(ValueError, match="threads"):
         dhcd.Scene().contacts(threads=threads)
+    with pytest.raises(ValueError, match="threads"):
+        dhcd.Scene().update_many({}, threads=threads)
 
 
 def test_bad_update_changes_nothing():
@@ -189,6 +191,8 @@ def test_scene_bad_ids_and_names():
         with pytest.raises(ValueError):
             s.update(bad, V)
         with pytest.raises(ValueError):
+            s.update_many({bad: V})
+        with pytest.raises(ValueError):
             s.remove(bad)
         with pytest.raises(ValueError):
             s.set_self_collision(bad, True)
@@ -196,6 +200,10 @@ def test_scene_bad_ids_and_names():
         s.remove(1.5)
     with pytest.raises(ValueError):
         s.update("ball", V[:3])
+    with pytest.raises(ValueError):
+        s.update_many([("ball", V[:3])])
+    with pytest.raises(ValueError, match="more than once"):
+        s.update_many([("ball", V), (i, V)])
     s.remove("ball")
     with pytest.raises(ValueError):
         s.update(i, V)

@@ -2,6 +2,7 @@
 ids and names."""
 
 import numpy as np
+import pytest
 
 import dhcd
 from meshes import brute_force_pairs, brute_force_self_pairs, folded_grid, icosphere, wave
@@ -47,3 +48,94 @@ def test_scene_self_collision_and_removal():
     assert len(s.contacts().pairs) == 0
     s.remove(sheet)
     assert len(s) == 0 and len(s.contacts().pairs) == 0
+
+
+def test_update_many_equals_separate_updates():
+    v, f = icosphere(2)
+    n = 5
+    for method in dhcd._dhcd.METHODS:
+        one_by_one = dhcd.Scene(method=method)
+        batched = [(dhcd.Scene(method=method), t) for t in [None, 1, 2, 0]]
+        for s in [one_by_one] + [s for s, _ in batched]:
+            for k in range(n):
+                s.add(v, f, name=f"ball{k}")
+            s.set_self_collision(0, True)
+        for step in range(4):
+            poses = [wave(v, step + k, 0.3, (1.7 * k, 0.0, 0.0)) for k in range(n)]
+            # Step 1 moves only some objects, the others by single updates.
+            moved = [3, 1, 0] if step == 1 else list(range(n))
+            for k in range(n):
+                one_by_one.update(k, poses[k])
+            expected = one_by_one.contacts()
+            assert len(expected.pairs) > 0
+            for s, threads in batched:
+                if step == 0:  # a dict by id
+                    updates = {k: poses[k] for k in moved}
+                elif step == 1:  # a list of pairs, by id and by name, in any order
+                    updates = [(k if k % 2 else f"ball{k}", poses[k]) for k in moved]
+                elif step == 2:  # a generator of pairs; float64 and nested lists convert
+                    updates = ((k, poses[k].astype(np.float64)) for k in moved)
+                else:  # a dict by name, vertices as lists
+                    updates = {f"ball{k}": poses[k].tolist() for k in moved}
+                s.update_many(updates, threads=threads)
+                for k in set(range(n)) - set(moved):
+                    s.update(k, poses[k])
+                got = s.contacts()
+                np.testing.assert_array_equal(got.pairs, expected.pairs)
+                assert got.counters == expected.counters, (method, step, threads)
+        # No updates: nothing changes.
+        for s, threads in batched:
+            before = s.contacts().pairs
+            s.update_many({}, threads=threads)
+            s.update_many([])
+            np.testing.assert_array_equal(s.contacts().pairs, before)
+
+
+def test_update_many_bad_entry_changes_nothing():
+    v, f = icosphere(1)
+    s = dhcd.Scene()
+    a = s.add(v, f, name="a")
+    b = s.add(v, f, name="b")
+    before = s.contacts().pairs
+    assert len(before) > 0
+    far = v + np.float32(10.0)  # moving either object this far ends every contact
+    nan = far.copy()
+    nan[5, 1] = np.nan
+    bad_entries = [
+        (9, far),
+        ("nobody", far),
+        (-1, far),
+        (2**64, far),
+        (b, far[:-1]),
+        (b, nan),
+        (b, far[:, :2]),
+        (b, "not an array"),
+    ]
+    for entry in bad_entries:
+        # The same exception as `update` with that entry, and nothing moved.
+        with pytest.raises(ValueError) as single:
+            s.update(*entry)
+        with pytest.raises(ValueError) as many:
+            s.update_many([(a, far), entry])
+        assert str(many.value) == str(single.value)
+        with pytest.raises(ValueError):
+            s.update_many([(a, far), entry], threads=2)
+        np.testing.assert_array_equal(s.contacts().pairs, before)
+    # An object given twice, also by id and by name.
+    for updates in [[(a, far), (b, far), (a, far)], {b: far, "b": far}, [("a", far), (0, nan)]]:
+        with pytest.raises(ValueError, match="more than once"):
+            s.update_many(updates)
+        np.testing.assert_array_equal(s.contacts().pairs, before)
+    # Entries that are not (id, vertices) pairs; bad thread counts.
+    with pytest.raises(TypeError):
+        s.update_many([(a, far), a])
+    with pytest.raises(TypeError):
+        s.update_many(a)
+    with pytest.raises(ValueError, match="pair"):
+        s.update_many([(a, far, far)])
+    with pytest.raises(ValueError, match="threads"):
+        s.update_many({a: far}, threads=-1)
+    np.testing.assert_array_equal(s.contacts().pairs, before)
+    # A good update still works.
+    s.update_many([(a, far)], threads=2)
+    assert len(s.contacts().pairs) == 0

@@ -181,6 +181,8 @@ int main(void) {
   OK(dhcd_scene_add(scene, g, nv, gt, nt, 1, &id2));
   CHECK(id0 == 0 && id1 == 1 && id2 == 2);
   OK(dhcd_scene_update_positions(scene, id1, h, nv));
+  float *crossing = malloc(3 * nv * sizeof(float)); /* h's pose, before moving it away */
+  memcpy(crossing, h, 3 * nv * sizeof(float));
   for (size_t v = 0; v < nv; v++) h[3 * v + 0] += 100.0f;
   OK(dhcd_scene_update_positions(scene, id2, h, nv));
   DhcdSceneContacts sc = {0};
@@ -199,7 +201,36 @@ int main(void) {
   OK(dhcd_scene_contacts(scene, 1, &sc));
   CHECK(sc.count == 0);
   dhcd_scene_contacts_free(&sc);
+
+  /* Several objects in one call: entry k gives object ids[k] the vertex_counts[k] vertices
+   * at poses[k]. Every entry is checked before any is applied, so a repeated or removed id
+   * moves nothing. Then id2 takes the crossing pose (and id0 its flat one again): id0 and
+   * id2 have exactly the contacts id0 and id1 had. */
+  const uint64_t ids[2] = {id2, id0};
+  const float *poses[2] = {crossing, g};
+  const size_t vertex_counts[2] = {nv, nv};
+  const uint64_t twice[2] = {id2, id2}, removed[2] = {id2, id1};
+  CHECK(dhcd_scene_update_many(scene, twice, poses, vertex_counts, 2, 1) ==
+        DHCD_ERR_REPEATED_OBJECT);
+  printf("expected error: %s\n", dhcd_last_error_message());
+  CHECK(dhcd_scene_update_many(scene, removed, poses, vertex_counts, 2, 1) ==
+        DHCD_ERR_UNKNOWN_OBJECT);
+  OK(dhcd_scene_contacts(scene, 1, &sc));
+  CHECK(sc.count == 0); /* nothing moved */
+  dhcd_scene_contacts_free(&sc);
+  OK(dhcd_scene_update_many(scene, ids, poses, vertex_counts, 2, 2));
+  OK(dhcd_scene_update_many(scene, NULL, NULL, NULL, 0, 1)); /* no entries: nothing to do */
+  OK(dhcd_scene_contacts(scene, 1, &sc));
+  CHECK(sc.count == first.count);
+  for (size_t k = 0; k < sc.count && k < first.count; k++) {
+    const uint64_t *q = sc.pairs + 4 * k;
+    CHECK(q[0] == id0 && q[2] == id2);
+    CHECK(q[1] == first.pairs[2 * k] && q[3] == first.pairs[2 * k + 1]);
+  }
+  printf("scene after dhcd_scene_update_many: %zu contacts\n", sc.count);
+  dhcd_scene_contacts_free(&sc);
   dhcd_scene_free(scene);
+  free(crossing);
 
   dhcd_contacts_free(&first);
   free(g);
