@@ -728,6 +728,62 @@ fn given_bounds_change_no_verdict_on_all_backends() {
     on_all_backends!(check_given_bounds);
 }
 
+/// Two strips along x, in order (as lane-ordered leaves are): a flat triangle at `x = i`
+/// meets the posts at `x = t` within 0.15 of it, so each lane vector of one strip meets a few
+/// rows of the other and the per-vector row culling removes the rest. Some posts are NaN
+/// (their boxes must not poison a vector's box). Verdicts equal the scalar reference for
+/// every pairing, every block size and both orders, and the expected crossings are found.
+fn check_vector_culling<S: Simd>(simd: S) {
+    let flat = |x: f32| [[x - 0.3, 0.0, 0.0], [x + 0.3, 0.0, 0.0], [x, 1.0, 0.0]];
+    let post = |x: f32| [[x, 0.5, -1.0], [x, 0.5, 1.0], [x + 0.1, 0.7, 1.0]];
+    let nan = [[f32::NAN; 3]; 3];
+    for n in block_sizes(S::F32_LANES, narrow::MAX_ROW) {
+        let flats: Vec<_> = (0..n).map(|i| flat(0.5 * i as f32)).collect();
+        let posts: Vec<_> = (0..n)
+            .map(|t| {
+                if t % 7 == 3 {
+                    nan
+                } else {
+                    post(0.5 * t as f32 + 0.05)
+                }
+            })
+            .collect();
+        // Flat i meets post t iff t == i (0.05 apart; neighbours are 0.5 apart), NaN aside.
+        let crossings = (0..n).filter(|t| t % 7 != 3).count();
+        let mixed: Vec<_> = (0..n)
+            .map(|t| if t % 2 == 0 { flats[t] } else { posts[t] })
+            .collect();
+        let (a, b, m) = (
+            Tris::new(&flats, 0),
+            Tris::new(&posts, 1000),
+            Tris::new(&mixed, 0),
+        );
+        let cases = [
+            (&a, &b, Some(crossings)),
+            (&b, &a, Some(crossings)),
+            (&m, &m, None),
+        ];
+        for (x, y, expected) in cases {
+            for pairing in PAIRINGS {
+                let mut want = vec![narrow::Row::default(); n];
+                let mut got = want.clone();
+                narrow::leaf_contacts_scalar(x.soa(), n, y.soa(), n, pairing, &mut want);
+                narrow::leaf_contacts_with(simd, x.soa(), n, y.soa(), n, pairing, &mut got);
+                assert_eq!(got, want, "{simd:?} n={n} {pairing:?}");
+                let found: u32 = got.iter().map(|r| r.candidates().count_ones()).sum();
+                if let (Some(e), narrow::Pairing::All) = (expected, pairing) {
+                    assert_eq!(found as usize, e, "{simd:?} n={n}: the crossings");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn vector_culling_loses_no_pair_on_all_backends() {
+    on_all_backends!(check_vector_culling);
+}
+
 /// A box that misses a triangle would lose its pairs: debug builds refuse it.
 #[test]
 #[cfg_attr(not(debug_assertions), ignore = "the check is a debug assertion")]
