@@ -668,7 +668,7 @@ fn devices_fifos_and_links_to_them_are_refused_without_reading() {
         (PathBuf::from("/dev/urandom"), "a character device"),
         (link, "a character device"),
         (fifo, "a FIFO"),
-        (dir.clone(), "a directory"),
+        (dir.to_path_buf(), "a directory"),
     ];
     for (path, kind) in cases {
         let shown = path.display().to_string();

@@ -12,7 +12,7 @@ use crate::support;
 fn write_obj(name: &str, mesh: &Mesh) -> PathBuf {
     static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
     let path = DIR
-        .get_or_init(|| support::temp_dir("self-scene-cli"))
+        .get_or_init(|| support::temp_dir("self-scene-cli").keep())
         .join(name);
     support::write_obj(mesh, &path);
     path
