@@ -15,5 +15,6 @@ mod scene;
 mod self_collision;
 mod shared_pairs;
 mod support;
+mod temp_dir;
 mod threads;
 mod tree;

@@ -1,40 +1,6 @@
 //! Helpers shared by the library's suites.
 
-use std::path::PathBuf;
-
-/// A fresh, empty directory for one test, removed when the test passes (kept for inspection
-/// when it panics). `name` must be unique across the suites (tests run in parallel and this
-/// removes what was there); the process id keeps concurrent runs apart.
-pub fn temp_dir(name: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("dhcd-test-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
-}
-
-/// See [`temp_dir`].
-pub struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = std::path::Path;
-    fn deref(&self) -> &std::path::Path {
-        &self.0
-    }
-}
-
-impl AsRef<std::path::Path> for TempDir {
-    fn as_ref(&self) -> &std::path::Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        if !std::thread::panicking() {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
+pub use crate::temp_dir::temp_dir;
 
 /// Counts the bytes each thread has allocated and not freed, so that a test can bound the
 /// memory a call takes ([`peak_bytes`]) without depending on what other tests do meanwhile.

@@ -10,9 +10,10 @@ use crate::support;
 
 /// Writes `mesh` as `name` in this suite's directory.
 fn write_obj(name: &str, mesh: &Mesh) -> PathBuf {
-    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    // A static is never dropped: the suite's directory stays.
+    static DIR: std::sync::OnceLock<support::TempDir> = std::sync::OnceLock::new();
     let path = DIR
-        .get_or_init(|| support::temp_dir("self-scene-cli").keep())
+        .get_or_init(|| support::temp_dir("self-scene-cli"))
         .join(name);
     support::write_obj(mesh, &path);
     path

@@ -5,7 +5,8 @@ mod bench;
 mod cli;
 mod cli_collide;
 mod experiment;
-// The mesh fixtures and the mutation fuzzer are the library's (one copy of each).
+// The mesh fixtures, the mutation fuzzer and the temporary directories are the library's
+// (one copy of each).
 #[path = "../../tests/fixtures.rs"]
 mod fixtures;
 mod fuzz;
@@ -14,3 +15,5 @@ mod hostile;
 mod mutation;
 mod sim;
 mod support;
+#[path = "../../tests/temp_dir.rs"]
+mod temp_dir;

@@ -1,53 +1,11 @@
 //! Helpers shared by the suites that run the `dhcd` binary on files.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use dhcd::Mesh;
 
-/// A fresh, empty directory for one test, removed when the test passes (kept for inspection
-/// when it panics). `name` must be unique across the suites (tests run in parallel and this
-/// removes what was there); the process id keeps concurrent runs apart.
-pub fn temp_dir(name: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("dhcd-test-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
-}
-
-/// See [`temp_dir`].
-pub struct TempDir(PathBuf);
-
-impl TempDir {
-    /// The path, no longer removed (a directory shared by a suite's tests through a static,
-    /// which is never dropped anyway).
-    pub fn keep(self) -> PathBuf {
-        let path = self.0.clone();
-        std::mem::forget(self);
-        path
-    }
-}
-
-impl std::ops::Deref for TempDir {
-    type Target = std::path::Path;
-    fn deref(&self) -> &std::path::Path {
-        &self.0
-    }
-}
-
-impl AsRef<std::path::Path> for TempDir {
-    fn as_ref(&self) -> &std::path::Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        if !std::thread::panicking() {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
+pub use crate::temp_dir::{temp_dir, TempDir};
 
 /// Writes `mesh` as OBJ with the library's own writer.
 pub fn write_obj(mesh: &Mesh, path: &Path) {
