@@ -3,7 +3,10 @@
 //!
 //! Ids:
 //! - `frame/<scene>/<impl>`: a whole step, `impl` in `dhcd-dh`, `dhcd-sphere`, `dhcd-aabb`,
-//!   `parry3d`, plus `dhcd-dh-t1` / `dhcd-dh-t2` on `pawns8` (the `Scene` API, object pairs in parallel, `Par::Rayon(1)` / `Rayon(2)`);
+//!   `parry3d`, plus `dhcd-dh-t1` / `dhcd-dh-t2` on `pawns8` (the `Scene` API, object pairs in parallel, `Par::Rayon(1)` / `Rayon(2)`),
+//!   and `dhcd-dh-front` / `dhcd-aabb-front` (each pair's workspace with front tracking:
+//!   every query starts from the last one's traversal front; the setup prints the BV tests
+//!   and refits of one cycle from the root and from the front);
 //! - `hier/<scene>/<impl>`: refit + traversal down to leaf pairs only (no triangle tests;
 //!   for dhcd `broad_phase`, which also refreshes the leaves' cached triangle boxes);
 //! - `narrow/<scene>/dhcd-dh`: the exact narrow phase alone on the leaf pairs of a frame
@@ -147,13 +150,22 @@ struct DhcdWorld<K: BvKind> {
 }
 
 impl<K: BvKind> DhcdWorld<K> {
-    fn new(scene: &Scene) -> Self {
+    /// `front`: each pair's workspace tracks its traversal front.
+    fn new(scene: &Scene, front: bool) -> Self {
         let hs = scene
             .meshes
             .iter()
             .map(|m| Hierarchy::<K>::new(m, Options::default()).expect("hierarchy"))
             .collect();
-        let ws = scene.pairs.iter().map(|_| Workspace::default()).collect();
+        let ws = scene
+            .pairs
+            .iter()
+            .map(|_| {
+                let mut ws = Workspace::default();
+                ws.set_front_tracking(front);
+                ws
+            })
+            .collect();
         Self { hs, ws }
     }
 
@@ -274,9 +286,9 @@ fn check(scene: &Scene) {
     } else {
         &[0, 5, 11]
     };
-    let mut dh = DhcdWorld::<Dh>::new(scene);
-    let mut sp = DhcdWorld::<Sphere>::new(scene);
-    let mut bx = DhcdWorld::<Aabb>::new(scene);
+    let mut dh = DhcdWorld::<Dh>::new(scene, false);
+    let mut sp = DhcdWorld::<Sphere>::new(scene, false);
+    let mut bx = DhcdWorld::<Aabb>::new(scene, false);
     let mut parry = ParryWorld::new(scene);
     let mut totals = [Counters::default(); 3];
     let mut parry_total = 0u64;
@@ -295,7 +307,7 @@ fn check(scene: &Scene) {
             totals[2] += c.counters;
         });
         // Threads give the same contacts and counters.
-        let mut dh2 = DhcdWorld::<Dh>::new(scene);
+        let mut dh2 = DhcdWorld::<Dh>::new(scene, false);
         dh2.step(scene, f, Par::Rayon(2), |k, c| {
             assert_eq!(c.pairs, got[0][k])
         });
@@ -345,8 +357,8 @@ fn check(scene: &Scene) {
     );
 }
 
-fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
-    let mut w = DhcdWorld::<K>::new(scene);
+fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par, front: bool) {
+    let mut w = DhcdWorld::<K>::new(scene, front);
     let mut f = 0;
     c.bench_function(&format!("frame/{}/{id}", scene.name), |b| {
         b.iter(|| {
@@ -356,6 +368,44 @@ fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
             black_box(n)
         })
     });
+}
+
+/// Prints the work of one cycle (after one to settle) from the root and from the front, and
+/// asserts both find the same contacts.
+fn front_counters<K: BvKind>(scene: &Scene) {
+    let sum = |front: bool| {
+        let mut w = DhcdWorld::<K>::new(scene, front);
+        let mut contacts = Vec::new();
+        let mut total = Counters::default();
+        for cycle in 0..2 {
+            for f in 0..FRAMES {
+                w.step(scene, f, Par::Seq, |_, c| {
+                    if cycle == 1 {
+                        total += c.counters;
+                        contacts.push(c.pairs.clone());
+                    }
+                });
+            }
+        }
+        (total, contacts)
+    };
+    let ((root, want), (front, got)) = (sum(false), sum(true));
+    assert!(
+        got == want,
+        "[{}] contacts from the front differ",
+        scene.name
+    );
+    eprintln!(
+        "[{}] {:?}, one cycle from the root / from the front: BV tests {} / {}, BV updates {} / {}, triangle pairs {} / {}",
+        scene.name,
+        K::METHOD,
+        root.bv_tests,
+        front.bv_tests,
+        root.bv_updates,
+        front.bv_updates,
+        root.prim_tests,
+        front.prim_tests
+    );
 }
 
 fn bench_scene(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
@@ -387,9 +437,13 @@ fn frame(c: &mut Criterion) {
         if checks {
             check(scene);
         }
-        bench_kind::<Dh>(c, scene, "dhcd-dh", Par::Seq);
-        bench_kind::<Sphere>(c, scene, "dhcd-sphere", Par::Seq);
-        bench_kind::<Aabb>(c, scene, "dhcd-aabb", Par::Seq);
+        bench_kind::<Dh>(c, scene, "dhcd-dh", Par::Seq, false);
+        bench_kind::<Sphere>(c, scene, "dhcd-sphere", Par::Seq, false);
+        bench_kind::<Aabb>(c, scene, "dhcd-aabb", Par::Seq, false);
+        front_counters::<Dh>(scene);
+        front_counters::<Aabb>(scene);
+        bench_kind::<Dh>(c, scene, "dhcd-dh-front", Par::Seq, true);
+        bench_kind::<Aabb>(c, scene, "dhcd-aabb-front", Par::Seq, true);
         let mut p = ParryWorld::new(scene);
         let mut f = 0;
         c.bench_function(&format!("frame/{}/parry3d", scene.name), |b| {
@@ -407,7 +461,7 @@ fn frame(c: &mut Criterion) {
             bench_scene(c, scene, "dhcd-dh-t2", Par::Rayon(2));
         }
 
-        let mut w = DhcdWorld::<Dh>::new(scene);
+        let mut w = DhcdWorld::<Dh>::new(scene, false);
         c.bench_function(&format!("hier/{}/dhcd-dh", scene.name), |b| {
             b.iter(|| {
                 f = (f + 1) % FRAMES;

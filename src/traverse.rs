@@ -18,10 +18,19 @@
 //! list. Lazy refit happens in the same walk: a sibling group is fitted right before its
 //! first test in a step (see [`LazyTiles`](dhcd_kernels::lazy::LazyTiles)), whichever thread gets there first.
 //!
+//! Frame-to-frame coherence (opt-in, [`Workspace::set_front_tracking`]): the walk records
+//! its *front*, the node pairs where it stopped (the lanes of each wide test that failed, and
+//! the overlapping leaf pairs). Those pairs partition every pair of leaves the query could
+//! reach, so the next query of the same trees can start from them instead of the root: each
+//! entry is tested again, descended where it now overlaps, and re-recorded. The front is a
+//! starting point, never a filter, so the contacts are those of a walk from the root.
+//!
 //! Parallelism: the walk is expanded breadth-first on the calling thread until there are
 //! enough pairs to share, then each pair is walked depth-first as a rayon task. Every pair
 //! of nodes is visited at most once whatever the split, so the counters are identical for
 //! every thread count, and the contacts are sorted.
+
+use std::sync::Arc;
 
 use pulp::{Simd, WithSimd};
 use rayon::prelude::*;
@@ -32,6 +41,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::narrow::leaves::{counted_pairs, leaf_pair, LeafSide, Leaves};
 use crate::par::Par;
+use crate::tree::RegionTree;
 use dhcd_kernels::narrow::{Row, MAX_ROW};
 
 /// Result of a query: contacts as `[triangle of A, triangle of B]` in the caller's original
@@ -48,14 +58,80 @@ pub const DEFAULT_GRAIN: usize = 1;
 /// Pairs the breadth-first start aims for, per thread, before the parallel walk.
 const SEEDS_PER_THREAD: usize = 64;
 
+/// Most entries a front may hold (16 bytes each: 16 MiB); a walk that would record more
+/// drops its front, and the next query starts from the root.
+pub const FRONT_MAX_ENTRIES: usize = 1 << 20;
+
+/// A front replayed into more than this many times the entries of the last front recorded
+/// from the root is dropped (the next query starts from the root again): a front only
+/// descends, so after contacts end it would keep testing pairs a walk from the root skips.
+const FRONT_REGROWTH: usize = 2;
+
 /// Reusable scratch of a query (the walk's stack, the leaf pairs of [`broad_phase`]): keep
-/// one per thread to avoid allocating every step. Also holds the parallel grain.
+/// one per thread to avoid allocating every step. Also holds the parallel grain and, with
+/// [`Workspace::set_front_tracking`], the last query's traversal front.
 #[derive(Clone, Debug)]
 pub struct Workspace {
     pub(crate) grain: usize,
     stack: Vec<[u32; 2]>,
     seeds: Vec<[u32; 2]>,
     leaves: Vec<[u32; 2]>,
+    front: Front,
+}
+
+/// Where the last query of a workspace stopped (see the module documentation).
+#[derive(Clone, Debug, Default)]
+struct Front {
+    tracking: bool,
+    /// The trees (and query kind) `entries` partitions; `None`: no front kept.
+    owner: Option<FrontOwner>,
+    entries: Vec<FrontEntry>,
+    /// The buffer the next front is recorded into (the one before `entries`).
+    spare: Vec<FrontEntry>,
+    /// Entries of the last front recorded from the root.
+    fresh_len: usize,
+}
+
+#[derive(Clone, Debug)]
+struct FrontOwner {
+    a: Arc<RegionTree>,
+    b: Arc<RegionTree>,
+    self_query: bool,
+}
+
+/// One entry of a front: pairs of nodes the last query stopped at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FrontEntry {
+    /// Node `a_node` of `a` against the sibling group `b_group` of `b`, on the set bits of
+    /// `lanes` (group positions): those pairs were tested and did not overlap.
+    NodeVsGroup {
+        a_node: u32,
+        b_group: u32,
+        lanes: u32,
+    },
+    /// The sibling group `a_group` of `a` against node `b_node` of `b`, likewise.
+    GroupVsNode {
+        a_group: u32,
+        b_node: u32,
+        lanes: u32,
+    },
+    /// An overlapping leaf pair (narrow-tested; `x == y` in a self query: a leaf with itself).
+    Leaves { x: u32, y: u32 },
+}
+
+impl Front {
+    /// Whether the kept front partitions the pairs of a query on trees `a`, `b`.
+    fn fits(&self, a: &Arc<RegionTree>, b: &Arc<RegionTree>, self_query: bool) -> bool {
+        self.owner.as_ref().is_some_and(|o| {
+            Arc::ptr_eq(&o.a, a) && Arc::ptr_eq(&o.b, b) && o.self_query == self_query
+        })
+    }
+
+    fn clear(&mut self) {
+        self.owner = None;
+        self.entries.clear();
+        self.fresh_len = 0;
+    }
 }
 
 impl Default for Workspace {
@@ -73,7 +149,39 @@ impl Workspace {
             stack: Vec::new(),
             seeds: Vec::new(),
             leaves: Vec::new(),
+            front: Front::default(),
         }
+    }
+
+    /// Frame-to-frame coherence (off by default). When on, each query records where its
+    /// traversal stopped (its *front*: the node pairs whose test failed and the overlapping
+    /// leaf pairs), and the next query on the same trees (same `Arc<RegionTree>`s, same query
+    /// kind) starts from that front instead of the root: it tests each front pair again,
+    /// descends where it now overlaps and records the new front. The contacts are exactly
+    /// those of a walk from the root (the front pairs partition all the pairs of leaves);
+    /// `bv_tests` and `bv_updates` count the work done, which is less above the front, and
+    /// are the same for every thread count. A query on other trees starts from the root.
+    /// A front is at most [`FRONT_MAX_ENTRIES`] entries (16 bytes each), else dropped; one that
+    /// has grown to twice the size of the last front recorded from the root is dropped too
+    /// (the next query starts from the root). Turning it off drops the front.
+    ///
+    /// Measured (docs/PERFORMANCE.md): the walk above the leaf pairs is a few percent of a
+    /// step on real meshes, so the saving is small; it is opt-in for that reason.
+    pub fn set_front_tracking(&mut self, on: bool) {
+        self.front.tracking = on;
+        if !on {
+            self.front.clear();
+        }
+    }
+
+    /// Whether [`set_front_tracking`](Self::set_front_tracking) is on.
+    pub fn front_tracking(&self) -> bool {
+        self.front.tracking
+    }
+
+    /// Entries of the kept front (0 when none is kept).
+    pub fn front_len(&self) -> usize {
+        self.front.entries.len()
     }
 
     /// The overlapping leaf pairs (node ids) found by the last [`broad_phase`].
@@ -103,6 +211,7 @@ pub fn collide_with<K: BvKind>(
         self_query: false,
         narrow: true,
         job: None,
+        track: ws.front_tracking(),
     };
     let mut c = par.install(|| walk.run(ws, par.is_parallel()));
     c.counters.bv_updates += updates;
@@ -149,6 +258,7 @@ pub fn self_collide_with<K: BvKind>(
         self_query: true,
         narrow: true,
         job: None,
+        track: ws.front_tracking(),
     };
     let mut c = par.install(|| walk.run(ws, par.is_parallel()));
     c.counters.bv_updates += updates;
@@ -173,6 +283,7 @@ pub(crate) fn scene_query<K: BvKind>(
         self_query,
         narrow: true,
         job: Some(job),
+        track: false,
     };
     par.install(|| walk.run(ws, par.is_parallel()))
 }
@@ -196,6 +307,7 @@ pub fn broad_phase<K: BvKind>(
         self_query: false,
         narrow: false,
         job: None,
+        track: ws.front_tracking(),
     }
     .broad(ws, par, updates)
 }
@@ -214,6 +326,7 @@ pub fn self_broad_phase<K: BvKind>(h: &mut Hierarchy<K>, ws: &mut Workspace, par
         self_query: true,
         narrow: false,
         job: None,
+        track: ws.front_tracking(),
     }
     .broad(ws, par, updates)
 }
@@ -247,6 +360,7 @@ pub fn narrow_phase<K: BvKind>(
         self_query: false,
         narrow: true,
         job: None,
+        track: false,
     };
     let run = |chunk: &[[u32; 2]]| {
         let mut out = Output::default();
@@ -281,15 +395,20 @@ struct Walk<'h, K: BvKind> {
     /// A scene job's index: fitted groups are claimed for it ([`Hierarchy::group_for_job`])
     /// and credited by the scene, not counted here.
     job: Option<usize>,
+    /// Record the front ([`Workspace::set_front_tracking`]).
+    track: bool,
 }
 
-/// What a walk produces: contacts, counters, and (broad phase only) leaf pairs; with the
-/// narrow phase's scratch: its rows, and the last leaf of each side (the walk often meets
-/// one leaf against several in a row).
+/// What a walk produces: contacts, counters, (broad phase only) leaf pairs and (front
+/// tracking only) the front; with the narrow phase's scratch: its rows, and the last leaf of
+/// each side (the walk often meets one leaf against several in a row).
 struct Output<'h> {
     pairs: Vec<[u32; 2]>,
     counters: Counters,
     leaves: Vec<[u32; 2]>,
+    front: Vec<FrontEntry>,
+    /// The front outgrew [`FRONT_MAX_ENTRIES`] (and was cleared).
+    front_overflow: bool,
     rows: [Row; MAX_ROW],
     last: [Option<(usize, LeafSide<'h>)>; 2],
 }
@@ -300,6 +419,8 @@ impl Default for Output<'_> {
             pairs: Vec::new(),
             counters: Counters::default(),
             leaves: Vec::new(),
+            front: Vec::new(),
+            front_overflow: false,
             rows: [Row::default(); MAX_ROW],
             last: [None, None],
         }
@@ -311,8 +432,31 @@ impl Output<'_> {
         self.last = [None, None];
         self.pairs.extend_from_slice(&other.pairs);
         self.leaves.extend_from_slice(&other.leaves);
+        self.front_overflow |= other.front_overflow;
+        if self.front.len() + other.front.len() > FRONT_MAX_ENTRIES {
+            self.front_overflow = true;
+        }
+        if self.front_overflow {
+            self.front = Vec::new();
+        } else {
+            self.front.extend_from_slice(&other.front);
+        }
         self.counters += other.counters;
         self
+    }
+
+    /// Records a front entry, within [`FRONT_MAX_ENTRIES`].
+    #[inline(always)]
+    fn record(&mut self, entry: FrontEntry) {
+        if self.front_overflow {
+            return;
+        }
+        if self.front.len() < FRONT_MAX_ENTRIES {
+            self.front.push(entry);
+        } else {
+            self.front_overflow = true;
+            self.front = Vec::new();
+        }
     }
 
     fn finish(mut self) -> Contacts {
@@ -342,6 +486,19 @@ impl<'h, K: BvKind> Walk<'h, K> {
         } else {
             1
         };
+        if self.track {
+            out.front = std::mem::take(&mut ws.front.spare);
+            out.front.clear();
+        }
+        let (ta, tb) = (self.a.tree(), self.b.tree());
+        if self.track && ws.front.fits(ta, tb, self.self_query) {
+            let entries = std::mem::take(&mut ws.front.entries);
+            out = self.replay(&entries, &mut ws.stack, threads, ws.grain, out);
+            ws.front.entries = entries;
+            self.keep_front(&mut ws.front, &mut out, false);
+            ws.leaves = std::mem::take(&mut out.leaves);
+            return out.finish();
+        }
         let seed_target = if threads > 1 {
             SEEDS_PER_THREAD * threads
         } else {
@@ -375,8 +532,75 @@ impl<'h, K: BvKind> Walk<'h, K> {
             out.leaves
                 .sort_unstable_by_key(|&[a, b]| (u64::from(a) << 32) | u64::from(b));
         }
+        if self.track {
+            self.keep_front(&mut ws.front, &mut out, true);
+        }
         ws.leaves = std::mem::take(&mut out.leaves);
         out.finish()
+    }
+
+    /// The walk from a kept front `entries` (on `threads` threads, in tasks of at least
+    /// `grain` entries), adding to `out`.
+    fn replay(
+        &self,
+        entries: &[FrontEntry],
+        stack: &mut Vec<[u32; 2]>,
+        threads: usize,
+        grain: usize,
+        mut out: Output<'h>,
+    ) -> Output<'h> {
+        if threads <= 1 {
+            dhcd_kernels::arch().dispatch(ReplayOp {
+                walk: self,
+                entries,
+                stack,
+                out: &mut out,
+            });
+        } else {
+            let chunk = entries
+                .len()
+                .div_ceil(SEEDS_PER_THREAD * threads)
+                .max(grain);
+            let part = entries
+                .par_chunks(chunk)
+                .fold(Output::default, |mut o, chunk| {
+                    let mut stack = Vec::new();
+                    dhcd_kernels::arch().dispatch(ReplayOp {
+                        walk: self,
+                        entries: chunk,
+                        stack: &mut stack,
+                        out: &mut o,
+                    });
+                    o
+                })
+                .reduce(Output::default, Output::merge);
+            out = out.merge(part);
+        }
+        // The collected leaf pairs (broad phase) in one order whatever the thread count.
+        out.leaves
+            .sort_unstable_by_key(|&[a, b]| (u64::from(a) << 32) | u64::from(b));
+        out
+    }
+
+    /// Keeps the front `out` recorded as `front` for the next query, or drops it (outgrown;
+    /// see [`Workspace::set_front_tracking`]). `fresh`: recorded by a walk from the root.
+    fn keep_front(&self, front: &mut Front, out: &mut Output<'h>, fresh: bool) {
+        let entries = std::mem::take(&mut out.front);
+        let len = entries.len();
+        let outgrown = !fresh && len > FRONT_REGROWTH * front.fresh_len.max(1);
+        if out.front_overflow || outgrown {
+            front.clear();
+            return;
+        }
+        if fresh {
+            front.fresh_len = len;
+        }
+        front.spare = std::mem::replace(&mut front.entries, entries);
+        front.owner = Some(FrontOwner {
+            a: Arc::clone(self.a.tree()),
+            b: Arc::clone(self.b.tree()),
+            self_query: self.self_query,
+        });
     }
 
     /// Sibling group `g` of `h` (one of this walk's two hierarchies), fitted first if stale:
@@ -403,7 +627,15 @@ impl<'h, K: BvKind> Walk<'h, K> {
         }
         let (ba, bb) = (self.group(self.a, 0, out), self.group(self.b, 0, out));
         out.counters.bv_tests += 1;
-        (K::test(simd, ba, 0, bb, 1) != 0).then_some([0, 0])
+        let overlap = K::test(simd, ba, 0, bb, 1) != 0;
+        if self.track && !overlap {
+            out.record(FrontEntry::NodeVsGroup {
+                a_node: 0,
+                b_group: 0,
+                lanes: 1,
+            });
+        }
+        overlap.then_some([0, 0])
     }
 
     /// Expands one overlapping pair: pushes its overlapping children pairs to `next`, or
@@ -432,7 +664,11 @@ impl<'h, K: BvKind> Walk<'h, K> {
                     // The whole group in one test (aligned loads); the pairs j <= i are
                     // masked off and not counted.
                     out.counters.bv_tests += (m - i - 1) as u64;
-                    let mut bits = K::test(simd, block, i, block, m) & !((2u32 << i) - 1);
+                    let row = !((2u32 << i) - 1);
+                    let mut bits = K::test(simd, block, i, block, m) & row;
+                    if self.track {
+                        self.record_misses(out, ci, g, row & lanes(m), bits, true);
+                    }
                     while bits != 0 {
                         let k = bits.trailing_zeros() as usize;
                         bits &= bits - 1;
@@ -457,6 +693,9 @@ impl<'h, K: BvKind> Walk<'h, K> {
             let nodes = ta.group_nodes(g);
             out.counters.bv_tests += nodes.len() as u64;
             let mut bits = K::test(simd, by, iy, children, nodes.len());
+            if self.track {
+                self.record_misses(out, y as u32, g, lanes(nodes.len()), bits, false);
+            }
             while bits != 0 {
                 let k = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
@@ -468,6 +707,9 @@ impl<'h, K: BvKind> Walk<'h, K> {
             let nodes = tb.group_nodes(g);
             out.counters.bv_tests += nodes.len() as u64;
             let mut bits = K::test(simd, bx, ix, children, nodes.len());
+            if self.track {
+                self.record_misses(out, x as u32, g, lanes(nodes.len()), bits, true);
+            }
             while bits != 0 {
                 let k = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
@@ -476,9 +718,120 @@ impl<'h, K: BvKind> Walk<'h, K> {
         }
     }
 
+    /// Records the lanes of `tested` that missed (`hits` clear) as a front entry: node `node`
+    /// against group `group` of the other side; `node_in_a`: the node is `a`'s.
+    #[inline(always)]
+    fn record_misses(
+        &self,
+        out: &mut Output<'h>,
+        node: u32,
+        group: usize,
+        tested: u32,
+        hits: u32,
+        node_in_a: bool,
+    ) {
+        let lanes = tested & !hits;
+        if lanes == 0 {
+            return;
+        }
+        let group = group as u32;
+        out.record(if node_in_a {
+            FrontEntry::NodeVsGroup {
+                a_node: node,
+                b_group: group,
+                lanes,
+            }
+        } else {
+            FrontEntry::GroupVsNode {
+                a_group: group,
+                b_node: node,
+                lanes,
+            }
+        });
+    }
+
+    /// One entry of a kept front: its pairs tested again; those that now overlap are walked
+    /// depth-first (on `stack`), the others recorded again.
+    #[inline(always)]
+    fn replay_entry<S: Simd>(
+        &self,
+        simd: S,
+        entry: FrontEntry,
+        stack: &mut Vec<[u32; 2]>,
+        out: &mut Output<'h>,
+    ) {
+        let (ta, tb) = (self.a.tree(), self.b.tree());
+        stack.clear();
+        match entry {
+            FrontEntry::NodeVsGroup {
+                a_node,
+                b_group,
+                lanes,
+            } => {
+                let gx = ta.group_of(a_node as usize);
+                let bx = self.group(self.a, gx, out);
+                let ix = a_node as usize - ta.group_nodes(gx).start;
+                let (g, nodes) = (b_group as usize, tb.group_nodes(b_group as usize));
+                let children = self.group(self.b, g, out);
+                out.counters.bv_tests += u64::from(lanes.count_ones());
+                let mut bits = K::test(simd, bx, ix, children, nodes.len()) & lanes;
+                self.record_misses(out, a_node, g, lanes, bits, true);
+                while bits != 0 {
+                    let k = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    stack.push([a_node, (nodes.start + k) as u32]);
+                }
+            }
+            FrontEntry::GroupVsNode {
+                a_group,
+                b_node,
+                lanes,
+            } => {
+                let gy = tb.group_of(b_node as usize);
+                let by = self.group(self.b, gy, out);
+                let iy = b_node as usize - tb.group_nodes(gy).start;
+                let (g, nodes) = (a_group as usize, ta.group_nodes(a_group as usize));
+                let children = self.group(self.a, g, out);
+                out.counters.bv_tests += u64::from(lanes.count_ones());
+                let mut bits = K::test(simd, by, iy, children, nodes.len()) & lanes;
+                self.record_misses(out, b_node, g, lanes, bits, false);
+                while bits != 0 {
+                    let k = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    stack.push([(nodes.start + k) as u32, b_node]);
+                }
+            }
+            FrontEntry::Leaves { x, y } => {
+                let (x, y) = (x as usize, y as usize);
+                if self.self_query && x == y {
+                    return self.leaves(simd, x, y, out);
+                }
+                let (gx, gy) = (ta.group_of(x), tb.group_of(y));
+                let bx = self.group(self.a, gx, out);
+                let by = self.group(self.b, gy, out);
+                let (ix, iy) = (x - ta.group_nodes(gx).start, y - tb.group_nodes(gy).start);
+                out.counters.bv_tests += 1;
+                let lane = 1u32 << iy;
+                if K::test(simd, bx, ix, by, iy + 1) & lane != 0 {
+                    return self.leaves(simd, x, y, out);
+                }
+                self.record_misses(out, x as u32, gy, lane, 0, true);
+            }
+        }
+        while let Some(pair) = stack.pop() {
+            self.expand(simd, pair, stack, out);
+        }
+    }
+
     /// An overlapping leaf pair: the narrow phase now, or collected (broad phase).
     #[inline(always)]
     fn leaves<S: Simd>(&self, simd: S, x: usize, y: usize, out: &mut Output<'h>) {
+        if self.track {
+            out.record(FrontEntry::Leaves {
+                x: x as u32,
+                y: y as u32,
+            });
+        }
         if !self.narrow {
             out.leaves.push([x as u32, y as u32]);
             return;
@@ -621,6 +974,31 @@ impl<K: BvKind> WithSimd for WalkOp<'_, '_, K> {
     }
 }
 
+/// The walk from the entries of a kept front ([`Walk::replay`]).
+struct ReplayOp<'w, 'h, K: BvKind> {
+    walk: &'w Walk<'h, K>,
+    entries: &'w [FrontEntry],
+    stack: &'w mut Vec<[u32; 2]>,
+    out: &'w mut Output<'h>,
+}
+
+impl<K: BvKind> WithSimd for ReplayOp<'_, '_, K> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        for &entry in self.entries {
+            self.walk.replay_entry(simd, entry, self.stack, self.out);
+        }
+    }
+}
+
+/// The lanes `0..n` of a wide test.
+#[inline(always)]
+fn lanes(n: usize) -> u32 {
+    debug_assert!(n <= 32);
+    (((1u64) << n) - 1) as u32
+}
+
 /// The narrow phase of given leaf pairs ([`narrow_phase`]).
 struct NarrowOp<'w, 'h, K: BvKind> {
     walk: &'w Walk<'h, K>,
@@ -635,5 +1013,42 @@ impl<K: BvKind> WithSimd for NarrowOp<'_, '_, K> {
         for &[x, y] in self.leaves {
             self.walk.leaves(simd, x as usize, y as usize, self.out);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn recorded(n: usize) -> Output<'static> {
+        let mut out = Output::default();
+        for k in 0..n as u32 {
+            out.record(FrontEntry::Leaves { x: k, y: k });
+        }
+        out
+    }
+
+    /// A front that would pass its bound is dropped (memory freed), not grown, and stays
+    /// dropped; two parts within the bound whose sum is not merge into a dropped front.
+    #[test]
+    fn a_front_past_its_bound_is_dropped() {
+        let mut out = recorded(FRONT_MAX_ENTRIES);
+        assert!(!out.front_overflow);
+        assert_eq!(out.front.len(), FRONT_MAX_ENTRIES);
+        out.record(FrontEntry::Leaves { x: 0, y: 0 });
+        assert!(out.front_overflow);
+        assert_eq!(out.front.capacity(), 0);
+        out.record(FrontEntry::Leaves { x: 0, y: 0 });
+        assert!(out.front.is_empty());
+
+        let half = FRONT_MAX_ENTRIES / 2;
+        let over = recorded(half + 1).merge(recorded(half));
+        assert!(over.front_overflow && over.front.is_empty());
+        let full = recorded(half).merge(recorded(half));
+        assert!(!full.front_overflow);
+        assert_eq!(full.front.len(), FRONT_MAX_ENTRIES);
+        assert_eq!(full.front[half], FrontEntry::Leaves { x: 0, y: 0 });
+        let dropped = recorded(1).merge(over);
+        assert!(dropped.front_overflow && dropped.front.is_empty());
     }
 }

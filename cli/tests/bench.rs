@@ -198,6 +198,75 @@ fn broad_only_counts_what_the_full_step_counts_without_contacts() {
     assert!(text.contains("(broad phase only)"), "{text}");
 }
 
+/// `--front` starts each query from the last one's traversal front: the same contacts as
+/// from the root on every frame and pass, for every method, self and two-object benches, one
+/// and two threads; fewer BV tests once a front is kept.
+#[test]
+fn front_tracking_finds_the_same_contacts() {
+    let dir = temp_dir("bench-front");
+    let frames = crossing_sheets(&dir, 3);
+    let (moving, fixed) = passing_sphere(&dir, 3);
+    let fixed = fixed.to_str().unwrap();
+    let mut self_args = vec!["bench", "self"];
+    self_args.extend(strs(&frames));
+    let mut collide_args = vec!["bench", "collide", "--a"];
+    collide_args.extend(strs(&moving));
+    collide_args.extend(["--b", fixed]);
+    for base in [self_args, collide_args] {
+        let mut root = base.clone();
+        root.extend([
+            "--method",
+            "all",
+            "--repeat",
+            "3",
+            "--json",
+            "--leaf-size",
+            "4",
+        ]);
+        let root = json_of(&root);
+        for threads in ["1", "2"] {
+            let mut front = base.clone();
+            front.extend([
+                "--method",
+                "all",
+                "--repeat",
+                "3",
+                "--json",
+                "--leaf-size",
+                "4",
+            ]);
+            front.extend(["--front", "--threads", threads]);
+            let front = json_of(&front);
+            let (mut tests_root, mut tests_front) = (0, 0);
+            for (r, f) in root
+                .as_array()
+                .unwrap()
+                .iter()
+                .zip(front.as_array().unwrap())
+            {
+                assert_eq!(
+                    (r["front"].clone(), f["front"].clone()),
+                    (false.into(), true.into())
+                );
+                for (rf, ff) in r["frames"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .zip(f["frames"].as_array().unwrap())
+                {
+                    assert_eq!(rf["contacts"], ff["contacts"], "{r} {f}");
+                    tests_root += rf["counters"]["bv_tests"].as_u64().unwrap();
+                    tests_front += ff["counters"]["bv_tests"].as_u64().unwrap();
+                }
+            }
+            assert!(tests_front < tests_root, "{tests_front} vs {tests_root}");
+        }
+    }
+    let out = dhcd(&["bench", "self", frames[0].to_str().unwrap(), "--front"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("from the last front"), "{text}");
+}
+
 #[test]
 fn text_output_names_the_build_and_step_times_and_every_frame() {
     let dir = temp_dir("bench-text");

@@ -71,6 +71,11 @@ struct Opts {
     /// the narrow phase would test). A full step's time minus this one is the narrow phase's.
     #[arg(long)]
     broad_only: bool,
+    /// Frame-to-frame coherence: start each query from where the last one's traversal
+    /// stopped (its front) instead of the root. Same contacts; the counters count the work
+    /// done, so they can differ from pass to pass (the last pass's are printed).
+    #[arg(long)]
+    front: bool,
     /// Passes over the frames (each pass times one step per frame).
     #[arg(long, default_value_t = 5)]
     repeat: usize,
@@ -86,7 +91,8 @@ struct Run {
     method: Method,
     build_ms: f64,
     steps_ms: Vec<f64>,
-    /// Per frame: contacts and counters (of the last pass; every pass gives the same).
+    /// Per frame: contacts and counters (of the last pass; every pass gives the same unless
+    /// `--front`).
     frames: Vec<Counters>,
 }
 
@@ -132,6 +138,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         };
         let build_ms = t.elapsed().as_secs_f64() * 1e3;
         let mut ws = Workspace::default();
+        ws.set_front_tracking(opts.front);
         let mut steps_ms = Vec::with_capacity(opts.repeat * steps);
         let mut frames = vec![Counters::default(); steps];
         for _ in 0..opts.repeat {
@@ -164,10 +171,8 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         });
     }
     let out = if opts.json {
-        let values: Vec<serde_json::Value> = runs
-            .iter()
-            .map(|r| to_json(r, threads, opts.broad_only))
-            .collect();
+        let values: Vec<serde_json::Value> =
+            runs.iter().map(|r| to_json(r, threads, opts)).collect();
         let v = if methods.len() == 1 {
             values.into_iter().next().unwrap_or_default()
         } else {
@@ -215,14 +220,15 @@ fn counters_json(c: &Counters) -> serde_json::Value {
     })
 }
 
-/// `{"method", "threads", "broad_only", "build_ms", "step_ms": {"median", "min"}, "frames":
-/// [{"contacts", "counters"}...]}`.
-fn to_json(r: &Run, threads: usize, broad_only: bool) -> serde_json::Value {
+/// `{"method", "threads", "broad_only", "front", "build_ms", "step_ms": {"median", "min"},
+/// "frames": [{"contacts", "counters"}...]}`.
+fn to_json(r: &Run, threads: usize, opts: &Opts) -> serde_json::Value {
     let (median, min) = median_min(&r.steps_ms);
     json!({
         "method": r.method.name(),
         "threads": threads,
-        "broad_only": broad_only,
+        "broad_only": opts.broad_only,
+        "front": opts.front,
         "build_ms": r.build_ms,
         "step_ms": { "median": median, "min": min },
         "frames": r.frames.iter().map(|c| json!({
@@ -245,9 +251,14 @@ fn text(runs: &[Run], opts: &Opts, threads: usize, a: &[Mesh], b: Option<&[Mesh]
     };
     let _ = writeln!(
         s,
-        "{what}{}, {} steps per pass, {} passes, {} thread(s)",
+        "{what}{}{}, {} steps per pass, {} passes, {} thread(s)",
         if opts.broad_only {
             " (broad phase only)"
+        } else {
+            ""
+        },
+        if opts.front {
+            " from the last front"
         } else {
             ""
         },
