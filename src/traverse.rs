@@ -119,6 +119,9 @@ enum FrontEntry {
     Leaves { x: u32, y: u32 },
 }
 
+// FRONT_MAX_ENTRIES and LIMITS.md count 16 bytes an entry.
+const _: () = assert!(std::mem::size_of::<FrontEntry>() == 16);
+
 impl Front {
     /// Whether the kept front partitions the pairs of a query on trees `a`, `b`.
     fn fits(&self, a: &Arc<RegionTree>, b: &Arc<RegionTree>, self_query: bool) -> bool {
@@ -165,8 +168,10 @@ impl Workspace {
     /// has grown to twice the size of the last front recorded from the root is dropped too
     /// (the next query starts from the root). Turning it off drops the front.
     ///
-    /// Measured (docs/PERFORMANCE.md): the walk above the leaf pairs is a few percent of a
-    /// step on real meshes, so the saving is small; it is opt-in for that reason.
+    /// Opt-in because it does not pay everywhere (docs/PERFORMANCE.md, twelfth sitting):
+    /// 14% faster on the icosphere frames with DH (the upper levels are not refitted), within
+    /// a few percent on the real frames, 8-10% slower on the pawns with boxes (most object
+    /// pairs are apart, where a walk from the root is one test).
     pub fn set_front_tracking(&mut self, on: bool) {
         self.front.tracking = on;
         if !on {
