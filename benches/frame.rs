@@ -5,8 +5,8 @@
 //! - `frame/<scene>/<impl>`: a whole step, `impl` in `dhcd-dh`, `dhcd-sphere`, `dhcd-aabb`,
 //!   `parry3d`, plus `dhcd-dh-t1` / `dhcd-dh-t2` on `pawns8` (the `Scene` API, object pairs in parallel, `Par::Rayon(1)` / `Rayon(2)`),
 //!   and `dhcd-dh-front` / `dhcd-aabb-front` (each pair's workspace with front tracking:
-//!   every query starts from the last one's traversal front; the setup prints the BV tests
-//!   and refits of one cycle from the root and from the front);
+//!   every query starts from the last one's traversal front; the setup prints the BV tests,
+//!   refits and triangle pairs of one cycle from the root and from the front);
 //! - `hier/<scene>/<impl>`: refit + traversal down to leaf pairs only (no triangle tests;
 //!   for dhcd `broad_phase`, which also refreshes the leaves' cached triangle boxes);
 //! - `narrow/<scene>/dhcd-dh`: the exact narrow phase alone on the leaf pairs of a frame
