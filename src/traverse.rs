@@ -465,10 +465,7 @@ impl Output<'_> {
     }
 
     fn finish(mut self) -> Contacts {
-        // PERF: one u64 key per pair sorts several times faster than the lexicographic
-        // comparison of `[u32; 2]`.
-        self.pairs
-            .sort_unstable_by_key(|&[a, b]| (u64::from(a) << 32) | u64::from(b));
+        sort_pairs(&mut self.pairs);
         self.counters.contacts = self.pairs.len() as u64;
         Contacts {
             pairs: self.pairs,
@@ -495,96 +492,85 @@ impl<'h, K: BvKind> Walk<'h, K> {
             out.front = std::mem::take(&mut ws.front.spare);
             out.front.clear();
         }
-        let (ta, tb) = (self.a.tree(), self.b.tree());
-        if self.track && ws.front.fits(ta, tb, self.self_query) {
+        let replay = self.track && ws.front.fits(self.a.tree(), self.b.tree(), self.self_query);
+        if replay {
             let entries = std::mem::take(&mut ws.front.entries);
-            out = self.replay(&entries, &mut ws.stack, threads, ws.grain, out);
+            if threads <= 1 {
+                dhcd_kernels::arch().dispatch(ReplayOp {
+                    walk: self,
+                    entries: &entries,
+                    stack: &mut ws.stack,
+                    out: &mut out,
+                });
+            } else {
+                let chunk = entries
+                    .len()
+                    .div_ceil(SEEDS_PER_THREAD * threads)
+                    .max(ws.grain);
+                let part = self.in_parallel(&entries, chunk, |entries, stack, out| {
+                    dhcd_kernels::arch().dispatch(ReplayOp {
+                        walk: self,
+                        entries,
+                        stack,
+                        out,
+                    })
+                });
+                out = out.merge(part);
+            }
             ws.front.entries = entries;
-            self.keep_front(&mut ws.front, &mut out, false);
-            ws.leaves = std::mem::take(&mut out.leaves);
-            return out.finish();
-        }
-        let seed_target = if threads > 1 {
-            SEEDS_PER_THREAD * threads
         } else {
-            0
-        };
-        dhcd_kernels::arch().dispatch(StartOp {
-            walk: self,
-            seeds: &mut ws.seeds,
-            stack: &mut ws.stack,
-            seed_target,
-            out: &mut out,
-        });
-        if !ws.seeds.is_empty() {
-            // The breadth-first start left `seeds`: walk them in parallel.
-            let part = ws
-                .seeds
-                .par_chunks(ws.grain)
-                .fold(Output::default, |mut o, chunk| {
-                    let mut stack = Vec::new();
+            let seed_target = if threads > 1 {
+                SEEDS_PER_THREAD * threads
+            } else {
+                0
+            };
+            dhcd_kernels::arch().dispatch(StartOp {
+                walk: self,
+                seeds: &mut ws.seeds,
+                stack: &mut ws.stack,
+                seed_target,
+                out: &mut out,
+            });
+            if !ws.seeds.is_empty() {
+                // The breadth-first start left `seeds`: walk them in parallel.
+                let part = self.in_parallel(&ws.seeds, ws.grain, |seeds, stack, out| {
                     dhcd_kernels::arch().dispatch(WalkOp {
                         walk: self,
-                        seeds: chunk,
-                        stack: &mut stack,
-                        out: &mut o,
-                    });
-                    o
-                })
-                .reduce(Output::default, Output::merge);
-            out = out.merge(part);
-            // Deterministic order of the collected leaf pairs (the broad-phase API).
-            out.leaves
-                .sort_unstable_by_key(|&[a, b]| (u64::from(a) << 32) | u64::from(b));
+                        seeds,
+                        stack,
+                        out,
+                    })
+                });
+                out = out.merge(part);
+            }
+        }
+        if replay || !ws.seeds.is_empty() {
+            // The collected leaf pairs (broad phase) in one order whatever the split into
+            // tasks (a sequential walk from the root leaves them in its own order).
+            sort_pairs(&mut out.leaves);
         }
         if self.track {
-            self.keep_front(&mut ws.front, &mut out, true);
+            self.keep_front(&mut ws.front, &mut out, !replay);
         }
         ws.leaves = std::mem::take(&mut out.leaves);
         out.finish()
     }
 
-    /// The walk from a kept front `entries` (on `threads` threads, in tasks of at least
-    /// `grain` entries), adding to `out`.
-    fn replay(
+    /// `items` (seeds or front entries) split into tasks of `chunk`, each walked by `walk`
+    /// on its own stack and output; the outputs merged in order.
+    fn in_parallel<T: Sync>(
         &self,
-        entries: &[FrontEntry],
-        stack: &mut Vec<[u32; 2]>,
-        threads: usize,
-        grain: usize,
-        mut out: Output<'h>,
+        items: &[T],
+        chunk: usize,
+        walk: impl Fn(&[T], &mut Vec<[u32; 2]>, &mut Output<'h>) + Sync + Send,
     ) -> Output<'h> {
-        if threads <= 1 {
-            dhcd_kernels::arch().dispatch(ReplayOp {
-                walk: self,
-                entries,
-                stack,
-                out: &mut out,
-            });
-        } else {
-            let chunk = entries
-                .len()
-                .div_ceil(SEEDS_PER_THREAD * threads)
-                .max(grain);
-            let part = entries
-                .par_chunks(chunk)
-                .fold(Output::default, |mut o, chunk| {
-                    let mut stack = Vec::new();
-                    dhcd_kernels::arch().dispatch(ReplayOp {
-                        walk: self,
-                        entries: chunk,
-                        stack: &mut stack,
-                        out: &mut o,
-                    });
-                    o
-                })
-                .reduce(Output::default, Output::merge);
-            out = out.merge(part);
-        }
-        // The collected leaf pairs (broad phase) in one order whatever the thread count.
-        out.leaves
-            .sort_unstable_by_key(|&[a, b]| (u64::from(a) << 32) | u64::from(b));
-        out
+        items
+            .par_chunks(chunk)
+            .fold(Output::default, |mut o, chunk| {
+                walk(chunk, &mut Vec::new(), &mut o);
+                o
+            })
+            .reduce(Output::default, Output::merge)
     }
 
     /// Keeps the front `out` recorded as `front` for the next query, or drops it (outgrown;
@@ -979,7 +965,7 @@ impl<K: BvKind> WithSimd for WalkOp<'_, '_, K> {
     }
 }
 
-/// The walk from the entries of a kept front ([`Walk::replay`]).
+/// The walk from the entries of a kept front (one task's, or all of them).
 struct ReplayOp<'w, 'h, K: BvKind> {
     walk: &'w Walk<'h, K>,
     entries: &'w [FrontEntry],
@@ -995,6 +981,12 @@ impl<K: BvKind> WithSimd for ReplayOp<'_, '_, K> {
             self.walk.replay_entry(simd, entry, self.stack, self.out);
         }
     }
+}
+
+/// Sorts pairs ascending. PERF: one u64 key per pair sorts several times faster than the
+/// lexicographic comparison of `[u32; 2]`.
+fn sort_pairs(pairs: &mut [[u32; 2]]) {
+    pairs.sort_unstable_by_key(|&[a, b]| (u64::from(a) << 32) | u64::from(b));
 }
 
 /// The lanes `0..n` of a wide test.

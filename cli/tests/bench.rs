@@ -52,6 +52,20 @@ fn strs(paths: &[PathBuf]) -> Vec<&str> {
     paths.iter().map(|p| p.to_str().unwrap()).collect()
 }
 
+/// The arguments of a self bench of three crossing-sheet frames and of a collide bench of
+/// a sphere passing a fixed mesh in three frames (no options), and the first sheet frame.
+fn self_and_collide_benches(dir: &Path) -> (String, [Vec<String>; 2]) {
+    let frames = crossing_sheets(dir, 3);
+    let (moving, fixed) = passing_sphere(dir, 3);
+    let owned = |args: &[&str]| args.iter().map(|a| a.to_string()).collect::<Vec<_>>();
+    let mut self_bench = owned(&["bench", "self"]);
+    self_bench.extend(owned(&strs(&frames)));
+    let mut collide_bench = owned(&["bench", "collide", "--a"]);
+    collide_bench.extend(owned(&strs(&moving)));
+    collide_bench.extend(owned(&["--b", fixed.to_str().unwrap()]));
+    (self_bench[2].clone(), [self_bench, collide_bench])
+}
+
 fn json_of(args: &[&str]) -> Value {
     let out = dhcd(args);
     assert!(
@@ -155,15 +169,9 @@ fn collide_bench_finds_each_frames_contacts_and_cycles_the_shorter_list() {
 #[test]
 fn broad_only_counts_what_the_full_step_counts_without_contacts() {
     let dir = temp_dir("bench-broad");
-    let frames = crossing_sheets(&dir, 3);
-    let (moving, fixed) = passing_sphere(&dir, 3);
-    let fixed = fixed.to_str().unwrap();
-    let mut self_args = vec!["bench", "self"];
-    self_args.extend(strs(&frames));
-    let mut collide_args = vec!["bench", "collide", "--a"];
-    collide_args.extend(strs(&moving));
-    collide_args.extend(["--b", fixed]);
-    for base in [self_args, collide_args] {
+    let (first_frame, benches) = self_and_collide_benches(&dir);
+    for base in &benches {
+        let base: Vec<&str> = base.iter().map(String::as_str).collect();
         let mut full = base.clone();
         full.extend(["--method", "all", "--repeat", "1", "--json"]);
         let mut broad = full.clone();
@@ -193,7 +201,7 @@ fn broad_only_counts_what_the_full_step_counts_without_contacts() {
         }
         assert!(some_contacts, "{full}");
     }
-    let out = dhcd(&["bench", "self", frames[0].to_str().unwrap(), "--broad-only"]);
+    let out = dhcd(&["bench", "self", &first_frame, "--broad-only"]);
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("(broad phase only)"), "{text}");
 }
@@ -204,17 +212,10 @@ fn broad_only_counts_what_the_full_step_counts_without_contacts() {
 #[test]
 fn front_tracking_finds_the_same_contacts() {
     let dir = temp_dir("bench-front");
-    let frames = crossing_sheets(&dir, 3);
-    let (moving, fixed) = passing_sphere(&dir, 3);
-    let fixed = fixed.to_str().unwrap();
-    let mut self_args = vec!["bench", "self"];
-    self_args.extend(strs(&frames));
-    let mut collide_args = vec!["bench", "collide", "--a"];
-    collide_args.extend(strs(&moving));
-    collide_args.extend(["--b", fixed]);
-    for base in [self_args, collide_args] {
-        let mut root = base.clone();
-        root.extend([
+    let (first_frame, benches) = self_and_collide_benches(&dir);
+    for base in &benches {
+        let mut root_args: Vec<&str> = base.iter().map(String::as_str).collect();
+        root_args.extend([
             "--method",
             "all",
             "--repeat",
@@ -223,18 +224,9 @@ fn front_tracking_finds_the_same_contacts() {
             "--leaf-size",
             "4",
         ]);
-        let root = json_of(&root);
+        let root = json_of(&root_args);
         for threads in ["1", "2"] {
-            let mut front = base.clone();
-            front.extend([
-                "--method",
-                "all",
-                "--repeat",
-                "3",
-                "--json",
-                "--leaf-size",
-                "4",
-            ]);
+            let mut front = root_args.clone();
             front.extend(["--front", "--threads", threads]);
             let front = json_of(&front);
             let (mut tests_root, mut tests_front) = (0, 0);
@@ -264,7 +256,7 @@ fn front_tracking_finds_the_same_contacts() {
             assert_ne!(tests_front, tests_root);
         }
     }
-    let out = dhcd(&["bench", "self", frames[0].to_str().unwrap(), "--front"]);
+    let out = dhcd(&["bench", "self", &first_frame, "--front"]);
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("from the last front"), "{text}");
 }
