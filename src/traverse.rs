@@ -369,7 +369,7 @@ pub fn narrow_phase<K: BvKind>(
     };
     let run = |chunk: &[[u32; 2]]| {
         let mut out = Output::default();
-        dhcd_kernels::arch().dispatch(NarrowOp {
+        dispatch(NarrowOp {
             walk: &walk,
             leaves: chunk,
             out: &mut out,
@@ -493,12 +493,15 @@ impl<'h, K: BvKind> Walk<'h, K> {
             out.front.clear();
         }
         let replay = self.track && ws.front.fits(self.a.tree(), self.b.tree(), self.self_query);
+        // The collected leaf pairs (broad phase) are sorted when the walk's order is not a
+        // walk from the root: split into tasks, or from a front.
+        let sort;
         if replay {
             let entries = std::mem::take(&mut ws.front.entries);
             if threads <= 1 {
-                dhcd_kernels::arch().dispatch(ReplayOp {
+                dispatch(WalkOp {
                     walk: self,
-                    entries: &entries,
+                    work: Work::Front(&entries),
                     stack: &mut ws.stack,
                     out: &mut out,
                 });
@@ -508,9 +511,9 @@ impl<'h, K: BvKind> Walk<'h, K> {
                     .div_ceil(SEEDS_PER_THREAD * threads)
                     .max(ws.grain);
                 let part = self.in_parallel(&entries, chunk, |entries, stack, out| {
-                    dhcd_kernels::arch().dispatch(ReplayOp {
+                    dispatch(WalkOp {
                         walk: self,
-                        entries,
+                        work: Work::Front(entries),
                         stack,
                         out,
                     })
@@ -518,25 +521,33 @@ impl<'h, K: BvKind> Walk<'h, K> {
                 out = out.merge(part);
             }
             ws.front.entries = entries;
+            sort = true;
         } else {
-            let seed_target = if threads > 1 {
-                SEEDS_PER_THREAD * threads
-            } else {
-                0
-            };
-            dhcd_kernels::arch().dispatch(StartOp {
+            dispatch(StartOp {
                 walk: self,
                 seeds: &mut ws.seeds,
                 stack: &mut ws.stack,
-                seed_target,
+                seed_target: if threads > 1 {
+                    SEEDS_PER_THREAD * threads
+                } else {
+                    1
+                },
                 out: &mut out,
             });
-            if !ws.seeds.is_empty() {
+            sort = threads > 1 && !ws.seeds.is_empty();
+            if threads <= 1 {
+                dispatch(WalkOp {
+                    walk: self,
+                    work: Work::Seeds(&ws.seeds),
+                    stack: &mut ws.stack,
+                    out: &mut out,
+                });
+            } else if !ws.seeds.is_empty() {
                 // The breadth-first start left `seeds`: walk them in parallel.
                 let part = self.in_parallel(&ws.seeds, ws.grain, |seeds, stack, out| {
-                    dhcd_kernels::arch().dispatch(WalkOp {
+                    dispatch(WalkOp {
                         walk: self,
-                        seeds,
+                        work: Work::Seeds(seeds),
                         stack,
                         out,
                     })
@@ -544,9 +555,7 @@ impl<'h, K: BvKind> Walk<'h, K> {
                 out = out.merge(part);
             }
         }
-        if replay || !ws.seeds.is_empty() {
-            // The collected leaf pairs (broad phase) in one order whatever the split into
-            // tasks (a sequential walk from the root leaves them in its own order).
+        if sort {
             sort_pairs(&mut out.leaves);
         }
         if self.track {
@@ -741,10 +750,10 @@ impl<'h, K: BvKind> Walk<'h, K> {
         });
     }
 
-    /// One entry of a kept front: its pairs tested again; those that now overlap are walked
-    /// depth-first (on `stack`), the others recorded again.
+    /// One entry of a kept front, tested again: the pairs that now overlap pushed to
+    /// `stack` (to be walked), the others recorded again.
     #[inline(always)]
-    fn replay_entry<S: Simd>(
+    fn retest<S: Simd>(
         &self,
         simd: S,
         entry: FrontEntry,
@@ -752,7 +761,6 @@ impl<'h, K: BvKind> Walk<'h, K> {
         out: &mut Output<'h>,
     ) {
         let (ta, tb) = (self.a.tree(), self.b.tree());
-        stack.clear();
         match entry {
             FrontEntry::NodeVsGroup {
                 a_node,
@@ -792,11 +800,12 @@ impl<'h, K: BvKind> Walk<'h, K> {
                     stack.push([(nodes.start + k) as u32, b_node]);
                 }
             }
+            // An overlapping leaf pair is pushed too: `expand` runs its narrow phase.
             FrontEntry::Leaves { x, y } => {
-                let (x, y) = (x as usize, y as usize);
                 if self.self_query && x == y {
-                    return self.leaves(simd, x, y, out);
+                    return stack.push([x, y]);
                 }
+                let (x, y) = (x as usize, y as usize);
                 let (gx, gy) = (ta.group_of(x), tb.group_of(y));
                 let bx = self.group(self.a, gx, out);
                 let by = self.group(self.b, gy, out);
@@ -804,13 +813,10 @@ impl<'h, K: BvKind> Walk<'h, K> {
                 out.counters.bv_tests += 1;
                 let lane = 1u32 << iy;
                 if K::test(simd, bx, ix, by, iy + 1) & lane != 0 {
-                    return self.leaves(simd, x, y, out);
+                    return stack.push([x as u32, y as u32]);
                 }
                 self.record_misses(out, x as u32, gy, lane, 0, true);
             }
-        }
-        while let Some(pair) = stack.pop() {
-            self.expand(simd, pair, stack, out);
         }
     }
 
@@ -896,27 +902,17 @@ impl<'h, K: BvKind> Walk<'h, K> {
         }
     }
 
-    /// Depth-first from each of `seeds`.
+    /// Depth-first until `stack` (overlapping pairs) is empty.
     #[inline(always)]
-    fn walk<S: Simd>(
-        &self,
-        simd: S,
-        seeds: &[[u32; 2]],
-        stack: &mut Vec<[u32; 2]>,
-        out: &mut Output<'h>,
-    ) {
-        for &seed in seeds {
-            stack.clear();
-            stack.push(seed);
-            while let Some(pair) = stack.pop() {
-                self.expand(simd, pair, stack, out);
-            }
+    fn descend<S: Simd>(&self, simd: S, stack: &mut Vec<[u32; 2]>, out: &mut Output<'h>) {
+        while let Some(pair) = stack.pop() {
+            self.expand(simd, pair, stack, out);
         }
     }
 }
 
-/// The calling thread's part: the root, then either the whole walk (sequential) or a
-/// breadth-first expansion until `seed_target` pairs are waiting (left in `seeds`).
+/// The calling thread's part of a walk from the root: the root's test, then a breadth-first
+/// expansion until `seed_target` pairs are waiting (left in `seeds`; 1: the root alone).
 struct StartOp<'w, 'h, K: BvKind> {
     walk: &'w Walk<'h, K>,
     seeds: &'w mut Vec<[u32; 2]>,
@@ -933,9 +929,6 @@ impl<K: BvKind> WithSimd for StartOp<'_, '_, K> {
         let Some(root) = self.walk.root(simd, self.out) else {
             return;
         };
-        if self.seed_target == 0 {
-            return self.walk.walk(simd, &[root], self.stack, self.out);
-        }
         self.seeds.push(root);
         let mut next = std::mem::take(self.stack);
         while !self.seeds.is_empty() && self.seeds.len() < self.seed_target {
@@ -949,10 +942,19 @@ impl<K: BvKind> WithSimd for StartOp<'_, '_, K> {
     }
 }
 
-/// One parallel task: depth-first from each of its seeds.
+/// Where a walk task starts.
+#[derive(Clone, Copy)]
+enum Work<'w> {
+    /// Overlapping pairs: the root, or what the breadth-first start left.
+    Seeds(&'w [[u32; 2]]),
+    /// Entries of a kept front, each tested again first.
+    Front(&'w [FrontEntry]),
+}
+
+/// One walk task (the whole walk, sequentially): depth-first from each item of its work.
 struct WalkOp<'w, 'h, K: BvKind> {
     walk: &'w Walk<'h, K>,
-    seeds: &'w [[u32; 2]],
+    work: Work<'w>,
     stack: &'w mut Vec<[u32; 2]>,
     out: &'w mut Output<'h>,
 }
@@ -961,26 +963,29 @@ impl<K: BvKind> WithSimd for WalkOp<'_, '_, K> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
-        self.walk.walk(simd, self.seeds, self.stack, self.out);
-    }
-}
-
-/// The walk from the entries of a kept front (one task's, or all of them).
-struct ReplayOp<'w, 'h, K: BvKind> {
-    walk: &'w Walk<'h, K>,
-    entries: &'w [FrontEntry],
-    stack: &'w mut Vec<[u32; 2]>,
-    out: &'w mut Output<'h>,
-}
-
-impl<K: BvKind> WithSimd for ReplayOp<'_, '_, K> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
-        for &entry in self.entries {
-            self.walk.replay_entry(simd, entry, self.stack, self.out);
+        let items = match self.work {
+            Work::Seeds(seeds) => seeds.len(),
+            Work::Front(entries) => entries.len(),
+        };
+        for i in 0..items {
+            self.stack.clear();
+            match self.work {
+                Work::Seeds(seeds) => self.stack.push(seeds[i]),
+                Work::Front(entries) => self.walk.retest(simd, entries[i], self.stack, self.out),
+            }
+            // PERF (compile time): the one place the walk engine (`expand`, with the narrow
+            // phase and the refit inlined) is instantiated per backend and kind.
+            self.walk.descend(simd, self.stack, self.out);
         }
     }
+}
+
+/// `op` on the runtime-detected backend ([`dhcd_kernels::arch`]). Not inlined, so the
+/// scalar backend's copy of each operation (which `Arch::dispatch` inlines) is compiled once,
+/// not at every call site.
+#[inline(never)]
+fn dispatch<Op: WithSimd>(op: Op) -> Op::Output {
+    dhcd_kernels::arch().dispatch(op)
 }
 
 /// Sorts pairs ascending. PERF: one u64 key per pair sorts several times faster than the
