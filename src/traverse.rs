@@ -644,15 +644,30 @@ impl<'h, K: BvKind> Walk<'h, K> {
     fn expand<S: Simd>(
         &self,
         simd: S,
-        [x, y]: [u32; 2],
+        pair: [u32; 2],
         next: &mut Vec<[u32; 2]>,
         out: &mut Output<'h>,
     ) {
+        if !self.split(simd, pair, next, out) {
+            self.leaves(simd, pair[0] as usize, pair[1] as usize, out);
+        }
+    }
+
+    /// Pushes the overlapping children pairs of the overlapping pair `[x, y]` to `next`;
+    /// false (nothing pushed) for a leaf pair.
+    #[inline(always)]
+    fn split<S: Simd>(
+        &self,
+        simd: S,
+        [x, y]: [u32; 2],
+        next: &mut Vec<[u32; 2]>,
+        out: &mut Output<'h>,
+    ) -> bool {
         let (x, y) = (x as usize, y as usize);
         let (ta, tb) = (self.a.tree(), self.b.tree());
         if self.self_query && x == y {
             let Some(g) = ta.child_group(x) else {
-                return self.leaves(simd, x, y, out);
+                return false;
             };
             let block = self.group(self.a, g, out);
             let nodes = ta.group_nodes(g);
@@ -676,13 +691,13 @@ impl<'h, K: BvKind> Walk<'h, K> {
                     }
                 }
             }
-            return;
+            return true;
         }
         let (gx, gy) = (ta.group_of(x), tb.group_of(y));
         let (bx, by) = (self.a.group(gx).0, self.b.group(gy).0);
         let (ix, iy) = (x - ta.group_nodes(gx).start, y - tb.group_nodes(gy).start);
         let descend_x = match (ta.child_group(x), tb.child_group(y)) {
-            (None, None) => return self.leaves(simd, x, y, out),
+            (None, None) => return false,
             (Some(_), None) => true,
             (None, Some(_)) => false,
             (Some(_), Some(_)) => K::extent(bx, ix) >= K::extent(by, iy),
@@ -716,6 +731,7 @@ impl<'h, K: BvKind> Walk<'h, K> {
                 next.push([x as u32, (nodes.start + k) as u32]);
             }
         }
+        true
     }
 
     /// Records the lanes of `tested` that missed (`hits` clear) as a front entry: node `node`
@@ -913,6 +929,7 @@ impl<'h, K: BvKind> Walk<'h, K> {
 
 /// The calling thread's part of a walk from the root: the root's test, then a breadth-first
 /// expansion until `seed_target` pairs are waiting (left in `seeds`; 1: the root alone).
+/// Leaf pairs met on the way wait too: the walk tasks run their narrow phase.
 struct StartOp<'w, 'h, K: BvKind> {
     walk: &'w Walk<'h, K>,
     seeds: &'w mut Vec<[u32; 2]>,
@@ -931,10 +948,16 @@ impl<K: BvKind> WithSimd for StartOp<'_, '_, K> {
         };
         self.seeds.push(root);
         let mut next = std::mem::take(self.stack);
-        while !self.seeds.is_empty() && self.seeds.len() < self.seed_target {
+        let mut split = true;
+        while split && !self.seeds.is_empty() && self.seeds.len() < self.seed_target {
             next.clear();
+            split = false;
             for &pair in self.seeds.iter() {
-                self.walk.expand(simd, pair, &mut next, self.out);
+                if self.walk.split(simd, pair, &mut next, self.out) {
+                    split = true;
+                } else {
+                    next.push(pair);
+                }
             }
             std::mem::swap(self.seeds, &mut next);
         }
