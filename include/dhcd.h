@@ -173,6 +173,28 @@ void dhcd_hierarchy_free(struct DhcdHierarchy *h);
 int dhcd_hierarchy_method(const struct DhcdHierarchy *h, int *out);
 
 /**
+ * Frame-to-frame coherence, off by default: with `on` nonzero, each query through this
+ * handle's scratch (`dhcd_self_collide(h, ...)`, `dhcd_collide(h, b, ...)`) keeps where its
+ * traversal stopped, and the next query of the same kind on the same objects starts there
+ * instead of at the roots. The contacts are exactly the same; the work differs (less on
+ * most deforming meshes, more on some: docs/PERFORMANCE.md). One front per handle:
+ * alternating self and pair queries through one handle restarts from the roots each time.
+ * `on == 0` drops the kept front.
+ *
+ * # Safety
+ * `h` null or a live handle.
+ */
+int dhcd_hierarchy_set_front_tracking(struct DhcdHierarchy *h, int on);
+
+/**
+ * Whether front tracking is on (1) or off (0) for this handle, into `*out`.
+ *
+ * # Safety
+ * `h` null or a live handle; `out` null or valid for a write.
+ */
+int dhcd_hierarchy_front_tracking(const struct DhcdHierarchy *h, int *out);
+
+/**
  * New positions of the mesh (`3 * vertex_count` floats, the mesh's vertex order and
  * count). On error the hierarchy is unchanged.
  *

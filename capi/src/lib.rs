@@ -395,6 +395,46 @@ pub unsafe extern "C" fn dhcd_hierarchy_method(h: *const DhcdHierarchy, out: *mu
     })
 }
 
+/// Frame-to-frame coherence, off by default: with `on` nonzero, each query through this
+/// handle's scratch (`dhcd_self_collide(h, ...)`, `dhcd_collide(h, b, ...)`) keeps where its
+/// traversal stopped, and the next query of the same kind on the same objects starts there
+/// instead of at the roots. The contacts are exactly the same; the work differs (less on
+/// most deforming meshes, more on some: docs/PERFORMANCE.md). One front per handle:
+/// alternating self and pair queries through one handle restarts from the roots each time.
+/// `on == 0` drops the kept front.
+///
+/// # Safety
+/// `h` null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_hierarchy_set_front_tracking(
+    h: *mut DhcdHierarchy,
+    on: c_int,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on `h`.
+        let h = unsafe { handle(h, "hierarchy")? };
+        h.ws.set_front_tracking(on != 0);
+        Ok(())
+    })
+}
+
+/// Whether front tracking is on (1) or off (0) for this handle, into `*out`.
+///
+/// # Safety
+/// `h` null or a live handle; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_hierarchy_front_tracking(
+    h: *const DhcdHierarchy,
+    out: *mut c_int,
+) -> c_int {
+    guard(|| {
+        // SAFETY: null or a live handle (caller's contract); only read.
+        let h = unsafe { h.as_ref() }.ok_or_else(|| null("hierarchy"))?;
+        // SAFETY: caller's contract on `out`.
+        unsafe { write(out, c_int::from(h.ws.front_tracking()), "out") }
+    })
+}
+
 /// New positions of the mesh (`3 * vertex_count` floats, the mesh's vertex order and
 /// count). On error the hierarchy is unchanged.
 ///

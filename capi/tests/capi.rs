@@ -491,6 +491,86 @@ fn scene_update_many_bad_entry_changes_nothing() {
     }
 }
 
+/// Self and pair queries with the front kept (`dhcd_hierarchy_set_front_tracking`) give
+/// exactly the contacts of handles without it, pose after pose, and start from the front
+/// (other work counted) once one is kept.
+#[test]
+fn front_tracking_gives_the_same_contacts() {
+    let base = icosphere(2, 1.0, [0.0; 3]);
+    let pose = |k: usize, offset: [f32; 3]| -> Vec<f32> {
+        let time = 0.5 + 0.15 * k as f32;
+        wave(base.positions(), time, 0.6, offset)
+            .iter()
+            .flatten()
+            .copied()
+            .collect()
+    };
+    let nv = base.vertex_count();
+    for method in [DHCD_METHOD_DH, DHCD_METHOD_SPHERE, DHCD_METHOD_AABB] {
+        let [ta, tb, ra, rb] = [(); 4].map(|_| new_h(method, &base));
+        // SAFETY: live handles, valid out-pointers and arrays throughout.
+        unsafe {
+            let mut on = -1;
+            assert_eq!(dhcd_hierarchy_front_tracking(ta, &mut on), DHCD_OK);
+            assert_eq!(on, 0, "off by default");
+            for h in [ta, tb] {
+                assert_eq!(dhcd_hierarchy_set_front_tracking(h, 1), DHCD_OK);
+            }
+            assert_eq!(dhcd_hierarchy_front_tracking(ta, &mut on), DHCD_OK);
+            assert_eq!(on, 1);
+            let mut replayed = [false; 2];
+            for k in 0..4 {
+                let (pa, pb) = (pose(k, [0.0; 3]), pose(k + 1, [0.9, 0.2, 0.0]));
+                for (h, p) in [(ta, &pa), (ra, &pa), (tb, &pb), (rb, &pb)] {
+                    assert_eq!(dhcd_hierarchy_update_positions(h, p.as_ptr(), nv), DHCD_OK);
+                }
+                let [mut t, mut r] = [empty(), empty()];
+                assert_eq!(dhcd_self_collide(ta, 1, &mut t), DHCD_OK);
+                assert_eq!(dhcd_self_collide(ra, 1, &mut r), DHCD_OK);
+                assert!(r.count > 0, "the pose folds onto itself");
+                assert_eq!(
+                    pairs_of(&t),
+                    pairs_of(&r),
+                    "self, method {method}, pose {k}"
+                );
+                replayed[0] |= t.counters.bv_tests != r.counters.bv_tests;
+                dhcd_contacts_free(&mut t);
+                dhcd_contacts_free(&mut r);
+                // The pair queries through `tb`'s scratch (`ta`'s holds the self front).
+                assert_eq!(dhcd_collide(tb, ta, 2, &mut t), DHCD_OK);
+                assert_eq!(dhcd_collide(rb, ra, 2, &mut r), DHCD_OK);
+                assert!(r.count > 0, "the poses touch");
+                assert_eq!(
+                    pairs_of(&t),
+                    pairs_of(&r),
+                    "pair, method {method}, pose {k}"
+                );
+                replayed[1] |= t.counters.bv_tests != r.counters.bv_tests;
+                dhcd_contacts_free(&mut t);
+                dhcd_contacts_free(&mut r);
+            }
+            assert_eq!(
+                replayed, [true; 2],
+                "method {method}: no query started from a front"
+            );
+            assert_eq!(dhcd_hierarchy_set_front_tracking(ta, 0), DHCD_OK);
+            assert_eq!(dhcd_hierarchy_front_tracking(ta, &mut on), DHCD_OK);
+            assert_eq!(on, 0);
+            for h in [ta, tb, ra, rb] {
+                dhcd_hierarchy_free(h);
+            }
+            assert_eq!(
+                dhcd_hierarchy_set_front_tracking(null_mut(), 1),
+                DHCD_ERR_NULL
+            );
+            assert_eq!(
+                dhcd_hierarchy_front_tracking(null(), &mut on),
+                DHCD_ERR_NULL
+            );
+        }
+    }
+}
+
 #[test]
 fn bad_arguments_are_error_codes() {
     let m = icosphere(1, 1.0, [0.0; 3]);

@@ -92,6 +92,16 @@ class Hierarchy:
     def method(self) -> str:
         """``"dh"``, ``"sphere"`` or ``"aabb"``."""
     @property
+    def front_tracking(self) -> bool:
+        """Frame-to-frame coherence, off by default. On, each query through this
+        hierarchy's scratch (``self_collide()``, ``collide(self, other)``) keeps where its
+        traversal stopped, and the next query of the same kind on the same objects starts
+        there instead of at the roots: the same contacts, less work on most deforming meshes
+        (more on some). One front per hierarchy: alternating self and pair queries through
+        one hierarchy restarts from the roots. Setting it off drops the kept front."""
+    @front_tracking.setter
+    def front_tracking(self, on: bool) -> None: ...
+    @property
     def bytes_per_node(self) -> int:
         """Size of one node record: 8, 16 or 24."""
     @property

@@ -307,6 +307,19 @@ impl Hierarchy {
         self.h.method().name()
     }
 
+    /// Frame-to-frame coherence, off by default: on, each query through this hierarchy's
+    /// scratch (`self_collide`, `collide(self, other)`) starts where the last one of the same
+    /// kind on the same objects stopped. Same contacts; turning it off drops the front.
+    #[getter]
+    fn front_tracking(&self) -> bool {
+        self.ws.front_tracking()
+    }
+
+    #[setter]
+    fn set_front_tracking(&mut self, on: bool) {
+        self.ws.set_front_tracking(on);
+    }
+
     #[getter]
     fn bytes_per_node(&self) -> usize {
         self.h.bytes_per_node()

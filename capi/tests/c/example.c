@@ -161,6 +161,9 @@ int main(void) {
   }
   DhcdHierarchy *s = NULL;
   OK(dhcd_hierarchy_new(DHCD_METHOD_SPHERE, 5, both, 2 * nv, bt, 2 * nt, &s));
+  /* Frame-to-frame coherence (opt-in): each query keeps where its traversal stopped, and
+   * the next one on the same mesh starts there; the contacts are the same. */
+  OK(dhcd_hierarchy_set_front_tracking(s, 1));
   DhcdContacts self = {0};
   OK(dhcd_self_collide(s, 0, &self));
   CHECK(self.count == first.count);
@@ -169,6 +172,10 @@ int main(void) {
     CHECK(self.pairs[2 * k + 1] == first.pairs[2 * k + 1] + nt);
   }
   printf("self-collision: %zu contacts\n", self.count);
+  DhcdContacts again = {0};
+  OK(dhcd_self_collide(s, 0, &again)); /* from the kept front */
+  CHECK(same(&self, &again));
+  dhcd_contacts_free(&again);
   dhcd_contacts_free(&self);
   dhcd_hierarchy_free(s);
 
