@@ -2,7 +2,8 @@
 //! (every object pair at once on rayon over the shared hierarchies, each query splitting its
 //! own frontier),
 //! against the sequential step and against the alternative of running the same object
-//! pairs one after the other, each query parallel inside only.
+//! pairs one after the other, each query parallel inside only; and the sequential step with
+//! front tracking (`Scene::set_front_tracking`: each pair starts from its last front).
 //!
 //! `cargo bench --bench scene`
 
@@ -41,8 +42,13 @@ fn bench(c: &mut Criterion) {
     let (ball, poses) = poses();
     let mut g = c.benchmark_group("scene_step_8_balls_5120_tris");
     g.sample_size(20);
-    for (name, par) in [("scene_seq", Par::Seq), ("scene_rayon2", Par::Rayon(2))] {
+    for (name, par, front) in [
+        ("scene_seq", Par::Seq, false),
+        ("scene_rayon2", Par::Rayon(2), false),
+        ("scene_seq_front", Par::Seq, true),
+    ] {
         let mut scene = Scene::new(Method::Dh, Options::default());
+        scene.set_front_tracking(front);
         for _ in 0..OBJECTS {
             scene.add(&ball).unwrap();
         }

@@ -333,6 +333,26 @@ int dhcd_scene_update_many(struct DhcdScene *s,
 int dhcd_scene_set_self_collision(struct DhcdScene *s, uint64_t id, int on);
 
 /**
+ * Frame-to-frame coherence for the whole scene, off by default: with `on` nonzero, each
+ * object pair's query (and each self query) keeps where its traversal stopped, and the next
+ * `dhcd_scene_contacts` starts that pair there. The contacts are exactly the same; the work
+ * differs (less on most deforming meshes, more on some: docs/PERFORMANCE.md). A pair that
+ * stops overlapping drops its front; `on == 0` drops them all.
+ *
+ * # Safety
+ * `s` null or a live handle.
+ */
+int dhcd_scene_set_front_tracking(struct DhcdScene *s, int on);
+
+/**
+ * Whether front tracking is on (1) or off (0) for the scene, into `*out`.
+ *
+ * # Safety
+ * `s` null or a live handle; `out` null or valid for a write.
+ */
+int dhcd_scene_front_tracking(const struct DhcdScene *s, int *out);
+
+/**
  * Every contact of the scene's current poses into `*out` (release with
  * `dhcd_scene_contacts_free`): quadruples `[object_a, tri_a, object_b, tri_b]`, sorted,
  * `object_a < object_b` (`==` for self-contacts); `counters` are the totals.

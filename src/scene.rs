@@ -11,6 +11,10 @@
 //!    shared hierarchies, which may itself split its frontier across the pool. The lazy
 //!    refit fits each sibling group once, for whichever query needs it first.
 //!
+//! With [`Scene::set_front_tracking`] each job keeps its traversal front between steps, in a
+//! workspace of its own (keyed by the two object ids), and starts the next step's query of
+//! the same pair there; a pair that leaves the broad phase drops its front.
+//!
 //! Output is deterministic: contacts are sorted and per-pair counters listed in job order.
 //! A group's refit is credited to the first job *in job order* that needed it (not to the
 //! query that happened to fit it), and an object's eager refits to its first job, so every
@@ -130,7 +134,13 @@ pub struct Scene {
     next_id: u64,
     /// Sorted by id (ids only grow, so `add` appends).
     objects: Objects,
+    /// Front tracking on: the workspace (and front) of each job of the last step.
+    fronts: Option<PairFronts>,
 }
+
+/// One workspace per job of the last step, keyed by its object ids `[a, b]` (`a == b`: a
+/// self job), sorted by key (the job order).
+type PairFronts = Vec<([u64; 2], Workspace)>;
 
 impl Scene {
     /// An empty scene whose objects get hierarchies of kind `method` built with `options`.
@@ -140,6 +150,7 @@ impl Scene {
             options,
             next_id: 0,
             objects,
+            fronts: None,
         }
     }
 
@@ -274,7 +285,29 @@ impl Scene {
     /// Every contact of the current poses: between all object pairs, and inside objects with
     /// self-collision on. The result does not depend on `par`.
     pub fn contacts(&mut self, par: Par) -> SceneContacts {
-        each!(&mut self.objects, v => par.install(|| contacts_of(v, par.is_parallel())))
+        let fronts = self.fronts.as_mut();
+        each!(&mut self.objects, v => par.install(|| contacts_of(v, fronts, par.is_parallel())))
+    }
+
+    /// Frame-to-frame coherence for every job (off when created): with it on, each object
+    /// pair's query (and each self query) keeps where its traversal stopped, and the next
+    /// [`Scene::contacts`] starts that pair's query there
+    /// ([`Workspace::set_front_tracking`]). The contacts are exactly the same; `bv_tests`
+    /// and `bv_updates` count the work done, and are the same for every `par`. A pair that
+    /// leaves the broad phase (or an object that is removed) drops its front, so the fronts
+    /// kept are at most one per job of the last step, each bounded as in
+    /// [`Workspace::set_front_tracking`]. Turning it off drops them all.
+    pub fn set_front_tracking(&mut self, on: bool) {
+        if !on {
+            self.fronts = None;
+        } else if self.fronts.is_none() {
+            self.fronts = Some(PairFronts::new());
+        }
+    }
+
+    /// Whether [`Scene::set_front_tracking`] is on.
+    pub fn front_tracking(&self) -> bool {
+        self.fronts.is_some()
     }
 
     /// Intersection segments of `contacts` (from [`Scene::contacts`] in the current poses),
@@ -340,7 +373,30 @@ fn broad_phase(bounds: &[[[f32; 3]; 2]]) -> (Vec<(usize, usize)>, u64) {
     (out, tests)
 }
 
-fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
+/// The workspaces of `jobs` (object ids, sorted) from the last step's `fronts` (sorted):
+/// a job's own if it had one, else a new tracking one; the others are dropped.
+fn take_fronts(fronts: &mut PairFronts, jobs: &[[u64; 2]]) -> Vec<Workspace> {
+    let mut old = std::mem::take(fronts).into_iter().peekable();
+    jobs.iter()
+        .map(|key| {
+            while old.next_if(|(k, _)| k < key).is_some() {}
+            match old.next_if(|(k, _)| k == key) {
+                Some((_, ws)) => ws,
+                None => {
+                    let mut ws = Workspace::default();
+                    ws.set_front_tracking(true);
+                    ws
+                }
+            }
+        })
+        .collect()
+}
+
+fn contacts_of<K: BvKind>(
+    objects: &mut [Object<K>],
+    fronts: Option<&mut PairFronts>,
+    parallel: bool,
+) -> SceneContacts {
     let bounds: Vec<_> = objects.iter().map(|o| o.bounds).collect();
     let (candidates, broad_phase_tests) = broad_phase(&bounds);
     // Jobs in (a, b) order; a self job is (a, a).
@@ -361,17 +417,43 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
     let run = |ws: &mut Workspace, k: usize, (a, b): (usize, usize)| {
         scene_query(&shared[a].h, &shared[b].h, a == b, k, ws, inner)
     };
-    let mut results: Vec<Contacts> = if parallel && jobs.len() > 1 {
-        jobs.par_iter()
+    let mut results: Vec<Contacts> = match fronts {
+        // Each job on its own workspace, which holds its front.
+        Some(fronts) => {
+            let keys: Vec<[u64; 2]> = jobs
+                .iter()
+                .map(|&(a, b)| [shared[a].id, shared[b].id])
+                .collect();
+            let mut spaces = take_fronts(fronts, &keys);
+            let results = if parallel && jobs.len() > 1 {
+                (jobs.par_iter(), spaces.par_iter_mut())
+                    .into_par_iter()
+                    .enumerate()
+                    .map(|(k, (&job, ws))| run(ws, k, job))
+                    .collect()
+            } else {
+                jobs.iter()
+                    .zip(&mut spaces)
+                    .enumerate()
+                    .map(|(k, (&job, ws))| run(ws, k, job))
+                    .collect()
+            };
+            *fronts = keys.into_iter().zip(spaces).collect();
+            results
+        }
+        // One workspace per worker thread, reused across jobs.
+        None if parallel && jobs.len() > 1 => jobs
+            .par_iter()
             .enumerate()
             .map_init(Workspace::default, |ws, (k, &job)| run(ws, k, job))
-            .collect()
-    } else {
-        let mut ws = Workspace::default();
-        jobs.iter()
-            .enumerate()
-            .map(|(k, &job)| run(&mut ws, k, job))
-            .collect()
+            .collect(),
+        None => {
+            let mut ws = Workspace::default();
+            jobs.iter()
+                .enumerate()
+                .map(|(k, &job)| run(&mut ws, k, job))
+                .collect()
+        }
     };
     // The refits as a sequential run in job order would count them: each lazily fitted group
     // to the first job that needed it, each object's eager refits to its first job. Objects

@@ -288,7 +288,8 @@ pub(crate) fn scene_query<K: BvKind>(
         self_query,
         narrow: true,
         job: Some(job),
-        track: false,
+        // The scene's per-pair workspaces when it tracks fronts.
+        track: ws.front_tracking(),
     };
     par.install(|| walk.run(ws, par.is_parallel()))
 }

@@ -5,6 +5,7 @@
 
 use dhcd::bv::BvKind;
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
+use dhcd::scene::{Scene, SceneContacts};
 use dhcd::shapes::{grid, icosphere, translated, wave};
 use dhcd::{
     broad_phase, collide_with, for_each_kind, narrow_phase, self_broad_phase, self_collide_with,
@@ -297,4 +298,68 @@ fn turning_tracking_off_drops_the_front() {
     let off = self_collide_with(&mut h, &mut ws, Par::Seq);
     assert_eq!(off.pairs, first.pairs);
     assert_eq!(off.counters.bv_tests, first.counters.bv_tests);
+}
+
+/// A scene tracking fronts (one and two threads) finds what a scene without them finds,
+/// step after step, while pairs enter and leave the broad phase and an object is removed;
+/// its later steps start from the fronts; turning tracking off gives a walk from the roots.
+#[test]
+fn a_scene_tracking_fronts_finds_what_an_untracked_scene_finds() {
+    let ball = icosphere(2, 1.0, [0.0; 3]);
+    let small = icosphere(3, 0.8, [0.0; 3]);
+    for method in Method::ALL {
+        let new_scene = || {
+            let mut s = Scene::new(method, options());
+            let ids = [&ball, &small, &ball].map(|m| s.add(m).unwrap());
+            s.set_self_collision(ids[0], true).unwrap();
+            (s, ids)
+        };
+        let (mut seq, ids) = new_scene();
+        let (mut par, _) = new_scene();
+        let (mut root, _) = new_scene();
+        assert!(!seq.front_tracking());
+        seq.set_front_tracking(true);
+        par.set_front_tracking(true);
+        let mut replays = 0;
+        for step in 0..10 {
+            let t = 0.3 * step as f32;
+            // The ball folds onto itself, the small one passes through it, the third comes
+            // from far away, touches, and is removed at step 8.
+            let poses = [
+                wave(ball.positions(), t, 0.6, [0.0; 3]),
+                translated(small.positions(), [-3.0 + 0.6 * step as f32, 0.2, 0.1]),
+                translated(ball.positions(), [12.0 - 1.2 * step as f32, 0.0, 0.0]),
+            ];
+            for s in [&mut seq, &mut par, &mut root] {
+                if step == 8 {
+                    s.remove(ids[2]).unwrap();
+                }
+                for (id, p) in ids.iter().zip(&poses) {
+                    if s.contains(*id) {
+                        s.update_positions(*id, p).unwrap();
+                    }
+                }
+            }
+            let tracked = seq.contacts(Par::Seq);
+            let fresh = root.contacts(Par::Seq);
+            let label = format!("{method:?} step {step}");
+            assert_eq!(tracked.pairs, fresh.pairs, "{label}");
+            let jobs =
+                |c: &SceneContacts| c.per_pair.iter().map(|p| (p.a, p.b)).collect::<Vec<_>>();
+            assert_eq!(jobs(&tracked), jobs(&fresh), "{label}");
+            assert_eq!(par.contacts(Par::Rayon(2)), tracked, "{label}: two threads");
+            replays += usize::from(tracked.counters.bv_tests != fresh.counters.bv_tests);
+        }
+        assert!(
+            replays >= 5,
+            "{method:?}: {replays} steps started from fronts"
+        );
+        seq.set_front_tracking(false);
+        assert!(!seq.front_tracking());
+        assert_eq!(
+            seq.contacts(Par::Seq),
+            root.contacts(Par::Seq),
+            "{method:?}: off"
+        );
+    }
 }

@@ -745,6 +745,38 @@ pub unsafe extern "C" fn dhcd_scene_set_self_collision(
     })
 }
 
+/// Frame-to-frame coherence for the whole scene, off by default: with `on` nonzero, each
+/// object pair's query (and each self query) keeps where its traversal stopped, and the next
+/// `dhcd_scene_contacts` starts that pair there. The contacts are exactly the same; the work
+/// differs (less on most deforming meshes, more on some: docs/PERFORMANCE.md). A pair that
+/// stops overlapping drops its front; `on == 0` drops them all.
+///
+/// # Safety
+/// `s` null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_set_front_tracking(s: *mut DhcdScene, on: c_int) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract.
+        let s = unsafe { handle(s, "scene")? };
+        s.scene.set_front_tracking(on != 0);
+        Ok(())
+    })
+}
+
+/// Whether front tracking is on (1) or off (0) for the scene, into `*out`.
+///
+/// # Safety
+/// `s` null or a live handle; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_front_tracking(s: *const DhcdScene, out: *mut c_int) -> c_int {
+    guard(|| {
+        // SAFETY: null or a live handle (caller's contract); only read.
+        let s = unsafe { s.as_ref() }.ok_or_else(|| null("scene"))?;
+        // SAFETY: caller's contract on `out`.
+        unsafe { write(out, c_int::from(s.scene.front_tracking()), "out") }
+    })
+}
+
 /// Every contact of the scene's current poses into `*out` (release with
 /// `dhcd_scene_contacts_free`): quadruples `[object_a, tri_a, object_b, tri_b]`, sorted,
 /// `object_a < object_b` (`==` for self-contacts); `counters` are the totals.

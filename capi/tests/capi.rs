@@ -272,6 +272,52 @@ fn scene_of(m: &Mesh, n: usize) -> (*mut DhcdScene, Vec<u64>) {
     }
 }
 
+/// A scene tracking fronts (`dhcd_scene_set_front_tracking`) reports the contacts of one
+/// without, step after step, and its later steps start from the fronts.
+#[test]
+fn scene_front_tracking_gives_the_same_contacts() {
+    let m = icosphere(2, 1.0, [0.0; 3]);
+    let ((tracked, ids), (plain, _)) = (scene_of(&m, 3), scene_of(&m, 3));
+    // SAFETY: live handles, valid arrays and out-pointers throughout.
+    unsafe {
+        let mut on = -1;
+        assert_eq!(dhcd_scene_front_tracking(tracked, &mut on), DHCD_OK);
+        assert_eq!(on, 0, "off by default");
+        assert_eq!(dhcd_scene_set_front_tracking(tracked, 1), DHCD_OK);
+        assert_eq!(dhcd_scene_front_tracking(tracked, &mut on), DHCD_OK);
+        assert_eq!(on, 1);
+        let mut replays = 0;
+        for step in 0..6 {
+            let t = 0.4 * step as f32;
+            let poses = [
+                wave(m.positions(), t, 0.6, [0.0; 3]),
+                wave(m.positions(), -t, 0.1, [1.5, 0.2, 0.0]),
+                wave(m.positions(), t, 0.1, [0.3 * step as f32 - 1.0, 1.4, 0.0]),
+            ];
+            for s in [tracked, plain] {
+                for (&id, p) in ids.iter().zip(&poses) {
+                    let flat: Vec<f32> = p.iter().flatten().copied().collect();
+                    let rc = dhcd_scene_update_positions(s, id, flat.as_ptr(), p.len());
+                    assert_eq!(rc, DHCD_OK);
+                }
+            }
+            let (pairs, counters) = scene_contacts(tracked);
+            let (want, root) = scene_contacts(plain);
+            assert!(!want.is_empty());
+            assert_eq!(pairs, want, "step {step}");
+            replays += usize::from(counters.bv_tests != root.bv_tests);
+        }
+        assert!(replays > 0, "later steps start from the kept fronts");
+        assert_eq!(dhcd_scene_set_front_tracking(tracked, 0), DHCD_OK);
+        assert_eq!(dhcd_scene_front_tracking(tracked, &mut on), DHCD_OK);
+        assert_eq!(on, 0);
+        assert_eq!(dhcd_scene_set_front_tracking(null_mut(), 1), DHCD_ERR_NULL);
+        assert_eq!(dhcd_scene_front_tracking(null(), &mut on), DHCD_ERR_NULL);
+        dhcd_scene_free(tracked);
+        dhcd_scene_free(plain);
+    }
+}
+
 /// `dhcd_scene_update_many` is one `dhcd_scene_update_positions` per entry, for every
 /// thread count and entry order: same contacts, same counters.
 #[test]

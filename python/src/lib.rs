@@ -590,6 +590,18 @@ impl Scene {
         self.scene.set_self_collision(id, on).map_err(to_py)
     }
 
+    /// Frame-to-frame coherence, off by default: on, each object pair's query (and each self
+    /// query) starts where the last step's stopped. Same contacts; off drops the fronts.
+    #[getter]
+    fn front_tracking(&self) -> bool {
+        self.scene.front_tracking()
+    }
+
+    #[setter]
+    fn set_front_tracking(&mut self, on: bool) {
+        self.scene.set_front_tracking(on);
+    }
+
     /// Every contact: rows `[object_a, face_a, object_b, face_b]`, sorted.
     #[pyo3(signature = (threads = None), text_signature = "(self, threads=1)")]
     fn contacts(
