@@ -166,7 +166,9 @@ impl Workspace {
     /// are the same for every thread count. A query on other trees starts from the root.
     /// A front is at most [`FRONT_MAX_ENTRIES`] entries (16 bytes each), else dropped; one that
     /// has grown to twice the size of the last front recorded from the root is dropped too
-    /// (the next query starts from the root). Turning it off drops the front.
+    /// (the next query starts from the root), and so is one of several entries in which no
+    /// pair overlapped (the objects are apart: from the root that is one test). Turning it
+    /// off drops the front.
     ///
     /// Opt-in because it does not pay everywhere (docs/PERFORMANCE.md, twelfth sitting):
     /// 14% faster on the icosphere frames with DH (the upper levels are not refitted), within
@@ -415,6 +417,8 @@ struct Output<'h> {
     front: Vec<FrontEntry>,
     /// The front outgrew [`FRONT_MAX_ENTRIES`] (and was cleared).
     front_overflow: bool,
+    /// Replayed front entries in which some pair overlapped.
+    descents: u64,
     rows: [Row; MAX_ROW],
     last: [Option<(usize, LeafSide<'h>)>; 2],
 }
@@ -427,6 +431,7 @@ impl Default for Output<'_> {
             leaves: Vec::new(),
             front: Vec::new(),
             front_overflow: false,
+            descents: 0,
             rows: [Row::default(); MAX_ROW],
             last: [None, None],
         }
@@ -439,6 +444,7 @@ impl Output<'_> {
         self.pairs.extend_from_slice(&other.pairs);
         self.leaves.extend_from_slice(&other.leaves);
         self.front_overflow |= other.front_overflow;
+        self.descents += other.descents;
         if self.front.len() + other.front.len() > FRONT_MAX_ENTRIES {
             self.front_overflow = true;
         }
@@ -589,7 +595,10 @@ impl<'h, K: BvKind> Walk<'h, K> {
         let entries = std::mem::take(&mut out.front);
         let len = entries.len();
         let outgrown = !fresh && len > FRONT_REGROWTH * front.fresh_len.max(1);
-        if out.front_overflow || outgrown {
+        // A replay in which nothing overlapped (the objects are apart): the next query
+        // starts from the roots, where that is one test, not the whole front again.
+        let idle = !fresh && out.descents == 0 && len > 1;
+        if out.front_overflow || outgrown || idle {
             front.clear();
             return;
         }
@@ -995,7 +1004,10 @@ impl<K: BvKind> WithSimd for WalkOp<'_, '_, K> {
             self.stack.clear();
             match self.work {
                 Work::Seeds(seeds) => self.stack.push(seeds[i]),
-                Work::Front(entries) => self.walk.retest(simd, entries[i], self.stack, self.out),
+                Work::Front(entries) => {
+                    self.walk.retest(simd, entries[i], self.stack, self.out);
+                    self.out.descents += u64::from(!self.stack.is_empty());
+                }
             }
             // PERF (compile time): the one place the walk engine (`expand`, with the narrow
             // phase and the refit inlined) is instantiated per backend and kind.

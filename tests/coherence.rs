@@ -363,3 +363,44 @@ fn a_scene_tracking_fronts_finds_what_an_untracked_scene_finds() {
         );
     }
 }
+
+/// Objects that move apart: the deep front of their contact is replayed once, found idle
+/// (nothing overlaps) and dropped; from then on each query is the roots' one test, from the
+/// root or from the one-entry front it records; when they meet again the contacts are back.
+fn apart_again<K: BvKind>() {
+    let a = icosphere(2, 1.0, [0.0; 3]);
+    let b = icosphere(2, 1.0, [0.0; 3]);
+    let (mut ha, mut hb) = (
+        Hierarchy::<K>::new(&a, options()).unwrap(),
+        Hierarchy::<K>::new(&b, options()).unwrap(),
+    );
+    let mut ws = tracking();
+    let label = format!("{:?}", K::METHOD);
+    let mut at = |x: f32, ws: &mut Workspace| {
+        hb.update_positions(&translated(b.positions(), [x, 0.1, 0.0]))
+            .unwrap();
+        collide_with(&mut ha, &mut hb, ws, Par::Seq)
+    };
+    let touching = at(1.2, &mut ws);
+    assert!(!touching.pairs.is_empty(), "{label}");
+    assert!(ws.front_len() > 1, "{label}");
+    let idle = at(10.0, &mut ws);
+    assert!(
+        idle.pairs.is_empty() && idle.counters.bv_tests > 1,
+        "{label}"
+    );
+    assert_eq!(ws.front_len(), 0, "{label}: an idle replay drops its front");
+    for step in 0..3 {
+        let apart = at(10.0 + step as f32, &mut ws);
+        assert!(apart.pairs.is_empty(), "{label}");
+        assert_eq!(apart.counters.bv_tests, 1, "{label}: the roots' test");
+        assert_eq!(ws.front_len(), 1, "{label}: the roots' entry is kept");
+    }
+    let again = at(1.2, &mut ws);
+    assert_eq!(again.pairs, touching.pairs, "{label}");
+}
+
+#[test]
+fn objects_apart_cost_one_test_after_one_idle_replay() {
+    for_each_kind!(K => apart_again::<K>());
+}
