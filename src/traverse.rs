@@ -703,13 +703,17 @@ impl<'h, K: BvKind> Walk<'h, K> {
             }
             return true;
         }
+        let (cx, cy) = (ta.child_group(x), tb.child_group(y));
+        if cx.is_none() && cy.is_none() {
+            // A leaf pair: decided before reading the groups (a call each, lazy fit check).
+            return false;
+        }
         let (gx, gy) = (ta.group_of(x), tb.group_of(y));
         let (bx, by) = (self.a.group(gx).0, self.b.group(gy).0);
         let (ix, iy) = (x - ta.group_nodes(gx).start, y - tb.group_nodes(gy).start);
-        let descend_x = match (ta.child_group(x), tb.child_group(y)) {
-            (None, None) => return false,
+        let descend_x = match (cx, cy) {
             (Some(_), None) => true,
-            (None, Some(_)) => false,
+            (None, _) => false,
             (Some(_), Some(_)) => K::extent(bx, ix) >= K::extent(by, iy),
         };
         if descend_x {
