@@ -170,10 +170,10 @@ impl Workspace {
     /// pair overlapped (the objects are apart: from the root that is one test). Turning it
     /// off drops the front.
     ///
-    /// Opt-in because it does not pay everywhere (docs/PERFORMANCE.md, twelfth sitting):
-    /// 14% faster on the icosphere frames with DH (the upper levels are not refitted), within
-    /// a few percent on the real frames, 8-10% slower on the pawns with boxes (most object
-    /// pairs are apart, where a walk from the root is one test).
+    /// Opt-in because it does not pay on the meshes measured (docs/PERFORMANCE.md,
+    /// thirteenth sitting): fewer BV tests on most, but the same time as a walk from the root
+    /// on the icosphere and pawn scenes (within -2..+3%) and 2-9% slower on the real frames,
+    /// whose walk is a few percent of a step (the triangle tests dominate).
     pub fn set_front_tracking(&mut self, on: bool) {
         self.front.tracking = on;
         if !on {
