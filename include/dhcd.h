@@ -177,9 +177,9 @@ int dhcd_hierarchy_method(const struct DhcdHierarchy *h, int *out);
  * handle's scratch (`dhcd_self_collide(h, ...)`, `dhcd_collide(h, b, ...)`) keeps where its
  * traversal stopped, and the next query of the same kind on the same objects starts there
  * instead of at the roots. The contacts are exactly the same; the work differs (less on
- * most deforming meshes, more on some: docs/PERFORMANCE.md). One front per handle:
- * alternating self and pair queries through one handle restarts from the roots each time.
- * `on == 0` drops the kept front.
+ * many deforming meshes, not faster on the meshes measured so far: docs/PERFORMANCE.md).
+ * One front per handle: any other query through it (self after pair, another object, the
+ * two handles swapped) restarts from the roots. `on == 0` drops the kept front.
  *
  * # Safety
  * `h` null or a live handle.
@@ -336,8 +336,9 @@ int dhcd_scene_set_self_collision(struct DhcdScene *s, uint64_t id, int on);
  * Frame-to-frame coherence for the whole scene, off by default: with `on` nonzero, each
  * object pair's query (and each self query) keeps where its traversal stopped, and the next
  * `dhcd_scene_contacts` starts that pair there. The contacts are exactly the same; the work
- * differs (less on most deforming meshes, more on some: docs/PERFORMANCE.md). A pair that
- * stops overlapping drops its front; `on == 0` drops them all.
+ * differs (fewer node tests on many meshes, not faster on the meshes measured so far:
+ * docs/PERFORMANCE.md). A pair that stops overlapping, or an object removed, drops its
+ * front; `on == 0` drops them all.
  *
  * # Safety
  * `s` null or a live handle.

@@ -203,6 +203,10 @@ impl Scene {
     pub fn remove(&mut self, id: ObjectId) -> Result<()> {
         let i = self.index(id)?;
         each!(&mut self.objects, v => { v.remove(i); });
+        if let Some(fronts) = &mut self.fronts {
+            // Its jobs' fronts (and the trees they hold) go now, not at the next step.
+            fronts.retain(|(key, _)| !key.contains(&id.0));
+        }
         Ok(())
     }
 

@@ -167,8 +167,9 @@ impl Workspace {
     /// A front is at most [`FRONT_MAX_ENTRIES`] entries (16 bytes each), else dropped; one that
     /// has grown to twice the size of the last front recorded from the root is dropped too
     /// (the next query starts from the root), and so is one of several entries in which no
-    /// pair overlapped (the objects are apart: from the root that is one test). Turning it
-    /// off drops the front.
+    /// pair overlapped (the next query starts from the roots: one test if the objects are
+    /// apart, a walk down to where they separate if only their bounds meet). Turning it off
+    /// drops the front.
     ///
     /// Opt-in because it does not pay on the meshes measured (docs/PERFORMANCE.md,
     /// thirteenth sitting): fewer BV tests on most, but the same time as a walk from the root
@@ -595,8 +596,9 @@ impl<'h, K: BvKind> Walk<'h, K> {
         let entries = std::mem::take(&mut out.front);
         let len = entries.len();
         let outgrown = !fresh && len > FRONT_REGROWTH * front.fresh_len.max(1);
-        // A replay in which nothing overlapped (the objects are apart): the next query
-        // starts from the roots, where that is one test, not the whole front again.
+        // A replay in which nothing overlapped: the next query starts from the roots, which
+        // is one test if the objects are apart (a front recorded while they touched stays
+        // deep), else a walk down to where they separate, recording that front.
         let idle = !fresh && out.descents == 0 && len > 1;
         if out.front_overflow || outgrown || idle {
             front.clear();

@@ -5,7 +5,7 @@
 
 use dhcd::bv::BvKind;
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
-use dhcd::scene::{Scene, SceneContacts};
+use dhcd::scene::{ObjectId, Scene, SceneContacts};
 use dhcd::shapes::{grid, icosphere, translated, wave};
 use dhcd::{
     broad_phase, collide_with, for_each_kind, narrow_phase, self_broad_phase, self_collide_with,
@@ -320,15 +320,18 @@ fn a_scene_tracking_fronts_finds_what_an_untracked_scene_finds() {
         assert!(!seq.front_tracking());
         seq.set_front_tracking(true);
         par.set_front_tracking(true);
-        let mut replays = 0;
-        for step in 0..10 {
+        let (mut replays, mut third_met, mut small_jobs) = (0, false, Vec::<bool>::new());
+        for step in 0..14 {
             let t = 0.3 * step as f32;
-            // The ball folds onto itself, the small one passes through it, the third comes
-            // from far away, touches, and is removed at step 8.
+            // The ball folds onto itself, the small one swings through it, out, back in and
+            // out again; the third comes from far away, touches, and is removed at step 8.
             let poses = [
                 wave(ball.positions(), t, 0.6, [0.0; 3]),
-                translated(small.positions(), [-3.0 + 0.6 * step as f32, 0.2, 0.1]),
-                translated(ball.positions(), [12.0 - 1.2 * step as f32, 0.0, 0.0]),
+                translated(
+                    small.positions(),
+                    [3.2 * (0.45 * step as f32).cos(), 0.2, 0.1],
+                ),
+                translated(ball.positions(), [12.0 - 1.6 * step as f32, 0.0, 0.0]),
             ];
             for s in [&mut seq, &mut par, &mut root] {
                 if step == 8 {
@@ -349,10 +352,20 @@ fn a_scene_tracking_fronts_finds_what_an_untracked_scene_finds() {
             assert_eq!(jobs(&tracked), jobs(&fresh), "{label}");
             assert_eq!(par.contacts(Par::Rayon(2)), tracked, "{label}: two threads");
             replays += usize::from(tracked.counters.bv_tests != fresh.counters.bv_tests);
+            let in_job = |id: ObjectId| tracked.per_pair.iter().any(|p| p.a != p.b && p.b == id);
+            third_met |= step < 8 && in_job(ids[2]);
+            small_jobs.push(in_job(ids[1]));
         }
         assert!(
             replays >= 5,
             "{method:?}: {replays} steps started from fronts"
+        );
+        assert!(third_met, "{method:?}: the removed object had a job");
+        // The small ball's pair with the big one leaves the broad phase and comes back.
+        let changes = small_jobs.windows(2).filter(|w| w[0] != w[1]).count();
+        assert!(
+            changes >= 3,
+            "{method:?}: the pair entered and left {changes} times"
         );
         seq.set_front_tracking(false);
         assert!(!seq.front_tracking());

@@ -313,6 +313,7 @@ fn scene_front_tracking_gives_the_same_contacts() {
         assert_eq!(on, 0);
         assert_eq!(dhcd_scene_set_front_tracking(null_mut(), 1), DHCD_ERR_NULL);
         assert_eq!(dhcd_scene_front_tracking(null(), &mut on), DHCD_ERR_NULL);
+        assert_eq!(dhcd_scene_front_tracking(plain, null_mut()), DHCD_ERR_NULL);
         dhcd_scene_free(tracked);
         dhcd_scene_free(plain);
     }
@@ -613,6 +614,9 @@ fn front_tracking_gives_the_same_contacts() {
                 dhcd_hierarchy_front_tracking(null(), &mut on),
                 DHCD_ERR_NULL
             );
+            let h = new_h(method, &base);
+            assert_eq!(dhcd_hierarchy_front_tracking(h, null_mut()), DHCD_ERR_NULL);
+            dhcd_hierarchy_free(h);
         }
     }
 }

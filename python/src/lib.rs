@@ -308,8 +308,8 @@ impl Hierarchy {
     }
 
     /// Frame-to-frame coherence, off by default: on, each query through this hierarchy's
-    /// scratch (`self_collide`, `collide(self, other)`) starts where the last one of the same
-    /// kind on the same objects stopped. Same contacts; turning it off drops the front.
+    /// scratch (`self_collide`, `collide(h, other)` with it first) starts where the last one
+    /// of the same kind on the same objects stopped. Same contacts; off drops the front.
     #[getter]
     fn front_tracking(&self) -> bool {
         self.ws.front_tracking()
