@@ -418,8 +418,8 @@ struct Output<'h> {
     front: Vec<FrontEntry>,
     /// The front outgrew [`FRONT_MAX_ENTRIES`] (and was cleared).
     front_overflow: bool,
-    /// Replayed front entries in which some pair overlapped.
-    descents: u64,
+    /// Some replayed front entry had a pair that overlapped.
+    descended: bool,
     rows: [Row; MAX_ROW],
     last: [Option<(usize, LeafSide<'h>)>; 2],
 }
@@ -432,7 +432,7 @@ impl Default for Output<'_> {
             leaves: Vec::new(),
             front: Vec::new(),
             front_overflow: false,
-            descents: 0,
+            descended: false,
             rows: [Row::default(); MAX_ROW],
             last: [None, None],
         }
@@ -445,7 +445,7 @@ impl Output<'_> {
         self.pairs.extend_from_slice(&other.pairs);
         self.leaves.extend_from_slice(&other.leaves);
         self.front_overflow |= other.front_overflow;
-        self.descents += other.descents;
+        self.descended |= other.descended;
         if self.front.len() + other.front.len() > FRONT_MAX_ENTRIES {
             self.front_overflow = true;
         }
@@ -506,28 +506,12 @@ impl<'h, K: BvKind> Walk<'h, K> {
         let sort;
         if replay {
             let entries = std::mem::take(&mut ws.front.entries);
-            if threads <= 1 {
-                dispatch(WalkOp {
-                    walk: self,
-                    work: Work::Front(&entries),
-                    stack: &mut ws.stack,
-                    out: &mut out,
-                });
-            } else {
-                let chunk = entries
-                    .len()
-                    .div_ceil(SEEDS_PER_THREAD * threads)
-                    .max(ws.grain);
-                let part = self.in_parallel(&entries, chunk, |entries, stack, out| {
-                    dispatch(WalkOp {
-                        walk: self,
-                        work: Work::Front(entries),
-                        stack,
-                        out,
-                    })
-                });
-                out = out.merge(part);
-            }
+            let chunk = entries
+                .len()
+                .div_ceil(SEEDS_PER_THREAD * threads)
+                .max(ws.grain);
+            let work = Work::Front(&entries);
+            out = self.walk_tasks(work, threads, chunk, &mut ws.stack, out);
             ws.front.entries = entries;
             sort = true;
         } else {
@@ -543,25 +527,8 @@ impl<'h, K: BvKind> Walk<'h, K> {
                 out: &mut out,
             });
             sort = threads > 1 && !ws.seeds.is_empty();
-            if threads <= 1 {
-                dispatch(WalkOp {
-                    walk: self,
-                    work: Work::Seeds(&ws.seeds),
-                    stack: &mut ws.stack,
-                    out: &mut out,
-                });
-            } else if !ws.seeds.is_empty() {
-                // The breadth-first start left `seeds`: walk them in parallel.
-                let part = self.in_parallel(&ws.seeds, ws.grain, |seeds, stack, out| {
-                    dispatch(WalkOp {
-                        walk: self,
-                        work: Work::Seeds(seeds),
-                        stack,
-                        out,
-                    })
-                });
-                out = out.merge(part);
-            }
+            let work = Work::Seeds(&ws.seeds);
+            out = self.walk_tasks(work, threads, ws.grain, &mut ws.stack, out);
         }
         if sort {
             sort_pairs(&mut out.leaves);
@@ -573,21 +540,42 @@ impl<'h, K: BvKind> Walk<'h, K> {
         out.finish()
     }
 
-    /// `items` (seeds or front entries) split into tasks of `chunk`, each walked by `walk`
-    /// on its own stack and output; the outputs merged in order.
-    fn in_parallel<T: Sync>(
+    /// Walks `work` (seeds or front entries) into `out`: on the calling thread with `stack`,
+    /// or (`threads > 1`) in rayon tasks of `chunk` items, each on its own stack and output,
+    /// merged in order.
+    fn walk_tasks(
         &self,
-        items: &[T],
+        work: Work<'_>,
+        threads: usize,
         chunk: usize,
-        walk: impl Fn(&[T], &mut Vec<[u32; 2]>, &mut Output<'h>) + Sync + Send,
+        stack: &mut Vec<[u32; 2]>,
+        mut out: Output<'h>,
     ) -> Output<'h> {
-        items
-            .par_chunks(chunk)
-            .fold(Output::default, |mut o, chunk| {
-                walk(chunk, &mut Vec::new(), &mut o);
+        if threads <= 1 {
+            dispatch(WalkOp {
+                walk: self,
+                work,
+                stack,
+                out: &mut out,
+            });
+            return out;
+        }
+        if work.len() == 0 {
+            return out;
+        }
+        let part = (0..work.len().div_ceil(chunk))
+            .into_par_iter()
+            .fold(Output::default, |mut o, task| {
+                dispatch(WalkOp {
+                    walk: self,
+                    work: work.slice(task * chunk, chunk),
+                    stack: &mut Vec::new(),
+                    out: &mut o,
+                });
                 o
             })
-            .reduce(Output::default, Output::merge)
+            .reduce(Output::default, Output::merge);
+        out.merge(part)
     }
 
     /// Keeps the front `out` recorded as `front` for the next query, or drops it (outgrown;
@@ -599,7 +587,7 @@ impl<'h, K: BvKind> Walk<'h, K> {
         // A replay in which nothing overlapped: the next query starts from the roots, which
         // is one test if the objects are apart (a front recorded while they touched stays
         // deep), else a walk down to where they separate, recording that front.
-        let idle = !fresh && out.descents == 0 && len > 1;
+        let idle = !fresh && !out.descended && len > 1;
         if out.front_overflow || outgrown || idle {
             front.clear();
             return;
@@ -990,6 +978,24 @@ enum Work<'w> {
     Front(&'w [FrontEntry]),
 }
 
+impl<'w> Work<'w> {
+    fn len(self) -> usize {
+        match self {
+            Work::Seeds(seeds) => seeds.len(),
+            Work::Front(entries) => entries.len(),
+        }
+    }
+
+    /// The items `start..start + n` (fewer at the end).
+    fn slice(self, start: usize, n: usize) -> Self {
+        let end = (start + n).min(self.len());
+        match self {
+            Work::Seeds(seeds) => Work::Seeds(&seeds[start..end]),
+            Work::Front(entries) => Work::Front(&entries[start..end]),
+        }
+    }
+}
+
 /// One walk task (the whole walk, sequentially): depth-first from each item of its work.
 struct WalkOp<'w, 'h, K: BvKind> {
     walk: &'w Walk<'h, K>,
@@ -1002,17 +1008,13 @@ impl<K: BvKind> WithSimd for WalkOp<'_, '_, K> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
-        let items = match self.work {
-            Work::Seeds(seeds) => seeds.len(),
-            Work::Front(entries) => entries.len(),
-        };
-        for i in 0..items {
+        for i in 0..self.work.len() {
             self.stack.clear();
             match self.work {
                 Work::Seeds(seeds) => self.stack.push(seeds[i]),
                 Work::Front(entries) => {
                     self.walk.retest(simd, entries[i], self.stack, self.out);
-                    self.out.descents += u64::from(!self.stack.is_empty());
+                    self.out.descended |= !self.stack.is_empty();
                 }
             }
             // PERF (compile time): the one place the walk engine (`expand`, with the narrow
