@@ -18,7 +18,7 @@
 //! are unspecified and may differ between backends). Sums start at `+0`; tail lanes are
 //! padded with `-0`, which leaves any sum unchanged bit for bit.
 
-use crate::lanes::{f32_array, fold_max, fold_min, fold_sum, load};
+use crate::lanes::{f32_array, fold_max, fold_max_simd, fold_min, fold_min_simd, fold_sum, load};
 use crate::{Soa3, MAX_LANES};
 use pulp::{Simd, WithSimd};
 
@@ -197,7 +197,8 @@ fn max_dist_sq_simd<S: Simd>(simd: S, p: Soa3, idx: Option<&[u32]>, c: [f32; 3])
         acc: simd.splat_f32s(0.0),
     };
     reduce(simd, p, idx, &mut r);
-    fold_max(f32_array::<S>(&r.acc))
+    // The accumulator starts at 0 and NaN never replaces: no NaN lane.
+    fold_max_simd(simd, r.acc)
 }
 
 struct MaxDistSq<'a> {
@@ -400,8 +401,9 @@ fn bounds_simd<S: Simd>(simd: S, p: Soa3, idx: Option<&[u32]>) -> ([f32; 3], [f3
     reduce(simd, p, idx, &mut r);
     let (mut lo, mut hi) = EMPTY_BOUNDS;
     for a in 0..3 {
-        lo[a] = fold_min(f32_array::<S>(&r.lo[a]));
-        hi[a] = fold_max(f32_array::<S>(&r.hi[a]));
+        // The accumulators start at +-inf and NaN never replaces: no NaN lane.
+        lo[a] = fold_min_simd(simd, r.lo[a]);
+        hi[a] = fold_max_simd(simd, r.hi[a]);
     }
     (lo, hi)
 }
