@@ -1047,3 +1047,83 @@ fn fast_path_equals_general_test_on_many_configurations() {
     }
     assert!(hits > 30_000, "enough intersecting cases: {hits}");
 }
+
+/// Coplanar and quad-diagonal pairs, which no plane certifies (a corner lies on the other's
+/// plane): the projection along the first triangle's dominant normal axis decides them, and
+/// never against the exact answer. Flat grids at several scales, offsets and tilts (every
+/// pair of triangles of nearby cells, touching and apart), and the diagonal pairs across a
+/// ring edge of a sphere's planar quads (the n-body frames' balls).
+#[test]
+fn projection_decides_coplanar_and_quad_diagonal_pairs() {
+    let (mut apart, mut decided_apart, mut checked) = (0, 0, 0);
+    let mut check = |a: &Tri, b: &Tri| {
+        let want = triangles_intersect(a, b);
+        check_verdict(a, b, want);
+        check_verdict(b, a, want);
+        checked += 1;
+        if !want {
+            apart += 1;
+            decided_apart += usize::from(pair_verdict(a, b) == Verdict::Apart);
+        }
+    };
+    // Flat grids: cell (i, j) split along one diagonal or the other; every pair of
+    // triangles in cells at most two apart (in-plane frame `ex`, `ey`, origin `o`).
+    let frames: [([f32; 3], [f32; 3], [f32; 3]); 4] = [
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]),
+        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [3.0, -2.0, 0.5]),
+        ([0.6, 0.8, 0.0], [0.0, 0.0, 1.0], [100.0, 7.0, -3.0]),
+        ([0.0, 0.6, 0.8], [1.0, 0.0, 0.0], [-0.25, 0.0, 1e3]),
+    ];
+    for (ex, ey, o) in frames {
+        for h in [1.0f32, 1e-3, 37.5] {
+            let at = |i: i32, j: i32| -> [f32; 3] {
+                std::array::from_fn(|k| o[k] + (i as f32 * ex[k] + j as f32 * ey[k]) * h)
+            };
+            let cell = |i: i32, j: i32, alt: bool| -> [Tri; 2] {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
+                if alt {
+                    [[a, b, c], [b, d, c]]
+                } else {
+                    [[a, b, d], [a, d, c]]
+                }
+            };
+            for alt in [false, true] {
+                let tris: Vec<Tri> = (0..4)
+                    .flat_map(|i| (0..4).flat_map(move |j| cell(i, j, alt ^ ((i + j) % 2 == 1))))
+                    .collect();
+                for (x, a) in tris.iter().enumerate() {
+                    for b in &tris[x + 1..] {
+                        check(a, b);
+                    }
+                }
+            }
+        }
+    }
+    // A UV sphere's planar quads, split along one diagonal: the triangles of two quads
+    // sharing a ring edge, each holding one end of it.
+    let (rings, segments) = (16, 16);
+    let point = |r: usize, s: usize| -> [f32; 3] {
+        let (t, p) = (
+            std::f32::consts::PI * r as f32 / rings as f32,
+            std::f32::consts::TAU * s as f32 / segments as f32,
+        );
+        [
+            4.0 + 0.3 * t.sin() * p.cos(),
+            9.0 + 0.3 * t.cos(),
+            4.1 + 0.3 * t.sin() * p.sin(),
+        ]
+    };
+    for r in 1..rings - 2 {
+        for s in 0..segments {
+            let (s1, r1, r2) = ((s + 1) % segments, r + 1, r + 2);
+            let upper = [point(r, s), point(r1, s), point(r1, s1)];
+            let lower = [point(r1, s1), point(r2, s1), point(r2, s)];
+            check(&upper, &lower);
+        }
+    }
+    assert!(checked > 10_000, "{checked} pairs");
+    assert!(
+        decided_apart * 100 >= apart * 99,
+        "{decided_apart} of {apart} separated pairs certified apart"
+    );
+}

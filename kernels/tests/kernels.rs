@@ -558,6 +558,71 @@ fn leaf_contacts_match_reference_on_all_backends() {
     on_all_backends!(check_leaf_contacts);
 }
 
+/// `n` triangles of a flat grid (two per unit cell, rows of 5 cells) in the plane spanned by
+/// `ex`, `ey`, from triangle `first` on, with the grid's vertex numbering (a mesh's).
+fn grid_tris(n: usize, first: usize, ex: [f32; 3], ey: [f32; 3]) -> Tris {
+    let at = |i: usize, j: usize| -> [f32; 3] {
+        std::array::from_fn(|k| 0.25 * (i as f32 * ex[k] + j as f32 * ey[k]))
+    };
+    let id = |i: usize, j: usize| (i + 6 * j) as u32;
+    let mut tris = Vec::new();
+    let mut ids = Vec::new();
+    for t in first..first + n {
+        let (cell, half) = (t / 2, t % 2);
+        let (i, j) = (cell % 5, cell / 5);
+        let corners = if half == 0 {
+            [(i, j), (i + 1, j), (i + 1, j + 1)]
+        } else {
+            [(i, j), (i + 1, j + 1), (i, j + 1)]
+        };
+        tris.push(corners.map(|(i, j)| at(i, j)));
+        ids.push(corners.map(|(i, j)| id(i, j)));
+    }
+    let mut out = Tris::new(&tris, 0);
+    for (t, v) in ids.iter().enumerate() {
+        for c in 0..3 {
+            out.set_vertex(c, t, v[c]);
+        }
+    }
+    out
+}
+
+/// The projection pass on every backend equals the scalar reference on coplanar blocks (flat
+/// grids in three orientations, blocks of neighbouring cells, one mesh's vertex numbering)
+/// and decides every allowed pair: they are all apart, and no plane separates any of them.
+fn check_coplanar_blocks<S: Simd>(simd: S) {
+    let planes = [
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+        ([0.0, 0.6, 0.8], [1.0, 0.0, 0.0]),
+        ([0.0, 0.0, 1.0], [0.8, 0.6, 0.0]),
+    ];
+    for (ex, ey) in planes {
+        for (na, nb, first_b) in [(64, 64, 10), (20, 64, 0), (64, 17, 30), (9, 9, 4)] {
+            let a = grid_tris(na, 0, ex, ey);
+            let b = grid_tris(nb, first_b, ex, ey);
+            for pairing in [
+                narrow::Pairing::NoSharedVertex,
+                narrow::Pairing::NoSharedVertexUpper,
+            ] {
+                let mut want = vec![narrow::Row::default(); na];
+                let mut got = vec![narrow::Row::default(); na];
+                narrow::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
+                narrow::leaf_contacts_with(simd, a.soa(), na, b.soa(), nb, pairing, &mut got);
+                assert_eq!(got, want, "{simd:?} na={na} nb={nb} {pairing:?}");
+                assert!(
+                    got.iter().all(|r| r.candidates() == 0),
+                    "{simd:?} na={na} nb={nb} {pairing:?}: a coplanar pair left undecided"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn coplanar_blocks_match_reference_on_all_backends() {
+    on_all_backends!(check_coplanar_blocks);
+}
+
 #[test]
 fn dispatched_leaf_contacts_match_reference() {
     let mut rng = Rng::new(9);
