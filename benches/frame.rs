@@ -3,7 +3,7 @@
 //!
 //! Ids:
 //! - `frame/<scene>/<impl>`: a whole step, `impl` in `dhcd-dh`, `dhcd-sphere`, `dhcd-aabb`,
-//!   `parry3d`, plus `dhcd-dh-t1` / `dhcd-dh-t2` on `pawns8` (the `Scene` API, object pairs in parallel, `Par::Rayon(1)` / `Rayon(2)`),
+//!   `parry3d`, plus `dhcd-dh-t1` / `dhcd-dh-t2` on `pawns8` (the `Scene` API, one `Scene::step` a frame: object pairs in parallel, `Par::Rayon(1)` / `Rayon(2)`),
 //!   and `dhcd-dh-front` / `dhcd-aabb-front` (each pair's workspace with front tracking:
 //!   every query starts from the last one's traversal front; the setup prints the BV tests,
 //!   refits and triangle pairs of one cycle from the root and from the front);
@@ -424,8 +424,8 @@ fn bench_scene(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
                 .zip(&scene.frames[f])
                 .map(|(&id, p)| (id, &p[..]))
                 .collect();
-            world.update_many(&updates, par).expect("valid positions");
-            black_box(world.contacts(par).pairs.len())
+            let contacts = world.step(&updates, par).expect("valid positions");
+            black_box(contacts.pairs.len())
         })
     });
 }

@@ -364,6 +364,23 @@ int dhcd_scene_front_tracking(const struct DhcdScene *s, int *out);
 int dhcd_scene_contacts(struct DhcdScene *s, uint32_t threads, struct DhcdSceneContacts *out);
 
 /**
+ * One simulation step: `dhcd_scene_update_many` with the same arguments, then
+ * `dhcd_scene_contacts` into `*out`, in one trip to the thread pool (with several threads,
+ * cheaper than the two calls: docs/PERFORMANCE.md). On error no object changes and `*out`
+ * is empty. With `count == 0` the arrays may be NULL (no object moves).
+ *
+ * # Safety
+ * As `dhcd_scene_update_many` and `dhcd_scene_contacts`.
+ */
+int dhcd_scene_step(struct DhcdScene *s,
+                    const uint64_t *ids,
+                    const float *const *positions,
+                    const size_t *vertex_counts,
+                    size_t count,
+                    uint32_t threads,
+                    struct DhcdSceneContacts *out);
+
+/**
  * Releases the array of a `DhcdSceneContacts` and resets it to empty. Null, or an already
  * released or empty result, is a no-op.
  *

@@ -227,38 +227,37 @@ impl Scene {
     /// non-finite position) nothing changes. The result is the same as one
     /// [`Scene::update_positions`] per object, for every `par`.
     pub fn update_many(&mut self, updates: &[(ObjectId, &[[f32; 3]])], par: Par) -> Result<()> {
-        let mut slot: Vec<Option<&[[f32; 3]]>> = vec![None; self.len()];
+        let slot = self.update_slots(updates)?;
+        // One trip to the pool for the checks and the gathers (each trip wakes its threads).
+        each!(&mut self.objects, v => par.install(|| update_objects(v, &slot, par.is_parallel())))
+    }
+
+    /// One simulation step: [`Scene::update_many`] then [`Scene::contacts`], in one trip to
+    /// the thread pool (on two threads of a small scene, each trip costs about a tenth of the
+    /// step: `docs/PERFORMANCE.md`). On error nothing changes and there are no contacts.
+    pub fn step(&mut self, updates: &[(ObjectId, &[[f32; 3]])], par: Par) -> Result<SceneContacts> {
+        let slot = self.update_slots(updates)?;
+        let fronts = self.fronts.as_mut();
+        let parallel = par.is_parallel();
+        each!(&mut self.objects, v => par.install(|| {
+            update_objects(v, &slot, parallel)?;
+            Ok(contacts_of(v, fronts, parallel))
+        }))
+    }
+
+    /// Each object's new positions (by scene index), or an unknown or repeated id.
+    fn update_slots<'p>(
+        &self,
+        updates: &[(ObjectId, &'p [[f32; 3]])],
+    ) -> Result<Vec<Option<&'p [[f32; 3]]>>> {
+        let mut slot = vec![None; self.len()];
         for &(id, positions) in updates {
             let i = self.index(id)?;
             if slot[i].replace(positions).is_some() {
                 return Err(Error::RepeatedObject(id.0));
             }
         }
-        each!(&mut self.objects, v => {
-            // The first failing object in scene order, whatever `par`.
-            let check = |(o, p): (&Object<_>, &Option<&[[f32; 3]]>)| match p {
-                Some(p) => check_positions(p, o.h.tree().vertex_total()),
-                None => Ok(()),
-            };
-            let checks: Vec<Result<()>> = if par.is_parallel() {
-                par.install(|| v.par_iter().zip(&slot).with_max_len(1).map(check).collect())
-            } else {
-                v.iter().zip(&slot).map(check).collect()
-            };
-            checks.into_iter().collect::<Result<()>>()?;
-            let apply = |(o, p): (&mut Object<_>, &Option<&[[f32; 3]]>)| {
-                if let Some(p) = p {
-                    o.h.apply_positions(p);
-                    o.refresh_bounds();
-                }
-            };
-            if par.is_parallel() {
-                par.install(|| v.par_iter_mut().zip(&slot).with_max_len(1).for_each(apply));
-            } else {
-                v.iter_mut().zip(&slot).for_each(apply);
-            }
-        });
-        Ok(())
+        Ok(slot)
     }
 
     /// Turns the object's self-collision on or off (off when added). With it on,
@@ -394,6 +393,47 @@ fn take_fronts(fronts: &mut PairFronts, jobs: &[[u64; 2]]) -> Vec<Workspace> {
             }
         })
         .collect()
+}
+
+/// Applies `slot[i]` to object `i` (in parallel in the ambient pool if `parallel`), after
+/// checking every one: on error (the first failing object in scene order, whatever
+/// `parallel`) nothing changes.
+fn update_objects<K: BvKind>(
+    objects: &mut [Object<K>],
+    slot: &[Option<&[[f32; 3]]>],
+    parallel: bool,
+) -> Result<()> {
+    let check = |(o, p): (&Object<K>, &Option<&[[f32; 3]]>)| match p {
+        Some(p) => check_positions(p, o.h.tree().vertex_total()),
+        None => Ok(()),
+    };
+    let checks: Vec<Result<()>> = if parallel {
+        objects
+            .par_iter()
+            .zip(slot)
+            .with_max_len(1)
+            .map(check)
+            .collect()
+    } else {
+        objects.iter().zip(slot).map(check).collect()
+    };
+    checks.into_iter().collect::<Result<()>>()?;
+    let apply = |(o, p): (&mut Object<K>, &Option<&[[f32; 3]]>)| {
+        if let Some(p) = p {
+            o.h.apply_positions(p);
+            o.refresh_bounds();
+        }
+    };
+    if parallel {
+        objects
+            .par_iter_mut()
+            .zip(slot)
+            .with_max_len(1)
+            .for_each(apply);
+    } else {
+        objects.iter_mut().zip(slot).for_each(apply);
+    }
+    Ok(())
 }
 
 fn contacts_of<K: BvKind>(

@@ -563,19 +563,25 @@ impl<'h, K: BvKind> Walk<'h, K> {
         if work.len() == 0 {
             return out;
         }
+        // One stack and one output per piece rayon splits the tasks into (not per task):
+        // the output is boxed because the fold moves it at every task (its rows are 1 KiB).
         let part = (0..work.len().div_ceil(chunk))
             .into_par_iter()
-            .fold(Output::default, |mut o, task| {
-                dispatch(WalkOp {
-                    walk: self,
-                    work: work.slice(task * chunk, chunk),
-                    stack: &mut Vec::new(),
-                    out: &mut o,
-                });
-                o
-            })
-            .reduce(Output::default, Output::merge);
-        out.merge(part)
+            .fold(
+                || (Box::<Output>::default(), Vec::new()),
+                |(mut o, mut stack), task| {
+                    dispatch(WalkOp {
+                        walk: self,
+                        work: work.slice(task * chunk, chunk),
+                        stack: &mut stack,
+                        out: &mut o,
+                    });
+                    (o, stack)
+                },
+            )
+            .map(|(o, _)| o)
+            .reduce(Box::default, |a, b| Box::new(a.merge(*b)));
+        out.merge(*part)
     }
 
     /// Keeps the front `out` recorded as `front` for the next query, or drops it (outgrown;

@@ -358,7 +358,8 @@ fn per_pair_counters_are_those_of_sequential_queries_in_job_order() {
 }
 
 /// `update_many` is one `update_positions` per object, for every thread count: same
-/// contacts, same counters, same root boxes.
+/// contacts, same counters, same root boxes; and `step` is `update_many` then `contacts`
+/// (every field of the result).
 #[test]
 fn update_many_equals_one_update_per_object() {
     let ball = icosphere(2, 1.0, [0.0; 3]);
@@ -374,6 +375,7 @@ fn update_many_equals_one_update_per_object() {
         .into_iter()
         .map(|par| (build().0, par))
         .collect();
+    let mut stepped: Vec<Scene> = batched.iter().map(|_| build().0).collect();
     for step in 0..3 {
         let poses: Vec<Mesh> = (0..n)
             .map(|k| {
@@ -392,7 +394,7 @@ fn update_many_equals_one_update_per_object() {
         assert!(!reference.pairs.is_empty());
         // Every other step, only some objects move.
         let moved = if step == 1 { 0..3 } else { 0..n };
-        for (scene, par) in &mut batched {
+        for ((scene, par), stepping) in batched.iter_mut().zip(&mut stepped) {
             let updates: Vec<(ObjectId, &[[f32; 3]])> = moved
                 .clone()
                 .map(|k| (ids[k], poses[k].positions()))
@@ -403,17 +405,26 @@ fn update_many_equals_one_update_per_object() {
                     scene
                         .update_positions(ids[k], poses[k].positions())
                         .unwrap();
+                    stepping
+                        .update_positions(ids[k], poses[k].positions())
+                        .unwrap();
                 }
             }
             for &id in &ids {
                 assert_eq!(scene.bounds(id), one_by_one.bounds(id));
             }
-            assert_eq!(scene.contacts(Par::Seq).pairs, reference.pairs, "{par:?}");
+            let contacts = scene.contacts(Par::Seq);
+            assert_eq!(contacts.pairs, reference.pairs, "{par:?}");
+            assert_eq!(stepping.step(&updates, *par).unwrap(), contacts, "{par:?}");
+            for &id in &ids {
+                assert_eq!(stepping.bounds(id), one_by_one.bounds(id));
+            }
         }
     }
 }
 
-/// A bad entry anywhere in an `update_many` is a typed error and no object moves.
+/// A bad entry anywhere in an `update_many` (or a `step`) is a typed error and no object
+/// moves.
 #[test]
 fn update_many_checks_everything_before_changing_anything() {
     let ball = icosphere(1, 1.0, [0.0; 3]);
@@ -455,6 +466,8 @@ fn update_many_checks_everything_before_changing_anything() {
             let got = scene.update_many(updates, par).unwrap_err();
             // NaN != NaN: compare the messages.
             assert_eq!(got.to_string(), error.to_string(), "{par:?}");
+            let got = scene.step(updates, par).unwrap_err();
+            assert_eq!(got.to_string(), error.to_string(), "step, {par:?}");
             assert_eq!(
                 (scene.bounds(a).unwrap(), scene.bounds(b).unwrap()),
                 before,

@@ -676,6 +676,57 @@ pub unsafe extern "C" fn dhcd_scene_update_positions(
     })
 }
 
+/// One object's new positions.
+type Update<'a> = (ObjectId, &'a [[f32; 3]]);
+
+/// The entries of an update call (`dhcd_scene_update_many`, `dhcd_scene_step`).
+///
+/// # Safety
+/// `ids`, `positions` and `vertex_counts` hold `count` elements each (`count > 0`), and each
+/// non-null `positions[k]` holds `3 * vertex_counts[k]` floats, alive for `'a`.
+unsafe fn updates<'a>(
+    ids: *const u64,
+    positions: *const *const f32,
+    vertex_counts: *const usize,
+    count: usize,
+) -> Result<Vec<Update<'a>>, Fail> {
+    // SAFETY: the three arrays hold `count` elements (caller's contract).
+    let (ids, ptrs, counts) = unsafe {
+        (
+            slice(ids, count, "ids")?,
+            slice(positions, count, "positions")?,
+            slice(vertex_counts, count, "vertex_counts")?,
+        )
+    };
+    ids.iter()
+        .zip(ptrs.iter().zip(counts))
+        .enumerate()
+        .map(|(k, (&id, (&p, &n)))| {
+            // SAFETY: `positions[k]` holds `3 * vertex_counts[k]` floats (caller's contract).
+            let p = unsafe { self::positions(p, n) }
+                .map_err(|Fail(code, msg)| Fail(code, format!("update {k}: {msg}")))?;
+            Ok((ObjectId(id), p))
+        })
+        .collect()
+}
+
+/// A scene's contacts as the C result (the array owned by the caller until
+/// `dhcd_scene_contacts_free`).
+fn scene_contacts_result(c: dhcd::SceneContacts) -> DhcdSceneContacts {
+    let count = c.pairs.len();
+    let pairs = if count == 0 {
+        std::ptr::null_mut()
+    } else {
+        let flat: Box<[u64]> = c.pairs.into_iter().flatten().collect();
+        Box::into_raw(flat).cast::<u64>()
+    };
+    DhcdSceneContacts {
+        pairs,
+        count,
+        counters: c.counters.into(),
+    }
+}
+
 /// New positions of several objects in one call: entry `k` gives object `ids[k]` the
 /// `3 * vertex_counts[k]` floats at `positions[k]` (as in `dhcd_scene_update_positions`).
 /// `ids`, `positions` and `vertex_counts` hold `count` elements each; each id at most once.
@@ -704,26 +755,8 @@ pub unsafe extern "C" fn dhcd_scene_update_many(
         if count == 0 {
             return Ok(());
         }
-        // SAFETY: the three arrays hold `count` elements (caller's contract).
-        let (ids, ptrs, counts) = unsafe {
-            (
-                slice(ids, count, "ids")?,
-                slice(positions, count, "positions")?,
-                slice(vertex_counts, count, "vertex_counts")?,
-            )
-        };
-        let updates = ids
-            .iter()
-            .zip(ptrs.iter().zip(counts))
-            .enumerate()
-            .map(|(k, (&id, (&p, &n)))| {
-                // SAFETY: `positions[k]` holds `3 * vertex_counts[k]` floats (caller's
-                // contract).
-                let p = unsafe { self::positions(p, n) }
-                    .map_err(|Fail(code, msg)| Fail(code, format!("update {k}: {msg}")))?;
-                Ok((ObjectId(id), p))
-            })
-            .collect::<Result<Vec<_>, Fail>>()?;
+        // SAFETY: caller's contract.
+        let updates = unsafe { updates(ids, positions, vertex_counts, count)? };
         Ok(s.scene.update_many(&updates, par)?)
     })
 }
@@ -801,20 +834,48 @@ pub unsafe extern "C" fn dhcd_scene_contacts(
         // SAFETY: caller's contract.
         let s = unsafe { handle(s, "scene")? };
         let c = s.scene.contacts(par(threads)?);
-        let count = c.pairs.len();
-        let pairs = if count == 0 {
-            std::ptr::null_mut()
-        } else {
-            let flat: Box<[u64]> = c.pairs.into_iter().flatten().collect();
-            Box::into_raw(flat).cast::<u64>()
-        };
-        let result = DhcdSceneContacts {
-            pairs,
-            count,
-            counters: c.counters.into(),
-        };
         // SAFETY: as above.
-        unsafe { write(out, result, "out") }
+        unsafe { write(out, scene_contacts_result(c), "out") }
+    })
+}
+
+/// One simulation step: `dhcd_scene_update_many` with the same arguments, then
+/// `dhcd_scene_contacts` into `*out`, in one trip to the thread pool (with several threads,
+/// cheaper than the two calls: docs/PERFORMANCE.md). On error no object changes and `*out`
+/// is empty. With `count == 0` the arrays may be NULL (no object moves).
+///
+/// # Safety
+/// As `dhcd_scene_update_many` and `dhcd_scene_contacts`.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_step(
+    s: *mut DhcdScene,
+    ids: *const u64,
+    positions: *const *const f32,
+    vertex_counts: *const usize,
+    count: usize,
+    threads: u32,
+    out: *mut DhcdSceneContacts,
+) -> c_int {
+    guard(|| {
+        let empty = DhcdSceneContacts {
+            pairs: std::ptr::null_mut(),
+            count: 0,
+            counters: DhcdCounters::default(),
+        };
+        // SAFETY: caller's contract on `out`: empty until there are contacts.
+        unsafe { write(out, empty, "out")? };
+        // SAFETY: caller's contract.
+        let s = unsafe { handle(s, "scene")? };
+        let par = par(threads)?;
+        let updates = if count == 0 {
+            Vec::new()
+        } else {
+            // SAFETY: caller's contract.
+            unsafe { updates(ids, positions, vertex_counts, count)? }
+        };
+        let c = s.scene.step(&updates, par)?;
+        // SAFETY: as above.
+        unsafe { write(out, scene_contacts_result(c), "out") }
     })
 }
 

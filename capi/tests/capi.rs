@@ -231,6 +231,17 @@ unsafe fn scene_contacts(s: *mut DhcdScene) -> (Vec<[u64; 4]>, DhcdCounters) {
             "{}",
             last_error()
         );
+        taken(&mut c)
+    }
+}
+
+/// The pairs and counters of a filled result, which is released.
+///
+/// # Safety
+/// `c` filled by the library and not released.
+unsafe fn taken(c: &mut DhcdSceneContacts) -> (Vec<[u64; 4]>, DhcdCounters) {
+    // SAFETY: caller's contract: `pairs` holds `4 * count` entries.
+    unsafe {
         let pairs = if c.count == 0 {
             Vec::new()
         } else {
@@ -240,8 +251,46 @@ unsafe fn scene_contacts(s: *mut DhcdScene) -> (Vec<[u64; 4]>, DhcdCounters) {
                 .collect()
         };
         let counters = c.counters;
-        dhcd_scene_contacts_free(&mut c);
+        dhcd_scene_contacts_free(c);
         (pairs, counters)
+    }
+}
+
+/// `dhcd_scene_step`'s result, or its error code.
+///
+/// # Safety
+/// As `dhcd_scene_step`.
+unsafe fn scene_step(
+    s: *mut DhcdScene,
+    ids: &[u64],
+    ptrs: &[*const f32],
+    counts: &[usize],
+    threads: u32,
+) -> Result<(Vec<[u64; 4]>, DhcdCounters), i32> {
+    let mut c = DhcdSceneContacts {
+        pairs: null_mut(),
+        count: 1,
+        counters: DhcdCounters::default(),
+    };
+    // SAFETY: caller's contract.
+    unsafe {
+        let rc = dhcd_scene_step(
+            s,
+            ids.as_ptr(),
+            ptrs.as_ptr(),
+            counts.as_ptr(),
+            ids.len(),
+            threads,
+            &mut c,
+        );
+        if rc != DHCD_OK {
+            assert!(
+                c.pairs.is_null() && c.count == 0,
+                "an error leaves no contacts"
+            );
+            return Err(rc);
+        }
+        Ok(taken(&mut c))
     }
 }
 
@@ -330,6 +379,7 @@ fn scene_update_many_equals_one_update_per_object() {
         .into_iter()
         .map(|t| (scene_of(&ball, n).0, t))
         .collect();
+    let stepped: Vec<*mut DhcdScene> = batched.iter().map(|_| scene_of(&ball, n).0).collect();
     for step in 0..3 {
         let poses: Vec<Vec<f32>> = (0..n)
             .map(|k| {
@@ -361,7 +411,7 @@ fn scene_update_many_equals_one_update_per_object() {
             let entry_ids: Vec<u64> = moved.iter().map(|&k| ids[k]).collect();
             let entry_ptrs: Vec<*const f32> = moved.iter().map(|&k| poses[k].as_ptr()).collect();
             let entry_counts = vec![ball.vertex_count(); moved.len()];
-            for &(s, threads) in &batched {
+            for (&(s, threads), &stepping) in batched.iter().zip(&stepped) {
                 let rc = dhcd_scene_update_many(
                     s,
                     entry_ids.as_ptr(),
@@ -379,20 +429,31 @@ fn scene_update_many_equals_one_update_per_object() {
                         ball.vertex_count(),
                     );
                     assert_eq!(rc, DHCD_OK, "{}", last_error());
+                    let rc = dhcd_scene_update_positions(
+                        stepping,
+                        ids[k],
+                        poses[k].as_ptr(),
+                        ball.vertex_count(),
+                    );
+                    assert_eq!(rc, DHCD_OK, "{}", last_error());
                 }
                 assert_eq!(
                     scene_contacts(s),
                     reference,
                     "step {step}, threads {threads}"
                 );
+                // `dhcd_scene_step` is the update, then the contacts.
+                let got = scene_step(stepping, &entry_ids, &entry_ptrs, &entry_counts, threads);
+                assert_eq!(got, Ok(reference.clone()), "step {step}, threads {threads}");
             }
         }
     }
     // SAFETY: live handles, released once.
     unsafe {
         dhcd_scene_free(one_by_one);
-        for (s, _) in batched {
+        for ((s, _), stepping) in batched.into_iter().zip(stepped) {
             dhcd_scene_free(s);
+            dhcd_scene_free(stepping);
         }
     }
 }
@@ -496,6 +557,17 @@ fn scene_update_many_bad_entry_changes_nothing() {
                 last_error()
             );
             assert_eq!(scene_contacts(s).0, before.0, "nothing moved ({message})");
+            assert_eq!(
+                scene_step(s, &ids, &ptrs, &counts, threads),
+                Err(code),
+                "{message}"
+            );
+            assert!(last_error().contains(message), "step: {}", last_error());
+            assert_eq!(
+                scene_contacts(s).0,
+                before.0,
+                "step: nothing moved ({message})"
+            );
         }
         // Null arrays with entries, a null scene.
         let (id, ptr, count) = ([a], [far.as_ptr()], [nv]);

@@ -154,6 +154,16 @@ class Scene:
         any is applied: an unknown id, an object given twice, a wrong shape or vertex count,
         a non-finite coordinate raise ``ValueError`` and nothing changes (an entry that is
         not a pair raises ``TypeError``). The result equals one ``update`` per entry."""
+    def step(
+        self,
+        updates: Union[
+            Mapping[Union[int, str], Vertices], Iterable[Tuple[Union[int, str], Vertices]]
+        ],
+        threads: int = 1,
+    ) -> Contacts:
+        """One simulation step: ``update_many(updates)`` then ``contacts()``, in one trip
+        to the thread pool (cheaper than the two calls with several threads). The same
+        errors as ``update_many``, and then nothing moves."""
     def remove(self, id: Union[int, str]) -> None: ...
     def set_self_collision(self, id: Union[int, str], on: bool) -> None:
         """With ``on``, ``contacts`` also reports the object's own intersecting faces."""

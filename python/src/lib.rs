@@ -458,9 +458,30 @@ impl Scene {
             _ => Err(value_error(format!("no object with id {i} in the scene"))),
         }
     }
+
+    /// The entries of `update_many` or `step` (a mapping or an iterable of pairs): the
+    /// objects and their vertex arrays, borrowed.
+    #[allow(clippy::type_complexity)]
+    fn updates<'py>(
+        &self,
+        updates: &Bound<'py, PyAny>,
+    ) -> PyResult<(Vec<ObjectId>, Vec<Vertices<'py>>)> {
+        let entries = match updates.cast::<PyMapping>() {
+            Ok(m) => m.items()?.into_any(),
+            Err(_) => updates.clone(),
+        };
+        let mut ids = Vec::new();
+        let mut vertices = Vec::new();
+        for (k, entry) in entries.try_iter()?.enumerate() {
+            let (id, v) = update_pair(&entry?, k)?;
+            ids.push(self.object(&id)?);
+            vertices.push(Vertices::new(&v)?);
+        }
+        Ok((ids, vertices))
+    }
 }
 
-/// Entry `k` of `Scene.update_many`: an `(id or name, vertices)` tuple or list.
+/// Entry `k` of `Scene.update_many` or `Scene.step`: an `(id or name, vertices)` tuple or list.
 fn update_pair<'py>(
     entry: &Bound<'py, PyAny>,
     k: usize,
@@ -552,18 +573,8 @@ impl Scene {
         threads: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         let par = par(threads)?;
-        let entries = match updates.cast::<PyMapping>() {
-            Ok(m) => m.items()?.into_any(),
-            Err(_) => updates.clone(),
-        };
         // The vertex arrays stay borrowed (alive, read-only) until the update is done.
-        let mut ids = Vec::new();
-        let mut vertices = Vec::new();
-        for (k, entry) in entries.try_iter()?.enumerate() {
-            let (id, v) = update_pair(&entry?, k)?;
-            ids.push(self.object(&id)?);
-            vertices.push(Vertices::new(&v)?);
-        }
+        let (ids, vertices) = self.updates(updates)?;
         let updates = ids
             .into_iter()
             .zip(&vertices)
@@ -572,6 +583,31 @@ impl Scene {
         let scene = &mut self.scene;
         py.detach(|| scene.update_many(&updates, par))
             .map_err(to_py)
+    }
+
+    /// One simulation step: `update_many(updates)` then `contacts()`, in one trip to the
+    /// thread pool (cheaper than the two calls with several threads). On error no object
+    /// moves.
+    #[pyo3(
+        signature = (updates, threads = None),
+        text_signature = "(self, updates, threads=1)"
+    )]
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        updates: &Bound<'_, PyAny>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Contacts> {
+        let par = par(threads)?;
+        let (ids, vertices) = self.updates(updates)?;
+        let updates = ids
+            .into_iter()
+            .zip(&vertices)
+            .map(|(id, v)| Ok((id, v.as_slice()?)))
+            .collect::<PyResult<Vec<_>>>()?;
+        let scene = &mut self.scene;
+        let c = py.detach(|| scene.step(&updates, par)).map_err(to_py)?;
+        Contacts::new(py, c.pairs, c.counters)
     }
 
     /// Removes an object (by id or name); its id is never handed out again.

@@ -91,6 +91,27 @@ def test_update_many_equals_separate_updates():
             np.testing.assert_array_equal(s.contacts().pairs, before)
 
 
+def test_step_is_update_many_then_contacts():
+    v, f = icosphere(2)
+    n = 4
+    for method in dhcd._dhcd.METHODS:
+        reference = dhcd.Scene(method=method)
+        stepped = [(dhcd.Scene(method=method), t) for t in [None, 1, 2]]
+        for s in [reference] + [s for s, _ in stepped]:
+            for k in range(n):
+                s.add(v, f, name=f"ball{k}")
+            s.set_self_collision(0, True)
+        for step in range(3):
+            poses = {k: wave(v, step + k, 0.3, (1.7 * k, 0.0, 0.0)) for k in range(n)}
+            reference.update_many(poses)
+            expected = reference.contacts()
+            assert len(expected.pairs) > 0
+            for s, threads in stepped:
+                got = s.step(poses, threads=threads)
+                np.testing.assert_array_equal(got.pairs, expected.pairs)
+                assert got.counters == expected.counters, (method, step, threads)
+
+
 def test_update_many_bad_entry_changes_nothing():
     v, f = icosphere(1)
     s = dhcd.Scene()
@@ -120,6 +141,9 @@ def test_update_many_bad_entry_changes_nothing():
         assert str(many.value) == str(single.value)
         with pytest.raises(ValueError):
             s.update_many([(a, far), entry], threads=2)
+        with pytest.raises(ValueError) as stepped:
+            s.step([(a, far), entry])
+        assert str(stepped.value) == str(single.value)
         np.testing.assert_array_equal(s.contacts().pairs, before)
     # An object given twice, also by id and by name.
     for updates in [[(a, far), (b, far), (a, far)], {b: far, "b": far}, [("a", far), (0, nan)]]:

@@ -236,6 +236,12 @@ int main(void) {
   }
   printf("scene after dhcd_scene_update_many: %zu contacts\n", sc.count);
   dhcd_scene_contacts_free(&sc);
+  /* One call per simulation step: the same update, then the contacts (one trip to the
+   * thread pool instead of two). The poses are the same, so are the contacts. */
+  OK(dhcd_scene_step(scene, ids, poses, vertex_counts, 2, 2, &sc));
+  CHECK(sc.count == first.count);
+  printf("scene after dhcd_scene_step: %zu contacts\n", sc.count);
+  dhcd_scene_contacts_free(&sc);
   dhcd_scene_free(scene);
   free(crossing);
 
