@@ -126,6 +126,11 @@ macro_rules! each {
 /// scene.remove(b)?;
 /// assert!(scene.contacts(Par::Seq).pairs.is_empty());
 /// assert!(scene.remove(b).is_err()); // ids are never reused
+/// // A simulation step in one call: new poses, then every contact.
+/// let back = shapes::translated(ball.positions(), [1.5, 0.0, 0.0]);
+/// let c = scene.step(&[(far, &back)], Par::Rayon(2))?;
+/// assert!(c.pairs.iter().all(|p| p[0] == a.0 && p[2] == far.0));
+/// assert!(!c.pairs.is_empty());
 /// # Ok::<(), dhcd::Error>(())
 /// ```
 #[derive(Clone, Debug)]
