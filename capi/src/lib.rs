@@ -322,6 +322,12 @@ const NO_CONTACTS: DhcdContacts = DhcdContacts {
     },
 };
 
+const NO_SCENE_CONTACTS: DhcdSceneContacts = DhcdSceneContacts {
+    pairs: std::ptr::null_mut(),
+    count: 0,
+    counters: NO_CONTACTS.counters,
+};
+
 /// The message of the last failed call on this thread (UTF-8, NUL-terminated; empty if
 /// none). Valid until the next failing call on this thread; never null. Successful calls
 /// leave it unchanged.
@@ -682,14 +688,18 @@ type Update<'a> = (ObjectId, &'a [[f32; 3]]);
 /// The entries of an update call (`dhcd_scene_update_many`, `dhcd_scene_step`).
 ///
 /// # Safety
-/// `ids`, `positions` and `vertex_counts` hold `count` elements each (`count > 0`), and each
-/// non-null `positions[k]` holds `3 * vertex_counts[k]` floats, alive for `'a`.
+/// `ids`, `positions` and `vertex_counts` hold `count` elements each (any of them may be
+/// null when `count == 0`: no entries), and each non-null `positions[k]` holds
+/// `3 * vertex_counts[k]` floats, alive for `'a`.
 unsafe fn updates<'a>(
     ids: *const u64,
     positions: *const *const f32,
     vertex_counts: *const usize,
     count: usize,
 ) -> Result<Vec<Update<'a>>, Fail> {
+    if count == 0 {
+        return Ok(Vec::new());
+    }
     // SAFETY: the three arrays hold `count` elements (caller's contract).
     let (ids, ptrs, counts) = unsafe {
         (
@@ -824,13 +834,8 @@ pub unsafe extern "C" fn dhcd_scene_contacts(
     out: *mut DhcdSceneContacts,
 ) -> c_int {
     guard(|| {
-        let empty = DhcdSceneContacts {
-            pairs: std::ptr::null_mut(),
-            count: 0,
-            counters: DhcdCounters::default(),
-        };
         // SAFETY: caller's contract on `out`: empty until there are contacts.
-        unsafe { write(out, empty, "out")? };
+        unsafe { write(out, NO_SCENE_CONTACTS, "out")? };
         // SAFETY: caller's contract.
         let s = unsafe { handle(s, "scene")? };
         let c = s.scene.contacts(par(threads)?);
@@ -857,22 +862,13 @@ pub unsafe extern "C" fn dhcd_scene_step(
     out: *mut DhcdSceneContacts,
 ) -> c_int {
     guard(|| {
-        let empty = DhcdSceneContacts {
-            pairs: std::ptr::null_mut(),
-            count: 0,
-            counters: DhcdCounters::default(),
-        };
         // SAFETY: caller's contract on `out`: empty until there are contacts.
-        unsafe { write(out, empty, "out")? };
+        unsafe { write(out, NO_SCENE_CONTACTS, "out")? };
         // SAFETY: caller's contract.
         let s = unsafe { handle(s, "scene")? };
         let par = par(threads)?;
-        let updates = if count == 0 {
-            Vec::new()
-        } else {
-            // SAFETY: caller's contract.
-            unsafe { updates(ids, positions, vertex_counts, count)? }
-        };
+        // SAFETY: caller's contract.
+        let updates = unsafe { updates(ids, positions, vertex_counts, count)? };
         let c = s.scene.step(&updates, par)?;
         // SAFETY: as above.
         unsafe { write(out, scene_contacts_result(c), "out") }
@@ -894,9 +890,7 @@ pub unsafe extern "C" fn dhcd_scene_contacts_free(c: *mut DhcdSceneContacts) {
                 // SAFETY: `pairs` came from `Box<[u64]>` of `4 * count` elements.
                 drop(unsafe { Box::from_raw(std::ptr::slice_from_raw_parts_mut(c.pairs, len)) });
             }
-            c.pairs = std::ptr::null_mut();
-            c.count = 0;
-            c.counters = DhcdCounters::default();
+            *c = NO_SCENE_CONTACTS;
         }
         Ok(())
     });

@@ -51,6 +51,8 @@ bytes; alias ``"sbv"``), ``"aabb"`` (24 bytes). Case-insensitive."""
 
 Vertices = npt.ArrayLike
 Faces = npt.ArrayLike
+# `Scene.update_many` and `Scene.step`: `{id or name: vertices}` or `[(id or name, vertices)]`.
+Updates = Union[Mapping[Union[int, str], Vertices], Iterable[Tuple[Union[int, str], Vertices]]]
 
 class Contacts:
     """The result of a query."""
@@ -143,9 +145,7 @@ class Scene:
         """New vertex positions of an object; on error nothing changes."""
     def update_many(
         self,
-        updates: Union[
-            Mapping[Union[int, str], Vertices], Iterable[Tuple[Union[int, str], Vertices]]
-        ],
+        updates: Updates,
         threads: int = 1,
     ) -> None:
         """New vertex positions of several objects in one call: ``{id: vertices}`` or
@@ -156,9 +156,7 @@ class Scene:
         not a pair raises ``TypeError``). The result equals one ``update`` per entry."""
     def step(
         self,
-        updates: Union[
-            Mapping[Union[int, str], Vertices], Iterable[Tuple[Union[int, str], Vertices]]
-        ],
+        updates: Updates,
         threads: int = 1,
     ) -> Contacts:
         """One simulation step: ``update_many(updates)`` then ``contacts()``, in one trip

@@ -459,26 +459,34 @@ impl Scene {
         }
     }
 
-    /// The entries of `update_many` or `step` (a mapping or an iterable of pairs): the
-    /// objects and their vertex arrays, borrowed.
-    #[allow(clippy::type_complexity)]
+    /// The entries of `update_many` or `step` (a mapping or an iterable of pairs): each
+    /// object and its vertex array, borrowed (alive, read-only) while the result lives.
     fn updates<'py>(
         &self,
         updates: &Bound<'py, PyAny>,
-    ) -> PyResult<(Vec<ObjectId>, Vec<Vertices<'py>>)> {
+    ) -> PyResult<Vec<(ObjectId, Vertices<'py>)>> {
         let entries = match updates.cast::<PyMapping>() {
             Ok(m) => m.items()?.into_any(),
             Err(_) => updates.clone(),
         };
-        let mut ids = Vec::new();
-        let mut vertices = Vec::new();
+        let mut out = Vec::new();
         for (k, entry) in entries.try_iter()?.enumerate() {
             let (id, v) = update_pair(&entry?, k)?;
-            ids.push(self.object(&id)?);
-            vertices.push(Vertices::new(&v)?);
+            out.push((self.object(&id)?, Vertices::new(&v)?));
         }
-        Ok((ids, vertices))
+        Ok(out)
     }
+}
+
+/// One object's new positions, as the library takes them.
+type Update<'a> = (ObjectId, &'a [[f32; 3]]);
+
+/// The entries of [`Scene::updates`] as the library takes them.
+fn as_updates<'a>(entries: &'a [(ObjectId, Vertices<'_>)]) -> PyResult<Vec<Update<'a>>> {
+    entries
+        .iter()
+        .map(|(id, v)| Ok((*id, v.as_slice()?)))
+        .collect()
 }
 
 /// Entry `k` of `Scene.update_many` or `Scene.step`: an `(id or name, vertices)` tuple or list.
@@ -573,13 +581,8 @@ impl Scene {
         threads: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         let par = par(threads)?;
-        // The vertex arrays stay borrowed (alive, read-only) until the update is done.
-        let (ids, vertices) = self.updates(updates)?;
-        let updates = ids
-            .into_iter()
-            .zip(&vertices)
-            .map(|(id, v)| Ok((id, v.as_slice()?)))
-            .collect::<PyResult<Vec<_>>>()?;
+        let entries = self.updates(updates)?;
+        let updates = as_updates(&entries)?;
         let scene = &mut self.scene;
         py.detach(|| scene.update_many(&updates, par))
             .map_err(to_py)
@@ -599,12 +602,8 @@ impl Scene {
         threads: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Contacts> {
         let par = par(threads)?;
-        let (ids, vertices) = self.updates(updates)?;
-        let updates = ids
-            .into_iter()
-            .zip(&vertices)
-            .map(|(id, v)| Ok((id, v.as_slice()?)))
-            .collect::<PyResult<Vec<_>>>()?;
+        let entries = self.updates(updates)?;
+        let updates = as_updates(&entries)?;
         let scene = &mut self.scene;
         let c = py.detach(|| scene.step(&updates, par)).map_err(to_py)?;
         Contacts::new(py, c.pairs, c.counters)
