@@ -68,6 +68,7 @@ pub fn f32_lanes() -> usize {
 /// of their element, so a slice of `F32_LANES` elements reinterprets in place; the only
 /// `unsafe` is the x86 masked load of a short slice and the backend-token casts.
 pub(crate) mod lanes {
+    use super::MAX_LANES;
     use pulp::Simd;
 
     /// Loads `v` (at most `S::F32_LANES` values; missing lanes are zero), reading nothing
@@ -165,6 +166,39 @@ pub(crate) mod lanes {
             let v: S::u32s = bytemuck::cast(m);
             u32_array::<S>(&v)[0] & 1
         }
+    }
+
+    /// `0, 1, 2, ...`: lane indices (loaded as one vector of the backend's lanes).
+    pub const IOTA: [f32; MAX_LANES] = {
+        let mut a = [0.0; MAX_LANES];
+        let mut i = 0;
+        while i < MAX_LANES {
+            a[i] = i as f32;
+            i += 1;
+        }
+        a
+    };
+
+    /// `x` with its lower and upper half of lanes swapped (one `vshuff32x4` on x86-v4).
+    #[inline(always)]
+    pub fn swap_halves<S: Simd>(simd: S, x: S::f32s) -> S::f32s {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(v4) = as_v4(simd) {
+            let v: pulp::f32x16 = bytemuck::cast(x);
+            // SAFETY: `f32x16` and `__m512` are 64 bytes of `f32`.
+            let v: core::arch::x86_64::__m512 = unsafe { core::mem::transmute(v) };
+            let w = v4.avx512f._mm512_shuffle_f32x4::<0b01_00_11_10>(v, v);
+            // SAFETY: as above.
+            let w: pulp::f32x16 = unsafe { core::mem::transmute(w) };
+            return bytemuck::cast(w);
+        }
+        let _ = simd;
+        let a = f32_array::<S>(&x);
+        let half = a.len() / 2;
+        let mut b = [0.0; MAX_LANES];
+        b[..half].copy_from_slice(&a[half..]);
+        b[half..2 * half].copy_from_slice(&a[..half]);
+        load::<S>(&b)
     }
 
     /// `simd` as pulp's x86-v3 token when that is its type.
@@ -302,6 +336,12 @@ impl<'a> Tile<'a> {
     #[inline(always)]
     pub fn stride(&self) -> usize {
         self.stride
+    }
+
+    /// Every field, side by side.
+    #[inline(always)]
+    pub fn data(&self) -> &'a [f32] {
+        self.data
     }
 
     /// Field `f`.
