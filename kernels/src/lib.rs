@@ -179,28 +179,6 @@ pub(crate) mod lanes {
         a
     };
 
-    /// `x` with its lower and upper half of lanes swapped (one `vshuff32x4` on x86-v4).
-    #[inline(always)]
-    pub fn swap_halves<S: Simd>(simd: S, x: S::f32s) -> S::f32s {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(v4) = as_v4(simd) {
-            let v: pulp::f32x16 = bytemuck::cast(x);
-            // SAFETY: `f32x16` and `__m512` are 64 bytes of `f32`.
-            let v: core::arch::x86_64::__m512 = unsafe { core::mem::transmute(v) };
-            let w = v4.avx512f._mm512_shuffle_f32x4::<0b01_00_11_10>(v, v);
-            // SAFETY: as above.
-            let w: pulp::f32x16 = unsafe { core::mem::transmute(w) };
-            return bytemuck::cast(w);
-        }
-        let _ = simd;
-        let a = f32_array::<S>(&x);
-        let half = a.len() / 2;
-        let mut b = [0.0; MAX_LANES];
-        b[..half].copy_from_slice(&a[half..]);
-        b[half..2 * half].copy_from_slice(&a[..half]);
-        load::<S>(&b)
-    }
-
     /// `simd` as pulp's x86-v3 token when that is its type.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
@@ -211,7 +189,7 @@ pub(crate) mod lanes {
     /// `simd` as pulp's x86-v4 token when that is its type.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn as_v4<S: Simd>(simd: S) -> Option<pulp::x86::V4> {
+    pub(crate) fn as_v4<S: Simd>(simd: S) -> Option<pulp::x86::V4> {
         as_backend(simd)
     }
 
@@ -336,12 +314,6 @@ impl<'a> Tile<'a> {
     #[inline(always)]
     pub fn stride(&self) -> usize {
         self.stride
-    }
-
-    /// Every field, side by side.
-    #[inline(always)]
-    pub fn data(&self) -> &'a [f32] {
-        self.data
     }
 
     /// Field `f`.

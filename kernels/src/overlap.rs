@@ -14,7 +14,7 @@
 //! are bit-identical to the `*_scalar` references on every backend. NaN policy: a NaN in the
 //! probe or an entry makes the pair not overlap, on every backend.
 
-use crate::lanes::{load, load_prefix, mask_bits, swap_halves, IOTA};
+use crate::lanes::{load_prefix, mask_bits};
 use crate::Tile;
 use pulp::{Simd, WithSimd};
 
@@ -64,12 +64,6 @@ impl<'a> SphereSoa<'a> {
         self.len() == 0
     }
 
-    /// The four fields side by side.
-    #[inline(always)]
-    fn data(&self) -> &'a [f32] {
-        self.tile.data()
-    }
-
     /// Entry `k` as `(centre, radius)`.
     #[inline(always)]
     pub fn get(&self, k: usize) -> ([f32; 3], f32) {
@@ -111,12 +105,6 @@ impl<'a> AabbSoa<'a> {
     #[inline(always)]
     pub fn is_empty(&self) -> bool {
         self.len() == 0
-    }
-
-    /// The six fields side by side.
-    #[inline(always)]
-    fn data(&self) -> &'a [f32] {
-        self.tile.data()
     }
 
     /// Entry `k` as `(min, max)`.
@@ -204,8 +192,9 @@ impl WithSimd for SphereBlock<'_> {
 #[inline(always)]
 pub fn sphere_block_with<S: Simd>(simd: S, c: [f32; 3], r: f32, b: SphereSoa, n: usize) -> u32 {
     let len = block_len(b.len(), n);
-    if 2 * len == S::F32_LANES {
-        return sphere_block_paired(simd, c, r, b.data(), n);
+    #[cfg(target_arch = "x86_64")]
+    if let Some(v3) = half_width(simd, len) {
+        return sphere_block_with(v3, c, r, b, n);
     }
     let (cx, cy, cz, rr) = (b.cx(), b.cy(), b.cz(), b.r());
     let (px, py, pz, pr) = (
@@ -231,39 +220,6 @@ pub fn sphere_block_with<S: Simd>(simd: S, c: [f32; 3], r: f32, b: SphereSoa, n:
         base = end;
     }
     bits
-}
-
-/// [`sphere_block_with`] for a block of half a vector (an octree's 8 children on 16 lanes):
-/// two fields per vector, `[cx | cy]` and `[cz | r]` (`t`: the four fields side by side),
-/// the halves combined by one lane swap each, in the reference's operation order
-/// (`kernels/sphere_block` 2.2x -> 2.4x its scalar reference, Zen 4).
-#[inline(always)]
-fn sphere_block_paired<S: Simd>(simd: S, c: [f32; 3], r: f32, t: &[f32], n: usize) -> u32 {
-    let half = S::F32_LANES / 2;
-    let (v0, v1) = (load::<S>(t), load::<S>(&t[2 * half..]));
-    let upper = upper_half::<S>(simd);
-    // `[c_x - cx | c_y - cy]`, squared, and each lane plus its other half: `dx^2 + dy^2`.
-    let d = simd.sub_f32s(
-        simd.select_f32s(upper, simd.splat_f32s(c[1]), simd.splat_f32s(c[0])),
-        v0,
-    );
-    let sq = simd.mul_f32s(d, d);
-    let xy = simd.add_f32s(sq, swap_halves(simd, sq));
-    // `[c_z - cz | r + rb]` (the lower half as `c_z + (-cz)`: the same value), squared.
-    let sign = simd.select_f32s(upper, simd.splat_f32s(1.0), simd.splat_f32s(-1.0));
-    let w = simd.add_f32s(
-        simd.select_f32s(upper, simd.splat_f32s(r), simd.splat_f32s(c[2])),
-        simd.mul_f32s(sign, v1),
-    );
-    let w2 = simd.mul_f32s(w, w);
-    let hit = simd.less_than_or_equal_f32s(simd.add_f32s(xy, w2), swap_halves(simd, w2));
-    mask_bits(simd, hit) & low_bits(n)
-}
-
-/// The mask of the upper half of the lanes.
-#[inline(always)]
-fn upper_half<S: Simd>(simd: S) -> S::m32s {
-    simd.less_than_or_equal_f32s(simd.splat_f32s((S::F32_LANES / 2) as f32), load::<S>(&IOTA))
 }
 
 // ---------------------------------------------------------------------------------------
@@ -304,8 +260,9 @@ impl WithSimd for AabbBlock<'_> {
 #[inline(always)]
 pub fn aabb_block_with<S: Simd>(simd: S, lo: [f32; 3], hi: [f32; 3], b: AabbSoa, n: usize) -> u32 {
     let len = block_len(b.len(), n);
-    if 2 * len == S::F32_LANES {
-        return aabb_block_paired(simd, lo, hi, b.data(), n);
+    #[cfg(target_arch = "x86_64")]
+    if let Some(v3) = half_width(simd, len) {
+        return aabb_block_with(v3, lo, hi, b, n);
     }
     let mins = [b.min(0), b.min(1), b.min(2)];
     let maxs = [b.max(0), b.max(1), b.max(2)];
@@ -346,45 +303,17 @@ pub fn aabb_block_with<S: Simd>(simd: S, lo: [f32; 3], hi: [f32; 3], b: AabbSoa,
     bits
 }
 
-/// [`aabb_block_with`] for a block of half a vector (an octree's 8 children on 16 lanes):
-/// two fields per vector, so the six fields are three full loads instead of six half-empty
-/// ones (`kernels/aabb_block` 1.7x -> 2.7x its scalar reference, Zen 4). `t` holds the six fields side by side (`3 * S::F32_LANES` entries): vectors
-/// `[min x | min y]`, `[min z | max x]`, `[max y | max z]`.
+/// The x86-v3 (8-lane) token for a block of at most 8 entries on x86-v4: an octree's 8
+/// children fill half of a 16-lane vector, and Zen 4 runs a 512-bit operation as two
+/// 256-bit halves, so the empty half costs as much as the full one (`kernels/sphere_block`
+/// 2.2x -> 4.1x its scalar reference, `aabb_block` 1.7x -> 2.9x; two fields per 16-lane
+/// vector were 2.4x and 2.7x). On CPUs with full-width 512-bit units the 8-lane body issues
+/// about as many operations as the paired one. Every x86-v4 CPU has x86-v3.
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn aabb_block_paired<S: Simd>(simd: S, lo: [f32; 3], hi: [f32; 3], t: &[f32], n: usize) -> u32 {
-    let half = S::F32_LANES / 2;
-    let low = low_bits(half);
-    let v = [
-        load::<S>(t),
-        load::<S>(&t[2 * half..]),
-        load::<S>(&t[4 * half..]),
-    ];
-    let upper = upper_half::<S>(simd);
-    let m0 = mask_bits(
-        simd,
-        simd.less_than_or_equal_f32s(
-            v[0],
-            simd.select_f32s(upper, simd.splat_f32s(hi[1]), simd.splat_f32s(hi[0])),
-        ),
-    );
-    // `[min z | max x]`: the lower half against the probe's max z, the upper its min x.
-    let m1 = (mask_bits(
-        simd,
-        simd.less_than_or_equal_f32s(v[1], simd.splat_f32s(hi[2])),
-    ) & low)
-        | (mask_bits(
-            simd,
-            simd.less_than_or_equal_f32s(simd.splat_f32s(lo[0]), v[1]),
-        ) & !low);
-    let m2 = mask_bits(
-        simd,
-        simd.less_than_or_equal_f32s(
-            simd.select_f32s(upper, simd.splat_f32s(lo[2]), simd.splat_f32s(lo[1])),
-            v[2],
-        ),
-    );
-    let m = m0 & m1 & m2;
-    m & (m >> half) & low_bits(n)
+fn half_width<S: Simd>(simd: S, len: usize) -> Option<pulp::x86::V3> {
+    let v4 = crate::lanes::as_v4(simd)?;
+    (2 * len <= S::F32_LANES).then_some(*v4)
 }
 
 /// The low `n` bits set (`n <= 32`).
