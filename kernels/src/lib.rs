@@ -68,7 +68,6 @@ pub fn f32_lanes() -> usize {
 /// of their element, so a slice of `F32_LANES` elements reinterprets in place; the only
 /// `unsafe` is the x86 masked load of a short slice and the backend-token casts.
 pub(crate) mod lanes {
-    use super::MAX_LANES;
     use pulp::Simd;
 
     /// Loads `v` (at most `S::F32_LANES` values; missing lanes are zero), reading nothing
@@ -167,17 +166,6 @@ pub(crate) mod lanes {
             u32_array::<S>(&v)[0] & 1
         }
     }
-
-    /// `0, 1, 2, ...`: lane indices (loaded as one vector of the backend's lanes).
-    pub const IOTA: [f32; MAX_LANES] = {
-        let mut a = [0.0; MAX_LANES];
-        let mut i = 0;
-        while i < MAX_LANES {
-            a[i] = i as f32;
-            i += 1;
-        }
-        a
-    };
 
     /// `simd` as pulp's x86-v3 token when that is its type.
     #[cfg(target_arch = "x86_64")]

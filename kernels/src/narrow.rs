@@ -66,13 +66,24 @@
 //! Results are bit-identical to [`leaf_contacts_scalar`] on every backend (same operation
 //! order, no fused multiply-add; the canonical form's vertex choices are selects).
 
-use crate::lanes::{load_prefix, load_prefix_u32, mask_bits, IOTA};
+use crate::lanes::{load_prefix, load_prefix_u32, mask_bits};
 use crate::Tile;
 use pulp::{Simd, WithSimd};
 
 /// Lane counts for which the filter culls rows per lane vector of the second block (see
 /// [`leaf_contacts_with`]).
 const CULL_ROWS_PER_VECTOR: std::ops::RangeInclusive<usize> = 4..=8;
+
+/// `0, 1, 2, ...`: lane indices.
+const IOTA: [f32; 64] = {
+    let mut a = [0.0; 64];
+    let mut i = 0;
+    while i < 64 {
+        a[i] = i as f32;
+        i += 1;
+    }
+    a
+};
 
 /// Largest second block: the bits of one row.
 pub const MAX_ROW: usize = 64;
@@ -942,7 +953,10 @@ fn block_box<S: Simd>(simd: S, f: &Fields, n: usize) -> Bounds {
 /// (NaN bounds skipped; empty: `+inf..-inf`).
 #[inline(always)]
 fn vector_box<S: Simd>(simd: S, n: usize, lo: &[S::f32s; 3], hi: &[S::f32s; 3]) -> Bounds {
-    let first = simd.less_than_f32s(crate::lanes::load::<S>(&IOTA), simd.splat_f32s(n as f32));
+    let first = simd.less_than_f32s(
+        load_prefix(simd, &IOTA[..S::F32_LANES]),
+        simd.splat_f32s(n as f32),
+    );
     let (inf, neg_inf) = (
         simd.splat_f32s(f32::INFINITY),
         simd.splat_f32s(f32::NEG_INFINITY),

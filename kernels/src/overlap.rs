@@ -306,9 +306,9 @@ pub fn aabb_block_with<S: Simd>(simd: S, lo: [f32; 3], hi: [f32; 3], b: AabbSoa,
 /// The x86-v3 (8-lane) token for a block of at most 8 entries on x86-v4: an octree's 8
 /// children fill half of a 16-lane vector, and Zen 4 runs a 512-bit operation as two
 /// 256-bit halves, so the empty half costs as much as the full one (`kernels/sphere_block`
-/// 2.2x -> 4.1x its scalar reference, `aabb_block` 1.7x -> 2.9x; two fields per 16-lane
-/// vector were 2.4x and 2.7x). On CPUs with full-width 512-bit units the 8-lane body issues
-/// about as many operations as the paired one. Every x86-v4 CPU has x86-v3.
+/// 2.2x -> 3.4-3.6x its scalar reference, `aabb_block` 1.7x -> 2.7-2.8x; packing two
+/// fields per 16-lane vector gave 2.4x and 2.7x: docs/PERFORMANCE.md, sixteenth sitting).
+/// Every x86-v4 CPU has x86-v3.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn half_width<S: Simd>(simd: S, len: usize) -> Option<pulp::x86::V3> {
