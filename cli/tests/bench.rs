@@ -93,14 +93,26 @@ fn frame_contacts(run: &Value, method: &str, threads: u64, frames: usize) -> Vec
     assert!(0.0 <= min && min <= median, "{run}");
     let list = run["frames"].as_array().unwrap();
     assert_eq!(list.len(), frames, "{run}");
-    list.iter()
+    // Every step is some frame's: the overall least is the least frame's least, and each
+    // frame's least is at most its median.
+    let mut least = f64::INFINITY;
+    let contacts = list
+        .iter()
         .map(|f| {
             let contacts = f["contacts"].as_u64().unwrap();
             assert_eq!(f["counters"]["contacts"].as_u64(), Some(contacts), "{run}");
             assert!(f["counters"]["bv_tests"].as_u64().unwrap() > 0, "{run}");
+            let (fmedian, fmin) = (
+                f["step_ms"]["median"].as_f64().unwrap(),
+                f["step_ms"]["min"].as_f64().unwrap(),
+            );
+            assert!(0.0 <= fmin && fmin <= fmedian, "{run}");
+            least = least.min(fmin);
             contacts
         })
-        .collect()
+        .collect();
+    assert_eq!(least, min, "{run}");
+    contacts
 }
 
 #[test]
@@ -273,7 +285,7 @@ fn text_output_names_the_build_and_step_times_and_every_frame() {
     assert!(text.contains("dh: build "), "{text}");
     assert!(text.contains("step median "), "{text}");
     assert!(
-        text.contains("  step 0: ") && text.contains("  step 1: "),
+        text.contains("  step 0: median ") && text.contains("  step 1: median "),
         "{text}"
     );
 }

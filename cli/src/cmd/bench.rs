@@ -1,7 +1,9 @@
 //! `dhcd bench self FRAME...` and `dhcd bench collide --a FRAME... --b FRAME...`: the
 //! microbenchmark users run on their own meshes. Builds once on the first frame, then
 //! cycles `update_positions` through the frames, timing each step (update + query); reports
-//! the build time, the median and least step time, and each frame's contacts and counters.
+//! the build time, the median and least step time over all steps and per frame (frames of
+//! different work make the overall median fall between them), and each frame's contacts and
+//! counters.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -90,6 +92,7 @@ struct Opts {
 struct Run {
     method: Method,
     build_ms: f64,
+    /// Pass by pass, one step per frame: frame `k`'s steps are `k, k + frames, ...`.
     steps_ms: Vec<f64>,
     /// Per frame: contacts and counters (of the last pass; every pass gives the same unless
     /// `--front`).
@@ -211,6 +214,20 @@ fn median_min(xs: &[f64]) -> (f64, f64) {
     (s[s.len() / 2], s[0])
 }
 
+impl Run {
+    /// Median and least of frame `k`'s steps (one per pass).
+    fn frame_median_min(&self, k: usize) -> (f64, f64) {
+        let steps: Vec<f64> = self
+            .steps_ms
+            .iter()
+            .skip(k)
+            .step_by(self.frames.len())
+            .copied()
+            .collect();
+        median_min(&steps)
+    }
+}
+
 fn counters_json(c: &Counters) -> serde_json::Value {
     json!({
         "bv_tests": c.bv_tests,
@@ -221,7 +238,7 @@ fn counters_json(c: &Counters) -> serde_json::Value {
 }
 
 /// `{"method", "threads", "broad_only", "front", "build_ms", "step_ms": {"median", "min"},
-/// "frames": [{"contacts", "counters"}...]}`.
+/// "frames": [{"contacts", "counters", "step_ms": {"median", "min"}}...]}`.
 fn to_json(r: &Run, threads: usize, opts: &Opts) -> serde_json::Value {
     let (median, min) = median_min(&r.steps_ms);
     json!({
@@ -231,10 +248,14 @@ fn to_json(r: &Run, threads: usize, opts: &Opts) -> serde_json::Value {
         "front": opts.front,
         "build_ms": r.build_ms,
         "step_ms": { "median": median, "min": min },
-        "frames": r.frames.iter().map(|c| json!({
-            "contacts": c.contacts,
-            "counters": counters_json(c),
-        })).collect::<Vec<_>>(),
+        "frames": r.frames.iter().enumerate().map(|(k, c)| {
+            let (median, min) = r.frame_median_min(k);
+            json!({
+                "contacts": c.contacts,
+                "counters": counters_json(c),
+                "step_ms": { "median": median, "min": min },
+            })
+        }).collect::<Vec<_>>(),
     })
 }
 
@@ -274,9 +295,11 @@ fn text(runs: &[Run], opts: &Opts, threads: usize, a: &[Mesh], b: Option<&[Mesh]
             r.method, r.build_ms, median, min
         );
         for (k, c) in r.frames.iter().enumerate() {
+            let (median, min) = r.frame_median_min(k);
             let _ = writeln!(
                 s,
-                "  step {k}: {} contacts; {} BV tests, {} triangle pairs, {} BV updates",
+                "  step {k}: median {median:.3} ms, min {min:.3} ms; {} contacts; {} BV tests, \
+                 {} triangle pairs, {} BV updates",
                 c.contacts, c.bv_tests, c.prim_tests, c.bv_updates
             );
         }
