@@ -296,17 +296,20 @@ unsafe fn mesh(
     Ok(Mesh::new(p.to_vec(), t.to_vec())?)
 }
 
+/// `pairs` flattened into an array the caller owns until the matching `*_free` (which
+/// rebuilds the `Box<[T]>` of `N * count` elements), or null when there are none.
+fn c_pairs<T, const N: usize>(pairs: Vec<[T; N]>) -> *mut T {
+    if pairs.is_empty() {
+        return std::ptr::null_mut();
+    }
+    let flat: Box<[T]> = pairs.into_iter().flatten().collect();
+    Box::into_raw(flat).cast::<T>()
+}
+
 fn contacts_out(c: Contacts) -> DhcdContacts {
-    let count = c.pairs.len();
-    let pairs = if count == 0 {
-        std::ptr::null_mut()
-    } else {
-        let flat: Box<[u32]> = c.pairs.into_iter().flatten().collect();
-        Box::into_raw(flat).cast::<u32>()
-    };
     DhcdContacts {
-        pairs,
-        count,
+        count: c.pairs.len(),
+        pairs: c_pairs(c.pairs),
         counters: c.counters.into(),
     }
 }
@@ -723,16 +726,9 @@ unsafe fn updates<'a>(
 /// A scene's contacts as the C result (the array owned by the caller until
 /// `dhcd_scene_contacts_free`).
 fn scene_contacts_result(c: dhcd::SceneContacts) -> DhcdSceneContacts {
-    let count = c.pairs.len();
-    let pairs = if count == 0 {
-        std::ptr::null_mut()
-    } else {
-        let flat: Box<[u64]> = c.pairs.into_iter().flatten().collect();
-        Box::into_raw(flat).cast::<u64>()
-    };
     DhcdSceneContacts {
-        pairs,
-        count,
+        count: c.pairs.len(),
+        pairs: c_pairs(c.pairs),
         counters: c.counters.into(),
     }
 }
