@@ -1,8 +1,12 @@
 //! Kernel microbenchmarks: each `dhcd-kernels` kernel against its scalar reference.
 //!
-//! - `kernels/{sphere,aabb}_block/{scalar,simd}`: 4,096 wide node tests (one volume against
-//!   a block of 8, the children of an octree node), as the traversal calls them: the SIMD
-//!   body inside one dispatch (`*_with`), never dispatched per test. Throughput in BV pairs.
+//! - `kernels/{sphere,aabb}_block/{scalar,simd}/<blocks>`: wide node tests (one volume
+//!   against a block of 8, the children of an octree node), as the traversal calls them: the
+//!   SIMD body inside one dispatch (`*_with`), never dispatched per test, the probe read from
+//!   memory. Throughput in BV pairs. `<blocks>` sets how much node data a pass streams:
+//!   64 blocks (12 KB of boxes, in L1: the armadillo frame's hierarchy holds 76), 512 (96 KB,
+//!   in L2: the 80-146 K-triangle frames' hold 586-593) and 4,096 (768 KB, a hierarchy of
+//!   about a million triangles).
 //! - `kernels/leaf_contacts{,_self}/{scalar,simd}`: the narrow phase's kernel (boxes, shared
 //!   vertices, separating planes, then the certified canonical form on the candidates) on
 //!   1,024 pairs of leaves of 8 nearby triangles, throughput in triangle pairs. (Before the
@@ -22,8 +26,9 @@ use dhcd_kernels::{Soa3, Tile};
 use std::hint::black_box;
 
 const SIZES: [usize; 2] = [1024, 16384];
-/// Blocks per node-test bench, and the block size (an octree's children).
-const BLOCKS: usize = 4096;
+/// Blocks per node-test bench (see the module doc), and the block size (an octree's
+/// children).
+const BLOCK_COUNTS: [usize; 3] = [64, 512, 4096];
 const BLOCK: usize = 8;
 /// Leaf pairs per narrow-filter bench, and triangles per leaf.
 const LEAF_PAIRS: usize = 1024;
@@ -56,19 +61,22 @@ impl Rng {
     }
 }
 
-/// `BLOCKS` blocks of `BLOCK` spheres and boxes (each block one tile, as a node's children
-/// are stored), and `BLOCKS` probes; about a third of the pairs overlap.
+/// Blocks of `BLOCK` spheres and boxes (each block one tile, as a node's children
+/// are stored), and `BLOCKS` probes; about a third of the pairs overlap. A probe is stored
+/// like a node (the traversal reads it from its tile): a sphere, and the box the blocks
+/// around the same sphere.
 struct Blocks {
     sphere: Vec<f32>,
     boxes: Vec<f32>,
     probes: Vec<([f32; 3], f32)>,
+    box_probes: Vec<([f32; 3], [f32; 3])>,
 }
 
 impl Blocks {
-    fn new(rng: &mut Rng) -> Self {
-        let mut sphere = Vec::with_capacity(BLOCKS * 4 * BLOCK);
-        let mut boxes = Vec::with_capacity(BLOCKS * 6 * BLOCK);
-        for _ in 0..BLOCKS {
+    fn new(rng: &mut Rng, blocks: usize) -> Self {
+        let mut sphere = Vec::with_capacity(blocks * 4 * BLOCK);
+        let mut boxes = Vec::with_capacity(blocks * 6 * BLOCK);
+        for _ in 0..blocks {
             let c = [0; 3].map(|_| rng.vec(BLOCK, -1.0, 1.0));
             let r = rng.vec(BLOCK, 0.0, 0.5);
             for f in c.iter().chain([&r]) {
@@ -79,13 +87,18 @@ impl Blocks {
                 boxes.extend((0..BLOCK).map(|i| c[a][i] + s * r[i] * 0.8));
             }
         }
-        let probes = (0..BLOCKS)
+        let probes: Vec<([f32; 3], f32)> = (0..blocks)
             .map(|_| ([0; 3].map(|_| rng.f32_in(-1.0, 1.0)), rng.f32_in(0.0, 0.5)))
+            .collect();
+        let box_probes = probes
+            .iter()
+            .map(|&(c, r)| (c.map(|c| c - r), c.map(|c| c + r)))
             .collect();
         Blocks {
             sphere,
             boxes,
             probes,
+            box_probes,
         }
     }
     fn sphere(&self, k: usize) -> SphereSoa<'_> {
@@ -110,49 +123,51 @@ impl WithSimd for AllBlocks<'_> {
     fn with_simd<S: Simd>(self, simd: S) -> u32 {
         let b = self.blocks;
         let mut hits = 0;
-        for (k, &(c, r)) in b.probes.iter().enumerate() {
-            hits += if self.aabb {
-                let lo = [c[0] - r, c[1] - r, c[2] - r];
-                let hi = [c[0] + r, c[1] + r, c[2] + r];
-                overlap::aabb_block_with(simd, lo, hi, b.aabb(k), BLOCK)
-            } else {
-                overlap::sphere_block_with(simd, c, r, b.sphere(k), BLOCK)
+        if self.aabb {
+            for (k, &(lo, hi)) in b.box_probes.iter().enumerate() {
+                hits += overlap::aabb_block_with(simd, lo, hi, b.aabb(k), BLOCK).count_ones();
             }
-            .count_ones();
+        } else {
+            for (k, &(c, r)) in b.probes.iter().enumerate() {
+                hits += overlap::sphere_block_with(simd, c, r, b.sphere(k), BLOCK).count_ones();
+            }
         }
         hits
     }
 }
 
 fn block_benches(c: &mut Criterion) {
-    let blocks = Blocks::new(&mut Rng::new(1));
     for (name, aabb) in [("sphere_block", false), ("aabb_block", true)] {
         let mut g = c.benchmark_group(format!("kernels/{name}"));
-        g.throughput(Throughput::Elements((BLOCKS * BLOCK) as u64));
-        g.bench_function("scalar", |bench| {
-            bench.iter(|| {
-                let mut hits = 0;
-                for (k, &(c, r)) in blocks.probes.iter().enumerate() {
-                    hits += if aabb {
-                        let lo = [c[0] - r, c[1] - r, c[2] - r];
-                        let hi = [c[0] + r, c[1] + r, c[2] + r];
-                        overlap::aabb_block_scalar(lo, hi, blocks.aabb(k), BLOCK)
+        for count in BLOCK_COUNTS {
+            let blocks = Blocks::new(&mut Rng::new(1), count);
+            g.throughput(Throughput::Elements((count * BLOCK) as u64));
+            g.bench_function(BenchmarkId::new("scalar", count), |bench| {
+                bench.iter(|| {
+                    let mut hits = 0;
+                    if aabb {
+                        for (k, &(lo, hi)) in blocks.box_probes.iter().enumerate() {
+                            hits += overlap::aabb_block_scalar(lo, hi, blocks.aabb(k), BLOCK)
+                                .count_ones();
+                        }
                     } else {
-                        overlap::sphere_block_scalar(c, r, blocks.sphere(k), BLOCK)
+                        for (k, &(c, r)) in blocks.probes.iter().enumerate() {
+                            hits += overlap::sphere_block_scalar(c, r, blocks.sphere(k), BLOCK)
+                                .count_ones();
+                        }
                     }
-                    .count_ones();
-                }
-                black_box(hits)
-            })
-        });
-        g.bench_function("simd", |bench| {
-            bench.iter(|| {
-                black_box(dhcd_kernels::arch().dispatch(AllBlocks {
-                    blocks: black_box(&blocks),
-                    aabb,
-                }))
-            })
-        });
+                    black_box(hits)
+                })
+            });
+            g.bench_function(BenchmarkId::new("simd", count), |bench| {
+                bench.iter(|| {
+                    black_box(dhcd_kernels::arch().dispatch(AllBlocks {
+                        blocks: black_box(&blocks),
+                        aabb,
+                    }))
+                })
+            });
+        }
         g.finish();
     }
 }
