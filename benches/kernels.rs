@@ -61,10 +61,10 @@ impl Rng {
     }
 }
 
-/// Blocks of `BLOCK` spheres and boxes (each block one tile, as a node's children
-/// are stored), and `BLOCKS` probes; about a third of the pairs overlap. A probe is stored
-/// like a node (the traversal reads it from its tile): a sphere, and the box the blocks
-/// around the same sphere.
+/// Blocks of `BLOCK` spheres and boxes (each block one tile, as a node's children are
+/// stored), and one probe per block; about a third of the pairs overlap. A probe is stored
+/// like a node (the traversal reads it from its tile): a sphere `(c, r)` for the sphere
+/// tests, and the box `c -+ r` around it for the box tests.
 struct Blocks {
     sphere: Vec<f32>,
     boxes: Vec<f32>,
