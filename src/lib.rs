@@ -48,7 +48,7 @@ pub use bv::Method;
 pub use counters::Counters;
 pub use error::{Error, Result};
 pub use hierarchy::{CentralVertex, Hierarchy, InvariantError, Options, Refit};
-pub use mesh::Mesh;
+pub use mesh::{Mesh, Precision};
 pub use par::Par;
 pub use scene::{ObjectId, Scene, SceneContacts};
 

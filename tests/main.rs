@@ -11,6 +11,7 @@ mod kinds;
 mod memory;
 mod mutation;
 mod narrow;
+mod precision;
 mod real_frames;
 mod scene;
 mod self_collision;

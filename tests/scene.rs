@@ -458,7 +458,7 @@ fn update_many_checks_everything_before_changing_anything() {
                 &[(a, &moved), (b, &nan)],
                 Error::NonFinite {
                     vertex: 3,
-                    position: nan[3],
+                    position: nan[3].map(f64::from),
                 },
             ),
         ];
