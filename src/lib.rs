@@ -38,10 +38,11 @@ pub mod mesh;
 pub mod narrow;
 pub mod par;
 pub mod points;
+pub mod query;
 pub mod scene;
 pub mod shapes;
-pub mod traverse;
 pub mod tree;
+mod walk;
 
 pub use any::AnyHierarchy;
 pub use bv::Method;
@@ -52,8 +53,9 @@ pub use mesh::{Mesh, Precision};
 pub use par::Par;
 pub use scene::{ObjectId, Scene, SceneContacts};
 
-pub use traverse::{
+pub use query::{
     broad_phase, collide, collide_with, narrow_phase, self_broad_phase, self_collide,
-    self_collide_with, Contacts, Workspace,
+    self_collide_with, BroadPhase, Contacts,
 };
 pub use tree::RegionTree;
+pub use walk::{Workspace, DEFAULT_GRAIN};

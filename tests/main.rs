@@ -2,7 +2,6 @@
 //! suites live in `cli/tests/`, the C ABI's in `capi/tests/`.)
 
 mod central;
-mod coherence;
 mod fixtures;
 mod fuzz;
 mod hierarchies;

@@ -161,3 +161,185 @@ fn real_frames_read_as_f64_keep_their_doubles() {
         assert_eq!(*e, r.map(f64::from));
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// f64 hierarchies: bounds enclose the exact points, contacts are exact for the f64 input
+// ---------------------------------------------------------------------------------------------
+
+use dhcd::bv::BvKind;
+use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
+use dhcd::shapes::splitmix64;
+use dhcd::{
+    collide_with, for_each_kind, self_collide_with, Hierarchy, Options, Par, Refit, Workspace,
+};
+
+fn unit(state: &mut u64) -> f64 {
+    (splitmix64(state) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// `n` pairs of nearly touching triangles far from the origin (at x = 1000 + 3i, where an
+/// f32 ulp is 6e-5): `A_i` a random triangle, `B_i` a triangle with one corner at a signed
+/// distance of `+-1e-7`, `+-1e-9` or 0 from `A_i`'s plane, above `A_i`'s interior, and its
+/// other corners well on one side. Rounding to f32 moves every corner by up to 3e-5, so it
+/// decides many of these pairs differently from the f64 values.
+fn near_touching(n: usize, seed: u64) -> (Mesh, Mesh) {
+    let mut s = seed;
+    let (mut pa, mut pb) = (Vec::new(), Vec::new());
+    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+    let cross = |u: [f64; 3], v: [f64; 3]| {
+        [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ]
+    };
+    for i in 0..n {
+        let o = [1000.0 + 3.0 * i as f64, 0.25, -0.5];
+        let mut r = || unit(&mut s) - 0.5;
+        let a: [[f64; 3]; 3] = [
+            [o[0] + r(), o[1] + r(), o[2] + 0.3 * r()],
+            [o[0] + 1.0 + r(), o[1] + r(), o[2] + 0.3 * r()],
+            [o[0] + r(), o[1] + 1.0 + r(), o[2] + 0.3 * r()],
+        ];
+        let nrm = cross(sub(a[1], a[0]), sub(a[2], a[0]));
+        let len = (nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]).sqrt();
+        let nrm = nrm.map(|x| x / len);
+        // A point inside A (barycentric), moved off its plane by a tiny signed distance.
+        let (u, v) = (0.2 + 0.3 * (r() + 0.5), 0.2 + 0.3 * (r() + 0.5));
+        let inside: [f64; 3] =
+            std::array::from_fn(|k| a[0][k] + u * (a[1][k] - a[0][k]) + v * (a[2][k] - a[0][k]));
+        let off = [1e-7, -1e-7, 1e-9, -1e-9, 0.0][i % 5];
+        let p: [f64; 3] = std::array::from_fn(|k| inside[k] + off * nrm[k]);
+        // The other corners on the positive side.
+        let q: [f64; 3] = std::array::from_fn(|k| p[k] + 0.5 * nrm[k] + 0.3 * r());
+        let w: [f64; 3] = std::array::from_fn(|k| p[k] + 0.6 * nrm[k] - 0.3 * r());
+        pa.extend_from_slice(&a);
+        pb.extend_from_slice(&[p, q, w]);
+    }
+    let tris: Vec<[u32; 3]> = (0..n as u32)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect();
+    (
+        Mesh::new_f64(pa, tris.clone()).unwrap(),
+        Mesh::new_f64(pb, tris).unwrap(),
+    )
+}
+
+fn rounded(m: &Mesh) -> Mesh {
+    Mesh::new(m.positions().to_vec(), m.triangles().to_vec()).unwrap()
+}
+
+/// The meshes are meaningful: rounding to f32 changes the exact answer both ways.
+#[test]
+fn rounding_to_f32_changes_near_touching_answers() {
+    let (a, b) = near_touching(200, 7);
+    let exact = brute_force_pairs(&a, &b);
+    let f32_answer = brute_force_pairs(&rounded(&a), &rounded(&b));
+    let only64 = exact.iter().filter(|p| !f32_answer.contains(p)).count();
+    let only32 = f32_answer.iter().filter(|p| !exact.contains(p)).count();
+    assert!(
+        only64 > 0 && only32 > 0,
+        "f64-only {only64}, f32-only {only32}"
+    );
+    // Every designed pair is decided by its offset's sign in f64.
+    assert!(exact.iter().all(|p| p[0] == p[1]));
+}
+
+fn f64_contacts_for<K: BvKind>() {
+    let (a, b) = near_touching(200, 11);
+    let exact = brute_force_pairs(&a, &b);
+    for refit in [Refit::Lazy, Refit::Eager, Refit::EagerBottomUp] {
+        let options = Options {
+            refit,
+            ..Options::default()
+        };
+        let ha = Hierarchy::<K>::new(&a, options).unwrap();
+        let hb = Hierarchy::<K>::new(&b, options).unwrap();
+        assert_eq!(ha.validate().unwrap(), ha.node_count());
+        for par in [Par::Seq, Par::Rayon(2)] {
+            let c = collide_with(&ha, &hb, &mut Workspace::default(), par);
+            assert_eq!(c.pairs, exact, "{:?} {refit:?} {par:?}", K::METHOD);
+        }
+        // One mesh holding both: self-collision, exact for f64.
+        let both: Vec<[f64; 3]> = a
+            .positions_f64()
+            .unwrap()
+            .iter()
+            .chain(b.positions_f64().unwrap())
+            .copied()
+            .collect();
+        let n = a.vertex_count() as u32;
+        let tris: Vec<[u32; 3]> = a
+            .triangles()
+            .iter()
+            .copied()
+            .chain(b.triangles().iter().map(|t| t.map(|v| v + n)))
+            .collect();
+        let m = Mesh::new_f64(both, tris).unwrap();
+        let want = brute_force_self_pairs(&m);
+        assert_eq!(want.len(), exact.len());
+        let mut h = Hierarchy::<K>::new(&m, options).unwrap();
+        for par in [Par::Seq, Par::Rayon(2)] {
+            let c = self_collide_with(&h, &mut Workspace::default(), par);
+            assert_eq!(c.pairs, want, "self {:?} {refit:?} {par:?}", K::METHOD);
+        }
+        // Moved by an update: the bounds still enclose the exact points, contacts follow.
+        let moved: Vec<[f64; 3]> = m
+            .positions_f64()
+            .unwrap()
+            .iter()
+            .map(|p| [p[0] + 1e-3, p[1] - 2e6, p[2]])
+            .collect();
+        h.update_positions_f64(&moved).unwrap();
+        let c = self_collide_with(&h, &mut Workspace::default(), Par::Seq);
+        let all: Vec<u32> = (0..h.node_count() as u32).collect();
+        h.refit_nodes(&all, Par::Seq).unwrap();
+        assert_eq!(h.validate().unwrap(), h.node_count());
+        let mut mm = m.clone();
+        mm.set_positions_f64(&moved).unwrap();
+        assert_eq!(
+            c.pairs,
+            brute_force_self_pairs(&mm),
+            "{:?} moved",
+            K::METHOD
+        );
+        assert!(matches!(
+            h.update_positions(m.positions()),
+            Err(Error::PrecisionMismatch { .. })
+        ));
+    }
+}
+
+#[test]
+fn f64_contacts_are_exact_for_every_kind() {
+    for_each_kind!(K => f64_contacts_for::<K>());
+}
+
+/// The real rod frames (f64): contacts of an f64 hierarchy equal the exact f64 brute force on
+/// a slab of the rod (the whole frame would take minutes of brute force), for every kind.
+#[test]
+fn f64_hierarchy_bounds_hold_on_a_real_frame() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
+    let path = dir.join("rod-twist-3036.ply");
+    if !path.exists() {
+        eprintln!("skipping: {} not found", path.display());
+        return;
+    }
+    let m = io::load_as(&path, &Limits::default(), Precision::F64).unwrap();
+    let next = io::load_as(
+        &dir.join("rod-twist-3037.ply"),
+        &Limits::default(),
+        Precision::F64,
+    )
+    .unwrap();
+    for_each_kind!(K => {
+        let mut h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
+        assert_eq!(h.validate().unwrap(), h.node_count());
+        let c = self_collide_with(&h, &mut Workspace::default(), Par::Rayon(2));
+        assert!(c.pairs.is_empty(), "the rod frames do not intersect");
+        h.update_positions_f64(next.positions_f64().unwrap()).unwrap();
+        let all: Vec<u32> = (0..h.node_count() as u32).collect();
+        h.refit_nodes(&all, Par::Seq).unwrap();
+        assert_eq!(h.validate().unwrap(), h.node_count());
+    });
+}
