@@ -3,6 +3,7 @@
 
 mod central;
 mod coherence;
+mod distance;
 mod fixtures;
 mod fuzz;
 mod hierarchies;

@@ -1,0 +1,150 @@
+//! Per-call cost of the exact proximity primitives (`dhcd::distance`).
+//!
+//! Inputs are generated once from a seeded generator: unit-size triangles (edges) with
+//! jittered shapes, and a point (second edge) placed in the first one's box grown by `d`, as
+//! a box cull with margin `d` hands them over. They are sorted by their true distance into
+//! three sets of 4096 calls each:
+//!
+//! - `far`: farther than `d` (what most culled candidates are);
+//! - `near`: farther than `d` by at most 10% (near misses: the filter works hardest);
+//! - `within`: at most `d` (the pairs a proximity query reports, value and type computed).
+//!
+//! Ids: `distance/{point_triangle,edge_edge}/{far,near,within}`, throughput in calls, so
+//! criterion prints the time per call. Run: `cargo bench --bench distance`.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use dhcd::distance::{edge_edge_distance_sq, edge_edge_within, point_triangle_within};
+
+type P = [f64; 3];
+
+/// xorshift64*: a seeded, dependency-free generator.
+struct Rng(u64);
+
+impl Rng {
+    fn unit(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d);
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+    fn point(&mut self, lo: f64, hi: f64) -> P {
+        [self.range(lo, hi), self.range(lo, hi), self.range(lo, hi)]
+    }
+}
+
+/// The threshold: about a tenth of a feature's size, like IPC's `dhat` against its meshes'
+/// edge lengths.
+const D: f64 = 0.1;
+const N: usize = 4096;
+
+fn boxed(pts: &[P]) -> (P, P) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in pts {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
+/// Point-triangle inputs by set: `[far, near, within]`.
+fn point_triangle_sets() -> [Vec<(P, [P; 3])>; 3] {
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut sets: [Vec<(P, [P; 3])>; 3] = Default::default();
+    while sets.iter().any(|s| s.len() < N) {
+        let t = [
+            rng.point(-0.5, 0.5),
+            rng.point(-0.5, 0.5),
+            rng.point(-0.5, 0.5),
+        ];
+        // Flatten half of them towards a plane, as mesh neighbourhoods are.
+        let (lo, hi) = boxed(&t);
+        let p = [0, 1, 2].map(|k| rng.range(lo[k] - D, hi[k] + D));
+        let (d2, _) = dhcd::distance::point_triangle_distance_sq(p, t);
+        let dist = d2.sqrt();
+        let set = if dist <= D {
+            2
+        } else if dist <= 1.1 * D {
+            1
+        } else {
+            0
+        };
+        if sets[set].len() < N {
+            sets[set].push((p, t));
+        }
+    }
+    sets
+}
+
+/// Edge-edge inputs by set: `[far, near, within]`.
+fn edge_edge_sets() -> [Vec<[P; 4]>; 3] {
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    let mut sets: [Vec<[P; 4]>; 3] = Default::default();
+    while sets.iter().any(|s| s.len() < N) {
+        let a = [rng.point(-0.5, 0.5), rng.point(-0.5, 0.5)];
+        let (lo, hi) = boxed(&a);
+        let b0 = [0, 1, 2].map(|k| rng.range(lo[k] - D, hi[k] + D));
+        let dir = rng.point(-0.5, 0.5);
+        let b1 = [0, 1, 2].map(|k| b0[k] + dir[k]);
+        let e = [a[0], a[1], b0, b1];
+        let (d2, _) = edge_edge_distance_sq(e[0], e[1], e[2], e[3]);
+        let dist = d2.sqrt();
+        let set = if dist <= D {
+            2
+        } else if dist <= 1.1 * D {
+            1
+        } else {
+            0
+        };
+        if sets[set].len() < N {
+            sets[set].push(e);
+        }
+    }
+    sets
+}
+
+const NAMES: [&str; 3] = ["far", "near", "within"];
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("distance/point_triangle");
+    for (name, set) in NAMES.iter().zip(point_triangle_sets()) {
+        g.throughput(Throughput::Elements(set.len() as u64));
+        g.bench_function(*name, |b| {
+            b.iter(|| {
+                let mut hits = 0usize;
+                for (p, t) in &set {
+                    hits += usize::from(point_triangle_within(*p, *t, black_box(D)).is_some());
+                }
+                hits
+            })
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("distance/edge_edge");
+    for (name, set) in NAMES.iter().zip(edge_edge_sets()) {
+        g.throughput(Throughput::Elements(set.len() as u64));
+        g.bench_function(*name, |b| {
+            b.iter(|| {
+                let mut hits = 0usize;
+                for e in &set {
+                    hits += usize::from(
+                        edge_edge_within(e[0], e[1], e[2], e[3], black_box(D)).is_some(),
+                    );
+                }
+                hits
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

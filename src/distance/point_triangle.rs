@@ -1,0 +1,474 @@
+//! Point-triangle: the closest sub-feature, the exact decision and the value.
+//!
+//! With `ab = t1 - t0`, `ac = t2 - t0`, `bc = t2 - t1`, `ap = p - t0`, `bp = p - t1`,
+//! `cp = p - t2` (the leaves) and the six dot products
+//! `d1 = ab.ap, d2 = ac.ap, d3 = ab.bp, d4 = ac.bp, d5 = ab.cp, d6 = ac.cp`
+//! (Ericson, *Real-Time Collision Detection*, 5.1.5), the closest point `c` of the closed
+//! triangle to `p` is characterised by signs (each an optimality condition of the convex
+//! problem, so exact for any triangle, degenerate or not):
+//!
+//! | `c` is | iff |
+//! |---|---|
+//! | `t0` | `d1 <= 0` and `d2 <= 0` |
+//! | `t1` | `d3 >= 0` and `d4 - d3 <= 0` (`d4 - d3 = bc.bp`) |
+//! | `t2` | `d6 >= 0` and `d5 - d6 <= 0` (`d5 - d6 = (t1 - t2).cp`) |
+//! | in the open edge `t0 t1` | `d1 > 0`, `d3 < 0`, `vc = d1 d4 - d3 d2 <= 0` |
+//! | in the open edge `t1 t2` | `d4 - d3 > 0`, `d5 - d6 > 0`, `va = d3 d6 - d5 d4 <= 0` |
+//! | in the open edge `t2 t0` | `d2 > 0`, `d6 < 0`, `vb = d5 d2 - d1 d6 <= 0` |
+//! | in the open face | none of the above |
+//!
+//! (`vc = n.(ab x ap)` with `n = ab x ac` by the Lagrange identity: `p` is on the far side of
+//! the edge's line from the triangle, or on it; `va`, `vb` likewise.) The table is tested in
+//! this order, so at a tie (coincident corners, a corner inside an edge of a collinear
+//! triangle) the first type in [`PointTriangle`]'s order wins. `p` is then within `d` iff the
+//! distance to that feature is: `|p - ti|^2 <= d^2`, `|e x w|^2 <= d^2 |e|^2` for the
+//! edge's line, `(n.ap)^2 <= d^2 |n|^2` for the face's plane.
+
+use num_bigint::BigInt;
+
+use super::arith::{
+    certified, cross, dot, lagrange, ldexp, line_parts, line_q, line_value, plane_parts, plane_q,
+    plane_value, point_q, ratio_to_f64, scale_of, sign_of, sub3, to_grid, Bound, Powers, Ring, DOT,
+    DOT2, LAGRANGE, LINE, PLANE, POINT, V,
+};
+use super::PointTriangle as Pt;
+
+/// A sign the classification or the decision needs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Q {
+    D1,
+    D2,
+    D3,
+    D6,
+    /// `d4 - d3`
+    D43,
+    /// `d5 - d6`
+    D56,
+    Va,
+    Vb,
+    Vc,
+    /// The distance to the type's feature minus `d` (in the squared, divided-out form).
+    Dist(Pt),
+}
+
+/// The filter bound of each quantity (checked against the formulas by a test).
+#[inline(always)]
+fn bound(q: Q) -> Bound {
+    match q {
+        Q::D1 | Q::D2 | Q::D3 | Q::D6 => DOT,
+        Q::D43 | Q::D56 => DOT2,
+        Q::Va | Q::Vb | Q::Vc => LAGRANGE,
+        Q::Dist(Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2) => POINT,
+        Q::Dist(Pt::Edge0 | Pt::Edge1 | Pt::Edge2) => LINE,
+        Q::Dist(Pt::Face) => PLANE,
+    }
+}
+
+/// The differences every quantity is a polynomial in.
+#[derive(Clone)]
+pub(crate) struct Leaves<R> {
+    ab: V<R>,
+    ac: V<R>,
+    bc: V<R>,
+    ap: V<R>,
+    bp: V<R>,
+    cp: V<R>,
+}
+
+impl<R: Ring> Leaves<R> {
+    #[inline(always)]
+    fn new(p: &V<R>, t: &[V<R>; 3]) -> Self {
+        Self {
+            ab: sub3(&t[1], &t[0]),
+            ac: sub3(&t[2], &t[0]),
+            bc: sub3(&t[2], &t[1]),
+            ap: sub3(p, &t[0]),
+            bp: sub3(p, &t[1]),
+            cp: sub3(p, &t[2]),
+        }
+    }
+
+    /// `[d1, .., d6]`.
+    #[inline(always)]
+    fn dots(&self) -> [R; 6] {
+        [
+            dot(&self.ab, &self.ap),
+            dot(&self.ac, &self.ap),
+            dot(&self.ab, &self.bp),
+            dot(&self.ac, &self.bp),
+            dot(&self.ab, &self.cp),
+            dot(&self.ac, &self.cp),
+        ]
+    }
+
+    /// The feature's line or plane (or corner) as `(e, w)`: an edge's direction and the
+    /// point relative to its first end.
+    #[inline(always)]
+    fn edge(&self, ty: Pt) -> (&V<R>, &V<R>) {
+        match ty {
+            Pt::Edge0 => (&self.ab, &self.ap),
+            Pt::Edge1 => (&self.bc, &self.bp),
+            _ => (&self.ac, &self.cp),
+        }
+    }
+
+    /// The point relative to a corner.
+    #[inline(always)]
+    fn corner(&self, ty: Pt) -> &V<R> {
+        match ty {
+            Pt::Vertex0 => &self.ap,
+            Pt::Vertex1 => &self.bp,
+            _ => &self.cp,
+        }
+    }
+}
+
+/// The quantities other than the six dot products, from the dots and leaves.
+#[inline(always)]
+fn quantity<R: Ring>(l: &Leaves<R>, d: &[R; 6], dd: &R, q: Q) -> R {
+    let [d1, d2, d3, d4, d5, d6] = d;
+    match q {
+        Q::D1 => d1.clone(),
+        Q::D2 => d2.clone(),
+        Q::D3 => d3.clone(),
+        Q::D6 => d6.clone(),
+        Q::D43 => d4.sub(d3),
+        Q::D56 => d5.sub(d6),
+        Q::Va => lagrange(d3, d6, d5, d4),
+        Q::Vb => lagrange(d5, d2, d1, d6),
+        Q::Vc => lagrange(d1, d4, d3, d2),
+        Q::Dist(ty @ (Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2)) => point_q(l.corner(ty), dd),
+        Q::Dist(ty @ (Pt::Edge0 | Pt::Edge1 | Pt::Edge2)) => {
+            let (e, w) = l.edge(ty);
+            line_q(e, w, dd)
+        }
+        Q::Dist(Pt::Face) => plane_q(&cross(&l.ab, &l.ac), &l.ap, dd),
+    }
+}
+
+/// Exact signs of the quantities.
+pub(crate) trait Signs {
+    fn sign(&mut self, q: Q) -> i8;
+}
+
+/// The closest sub-feature (exact, given exact signs).
+#[inline(always)]
+pub(crate) fn classify<S: Signs>(s: &mut S) -> Pt {
+    if s.sign(Q::D1) <= 0 && s.sign(Q::D2) <= 0 {
+        return Pt::Vertex0;
+    }
+    if s.sign(Q::D3) >= 0 && s.sign(Q::D43) <= 0 {
+        return Pt::Vertex1;
+    }
+    if s.sign(Q::D6) >= 0 && s.sign(Q::D56) <= 0 {
+        return Pt::Vertex2;
+    }
+    if s.sign(Q::D1) > 0 && s.sign(Q::D3) < 0 && s.sign(Q::Vc) <= 0 {
+        return Pt::Edge0;
+    }
+    if s.sign(Q::D43) > 0 && s.sign(Q::D56) > 0 && s.sign(Q::Va) <= 0 {
+        return Pt::Edge1;
+    }
+    if s.sign(Q::D2) > 0 && s.sign(Q::D6) < 0 && s.sign(Q::Vb) <= 0 {
+        return Pt::Edge2;
+    }
+    Pt::Face
+}
+
+// ---------------------------------------------------------------------------------------------
+// Exact.
+
+/// Everything in integers on the inputs' common grid.
+pub(crate) struct Exact {
+    l: Leaves<BigInt>,
+    d: [BigInt; 6],
+    dd: BigInt,
+    /// The grid's unit is `2^unit`.
+    unit: i32,
+}
+
+impl Exact {
+    /// From finite inputs (`d` is only used by `Q::Dist`).
+    pub(crate) fn new(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64) -> Self {
+        let xs = [
+            p[0], p[1], p[2], t[0][0], t[0][1], t[0][2], t[1][0], t[1][1], t[1][2], t[2][0],
+            t[2][1], t[2][2], d,
+        ];
+        let (g, unit) = to_grid(&xs);
+        let [p0, p1, p2, a0, a1, a2, b0, b1, b2, c0, c1, c2, d] = g;
+        let l = Leaves::new(&[p0, p1, p2], &[[a0, a1, a2], [b0, b1, b2], [c0, c1, c2]]);
+        let dots = l.dots();
+        Self {
+            dd: d.mul(&d),
+            d: dots,
+            l,
+            unit,
+        }
+    }
+
+    /// The squared distance to the feature `ty` (the closest one), correctly rounded.
+    pub(crate) fn distance(&self, ty: Pt) -> f64 {
+        let l = &self.l;
+        let (num, den) = match ty {
+            Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2 => {
+                let r = l.corner(ty);
+                (dot(r, r), BigInt::from(1))
+            }
+            Pt::Edge0 | Pt::Edge1 | Pt::Edge2 => {
+                let (e, w) = l.edge(ty);
+                line_parts(e, w)
+            }
+            Pt::Face => {
+                let (s, nn) = plane_parts(&cross(&l.ab, &l.ac), &l.ap);
+                (s.mul(&s), nn)
+            }
+        };
+        ratio_to_f64(&num, &den, 2 * i64::from(self.unit))
+    }
+}
+
+impl Signs for Exact {
+    fn sign(&mut self, q: Q) -> i8 {
+        match q {
+            Q::D1 => sign_of(&self.d[0]),
+            Q::D2 => sign_of(&self.d[1]),
+            Q::D3 => sign_of(&self.d[2]),
+            Q::D6 => sign_of(&self.d[5]),
+            _ => sign_of(&quantity(&self.l, &self.d, &self.dd, q)),
+        }
+    }
+}
+
+/// The exact context, built on the first sign the filter cannot certify.
+struct Lazy<'a> {
+    p: &'a [f64; 3],
+    t: &'a [[f64; 3]; 3],
+    d: f64,
+    ex: Option<Box<Exact>>,
+}
+
+impl Lazy<'_> {
+    #[cold]
+    #[inline(never)]
+    fn sign(&mut self, q: Q) -> i8 {
+        self.get().sign(q)
+    }
+
+    #[cold]
+    fn get(&mut self) -> &mut Exact {
+        let (p, t, d) = (self.p, self.t, self.d);
+        self.ex.get_or_insert_with(|| Box::new(Exact::new(p, t, d)))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Float.
+
+/// The float evaluation: each sign certified by its bound, else exact.
+struct Fast<'a> {
+    l: Leaves<f64>,
+    d: [f64; 6],
+    dd: f64,
+    /// `plane_q` (when deciding).
+    plane: f64,
+    pw: Powers,
+    lazy: Lazy<'a>,
+}
+
+impl Signs for Fast<'_> {
+    #[inline(always)]
+    fn sign(&mut self, q: Q) -> i8 {
+        let v = match q {
+            Q::Dist(Pt::Face) => self.plane,
+            _ => quantity(&self.l, &self.d, &self.dd, q),
+        };
+        match certified(v, self.pw.of(bound(q))) {
+            Some(s) => s,
+            None => self.lazy.sign(q),
+        }
+    }
+}
+
+/// The float value of the squared distance to the feature `ty` (unscaled by the caller), or
+/// `None` when the formula's accuracy is not assured (see [`plane_value`], [`line_value`]).
+#[inline(always)]
+fn value(l: &Leaves<f64>, n: &V<f64>, ty: Pt) -> Option<f64> {
+    match ty {
+        Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2 => {
+            let r = l.corner(ty);
+            Some(dot(r, r))
+        }
+        Pt::Edge0 | Pt::Edge1 | Pt::Edge2 => {
+            let (e, w) = l.edge(ty);
+            line_value(e, w)
+        }
+        Pt::Face => plane_value(&l.ab, &l.ac, n, &l.ap),
+    }
+}
+
+/// The largest side of the box of the points (exact extents, rounded once), and whether a
+/// coordinate gap already exceeds `d` (`far`: decided exactly, since rounding is monotone and
+/// `d` is a float).
+#[inline(always)]
+fn extent(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64) -> (f64, bool) {
+    let mut m = 0.0f64;
+    let mut far = false;
+    for k in 0..3 {
+        let (a, b, c) = (t[0][k], t[1][k], t[2][k]);
+        let lo = a.min(b).min(c);
+        let hi = a.max(b).max(c);
+        far |= lo - p[k] > d || p[k] - hi > d;
+        m = m.max(hi.max(p[k]) - lo.min(p[k]));
+    }
+    (m, far)
+}
+
+/// The float path for extents in the filter's range (`k`: the leaves' scaling exponent).
+/// `decide`: test the distance against `d` (else only classify and measure). `None`: not
+/// within `d`, or an input is not finite.
+#[inline(always)]
+fn fast(
+    p: &[f64; 3],
+    t: &[[f64; 3]; 3],
+    d: f64,
+    m: f64,
+    k: i32,
+    decide: bool,
+) -> Option<(f64, Pt)> {
+    let mut l = Leaves::new(p, t);
+    let (mut ds, mut ms) = (d, m);
+    if k != 0 {
+        // Scaling up by a power of two is exact.
+        let s = |v: &mut V<f64>| v.iter_mut().for_each(|x| *x = ldexp(*x, k));
+        for v in [
+            &mut l.ab, &mut l.ac, &mut l.bc, &mut l.ap, &mut l.bp, &mut l.cp,
+        ] {
+            s(v);
+        }
+        ds = ldexp(d, k);
+        ms = ldexp(m, k);
+    }
+    let dd = ds * ds;
+    let pw = Powers::new(if decide { ms.max(ds) } else { ms });
+    let n = cross(&l.ab, &l.ac);
+    let plane = if decide {
+        // Early exit: farther than `d` from the triangle's plane.
+        let q = plane_q(&n, &l.ap, &dd);
+        if q > pw.of(PLANE) {
+            return None;
+        }
+        q
+    } else {
+        f64::NAN
+    };
+    let dots = l.dots();
+    // A non-finite input makes some dot product non-finite (every input is in one).
+    if !(dots[0] + dots[1] + dots[2] + dots[3] + dots[4] + dots[5]).is_finite() {
+        return None;
+    }
+    let mut f = Fast {
+        l,
+        d: dots,
+        dd,
+        plane,
+        pw,
+        lazy: Lazy {
+            p,
+            t,
+            d: if decide { d } else { 0.0 },
+            ex: None,
+        },
+    };
+    let ty = classify(&mut f);
+    if decide && f.sign(Q::Dist(ty)) > 0 {
+        return None;
+    }
+    let v = match value(&f.l, &n, ty) {
+        Some(v) if k == 0 => v,
+        Some(v) => ldexp(v, -2 * k),
+        None => f.lazy.get().distance(ty),
+    };
+    Some((v, ty))
+}
+
+/// The exact path: extents beyond the filter's range, and non-finite input (`None`).
+#[cold]
+#[inline(never)]
+fn slow(p: &[f64; 3], t: &[[f64; 3]; 3], d: Option<f64>) -> Option<(f64, Pt)> {
+    let finite = p.iter().chain(t.as_flattened()).all(|x| x.is_finite());
+    if !finite || d.is_some_and(|d| !d.is_finite()) {
+        return None;
+    }
+    let mut ex = Exact::new(p, t, d.unwrap_or(0.0));
+    let ty = classify(&mut ex);
+    if d.is_some() && ex.sign(Q::Dist(ty)) > 0 {
+        return None;
+    }
+    Some((ex.distance(ty), ty))
+}
+
+/// See [`super::point_triangle_within`].
+#[inline]
+pub(crate) fn within(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64) -> Option<(f64, Pt)> {
+    if d.is_nan() || d < 0.0 {
+        return None;
+    }
+    let (m, far) = extent(p, t, d);
+    if far {
+        return None;
+    }
+    // The distance is at most |p - t0| <= sqrt(3) m_exact < 2 m: within when d >= 2 m.
+    let decide = d < 2.0 * m;
+    match scale_of(m) {
+        Some(k) => fast(p, t, d, m, k, decide),
+        None => slow(p, t, decide.then_some(d)),
+    }
+}
+
+/// See [`super::point_triangle_distance_sq`].
+#[inline]
+pub(crate) fn distance(p: &[f64; 3], t: &[[f64; 3]; 3]) -> (f64, Pt) {
+    let (m, _) = extent(p, t, f64::INFINITY);
+    match scale_of(m) {
+        Some(k) => fast(p, t, 0.0, m, k, false),
+        None => slow(p, t, None),
+    }
+    .unwrap_or((f64::NAN, Pt::Vertex0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::arith::count::Count;
+    use super::*;
+
+    #[test]
+    fn bounds_fit_every_quantity() {
+        let c = Count::diffs;
+        let l = Leaves {
+            ab: c(),
+            ac: c(),
+            bc: c(),
+            ap: c(),
+            bp: c(),
+            cp: c(),
+        };
+        let d = l.dots();
+        let dd = Count::input().mul(&Count::input());
+        let mut all = vec![
+            Q::D1,
+            Q::D2,
+            Q::D3,
+            Q::D6,
+            Q::D43,
+            Q::D56,
+            Q::Va,
+            Q::Vb,
+            Q::Vc,
+        ];
+        all.extend(Pt::ALL.map(Q::Dist));
+        for q in all {
+            let shape = quantity(&l, &d, &dd, q);
+            assert!(shape.fits(bound(q)), "{q:?}: {shape:?} vs {:?}", bound(q));
+        }
+    }
+}
