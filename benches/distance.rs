@@ -9,12 +9,15 @@
 //! - `near`: farther than `d` by at most 10% (near misses: the filter works hardest);
 //! - `within`: at most `d` (the pairs a proximity query reports, value and type computed).
 //!
+//! The points are stored once in a position array and each call gathers its 4 points by
+//! index, as a proximity query's inner loop does (`x[v]`, `x[t[0]]`, ...).
+//!
 //! Ids: `distance/{point_triangle,edge_edge}/{far,near,within}`, throughput in calls, so
 //! criterion prints the time per call. Run: `cargo bench --bench distance`.
 
 use std::hint::black_box;
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::{criterion_group, Criterion, Throughput};
 use dhcd::distance::{edge_edge_distance_sq, edge_edge_within, point_triangle_within};
 
 type P = [f64; 3];
@@ -113,15 +116,39 @@ fn edge_edge_sets() -> [Vec<[P; 4]>; 3] {
 
 const NAMES: [&str; 3] = ["far", "near", "within"];
 
+/// A set of calls as a position array and the 4 point indices of each call.
+struct Calls {
+    x: Vec<P>,
+    idx: Vec<[u32; 4]>,
+}
+
+impl Calls {
+    /// In order: the data (384 KiB a set) streams from cache, so the time is the
+    /// primitive's, not the memory's.
+    fn new(pts: impl Iterator<Item = [P; 4]>) -> Self {
+        let mut x = Vec::new();
+        let mut idx = Vec::new();
+        for q in pts {
+            let i = x.len() as u32;
+            x.extend(q);
+            idx.push([i, i + 1, i + 2, i + 3]);
+        }
+        Self { x, idx }
+    }
+}
+
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("distance/point_triangle");
     for (name, set) in NAMES.iter().zip(point_triangle_sets()) {
-        g.throughput(Throughput::Elements(set.len() as u64));
+        let calls = Calls::new(set.into_iter().map(|(p, t)| [p, t[0], t[1], t[2]]));
+        g.throughput(Throughput::Elements(calls.idx.len() as u64));
         g.bench_function(*name, |b| {
             b.iter(|| {
+                let (x, d) = (&calls.x, black_box(D));
                 let mut hits = 0usize;
-                for (p, t) in &set {
-                    hits += usize::from(point_triangle_within(*p, *t, black_box(D)).is_some());
+                for &[i, a, b, c] in &calls.idx {
+                    let t = [x[a as usize], x[b as usize], x[c as usize]];
+                    hits += usize::from(point_triangle_within(x[i as usize], t, d).is_some());
                 }
                 hits
             })
@@ -130,14 +157,15 @@ fn bench(c: &mut Criterion) {
     g.finish();
     let mut g = c.benchmark_group("distance/edge_edge");
     for (name, set) in NAMES.iter().zip(edge_edge_sets()) {
-        g.throughput(Throughput::Elements(set.len() as u64));
+        let calls = Calls::new(set.into_iter());
+        g.throughput(Throughput::Elements(calls.idx.len() as u64));
         g.bench_function(*name, |b| {
             b.iter(|| {
+                let (x, d) = (&calls.x, black_box(D));
                 let mut hits = 0usize;
-                for e in &set {
-                    hits += usize::from(
-                        edge_edge_within(e[0], e[1], e[2], e[3], black_box(D)).is_some(),
-                    );
+                for &[a0, a1, b0, b1] in &calls.idx {
+                    let [a0, a1, b0, b1] = [a0, a1, b0, b1].map(|i| x[i as usize]);
+                    hits += usize::from(edge_edge_within(a0, a1, b0, b1, d).is_some());
                 }
                 hits
             })
@@ -147,4 +175,48 @@ fn bench(c: &mut Criterion) {
 }
 
 criterion_group!(benches, bench);
-criterion_main!(benches);
+
+/// `DISTANCE_CALLS=<set> <reps>` (e.g. `point_triangle/far 10`) runs the set's calls `reps`
+/// times and exits, for counting instructions under valgrind (`valgrind --tool=cachegrind
+/// --branch-sim=yes`): the difference between two rep counts over the calls made is the cost
+/// per call, independent of the machine's load. Otherwise, criterion.
+fn main() {
+    if let Ok(spec) = std::env::var("DISTANCE_CALLS") {
+        let (name, reps) = spec.split_once(' ').expect("<set> <reps>");
+        let reps: usize = reps.parse().expect("reps");
+        let (kind, set) = name.split_once('/').expect("<kind>/<set>");
+        let which = NAMES
+            .iter()
+            .position(|n| *n == set)
+            .expect("far, near or within");
+        let mut hits = 0usize;
+        if kind == "point_triangle" {
+            let calls = Calls::new(
+                point_triangle_sets()[which]
+                    .iter()
+                    .map(|(p, t)| [*p, t[0], t[1], t[2]]),
+            );
+            for _ in 0..reps {
+                for &[i, a, b, c] in &calls.idx {
+                    let x = &calls.x;
+                    let t = [x[a as usize], x[b as usize], x[c as usize]];
+                    hits += usize::from(
+                        point_triangle_within(x[i as usize], t, black_box(D)).is_some(),
+                    );
+                }
+            }
+        } else {
+            let calls = Calls::new(edge_edge_sets()[which].iter().copied());
+            for _ in 0..reps {
+                for &[a0, a1, b0, b1] in &calls.idx {
+                    let [a0, a1, b0, b1] = [a0, a1, b0, b1].map(|i| calls.x[i as usize]);
+                    hits += usize::from(edge_edge_within(a0, a1, b0, b1, black_box(D)).is_some());
+                }
+            }
+        }
+        println!("{hits}");
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

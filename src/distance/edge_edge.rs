@@ -282,13 +282,11 @@ impl Lazy<'_> {
 // ---------------------------------------------------------------------------------------------
 // Float.
 
-/// The float evaluation: each sign certified by its bound, else exact.
+/// The float classification of the uncertain case: each sign certified by its bound, else
+/// exact.
 struct Fast<'a> {
     l: Leaves<f64>,
     d: [f64; 5],
-    dd: f64,
-    /// `plane_q` of the two lines (when deciding).
-    lines: f64,
     pw: Powers,
     lazy: Lazy<'a>,
 }
@@ -296,10 +294,8 @@ struct Fast<'a> {
 impl Signs for Fast<'_> {
     #[inline(always)]
     fn sign(&mut self, q: Q) -> i8 {
-        let v = match q {
-            Q::Dist(Ee::EaEb) => self.lines,
-            _ => quantity(&self.l, &self.d, &self.dd, q),
-        };
+        // Classification only (no `Q::Dist`): `dd` is not used.
+        let v = quantity(&self.l, &self.d, &0.0, q);
         match certified(v, self.pw.of(bound(q))) {
             Some(s) => s,
             None => self.lazy.sign(q),
@@ -326,41 +322,84 @@ fn value(l: &Leaves<f64>, n: &V<f64>, ty: Ee) -> Option<f64> {
 
 /// The largest side of the box of the four points, and whether the segments' boxes are
 /// farther apart than `d` along an axis (exact: rounding is monotone and `d` is a float).
+/// PERF: plain comparisons, as in the point-triangle twin.
 #[inline(always)]
 fn extent(a0: &[f64; 3], a1: &[f64; 3], b0: &[f64; 3], b1: &[f64; 3], d: f64) -> (f64, bool) {
+    let mn = |a: f64, b: f64| if a < b { a } else { b };
+    let mx = |a: f64, b: f64| if a > b { a } else { b };
     let mut m = 0.0f64;
     let mut far = false;
     for k in 0..3 {
-        let (alo, ahi) = (a0[k].min(a1[k]), a0[k].max(a1[k]));
-        let (blo, bhi) = (b0[k].min(b1[k]), b0[k].max(b1[k]));
-        far |= blo - ahi > d || alo - bhi > d;
-        m = m.max(ahi.max(bhi) - alo.min(blo));
+        let (alo, ahi) = (mn(a0[k], a1[k]), mx(a0[k], a1[k]));
+        let (blo, bhi) = (mn(b0[k], b1[k]), mx(b0[k], b1[k]));
+        far |= (blo - ahi > d) | (alo - bhi > d);
+        m = mx(m, mx(ahi, bhi) - mn(alo, blo));
     }
     (m, far)
+}
+
+/// The type from the float signs when every sign [`classify`] may read is certified (all
+/// nonzero then), branch-free; `None` otherwise (see the point-triangle twin).
+#[inline(always)]
+fn classify_certified(l: &Leaves<f64>, d: &[f64; 5], pw: &Powers) -> Option<Ee> {
+    let q = |q: Q| quantity(l, d, &0.0, q);
+    let (ru, rv) = (d[3], d[4]);
+    let (r01u, r01v, r10u, r10v) = (q(Q::R01u), q(Q::R01v), q(Q::R10u), q(Q::R10v));
+    let (r11u, r11v) = (q(Q::R11u), q(Q::R11v));
+    let (l0, l1, m0, m1) = (q(Q::L0), q(Q::L1), q(Q::M0), q(Q::M1));
+    let (b1, b2, b3) = (pw.of(DOT), pw.of(DOT2), pw.of(DOT3));
+    let (b4, b5) = (pw.of(LAGRANGE), pw.of(LAGRANGE2));
+    let sure = (ru.abs() > b1)
+        & (rv.abs() > b1)
+        & (r01u.abs() > b2)
+        & (r01v.abs() > b2)
+        & (r10u.abs() > b2)
+        & (r10v.abs() > b2)
+        & (r11u.abs() > b3)
+        & (r11v.abs() > b3)
+        & (l0.abs() > b4)
+        & (m0.abs() > b4)
+        & (l1.abs() > b5)
+        & (m1.abs() > b5);
+    if !sure {
+        return None;
+    }
+    let pos = |x: f64| x > 0.0;
+    let (pru, prv) = (pos(ru), pos(rv));
+    let (p01u, p01v, p10u, p10v) = (pos(r01u), pos(r01v), pos(r10u), pos(r10v));
+    let (p11u, p11v) = (pos(r11u), pos(r11v));
+    let mask = u32::from(pru & !prv)
+        | u32::from(p01u & p01v) << 1
+        | u32::from(!p10u & !p10v) << 2
+        | u32::from(!p11u & p11v) << 3
+        | u32::from(!pru & p10u & !pos(l0)) << 4
+        | u32::from(!p01u & p11u & pos(l1)) << 5
+        | u32::from(prv & !p01v & pos(m0)) << 6
+        | u32::from(p10v & !p11v & !pos(m1)) << 7
+        | 1 << 8;
+    Some(Ee::ALL[mask.trailing_zeros() as usize])
 }
 
 /// The float path for extents in the filter's range (see the point-triangle twin).
 #[inline(always)]
 fn fast(e: [&[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, Ee)> {
     let [a0, a1, b0, b1] = e;
-    let mut l = Leaves::new(a0, a1, b0, b1);
-    let (mut ds, mut ms) = (d, m);
-    if k != 0 {
-        let s = |v: &mut V<f64>| v.iter_mut().for_each(|x| *x = ldexp(*x, k));
-        for v in [
-            &mut l.u, &mut l.v, &mut l.r, &mut l.r01, &mut l.r10, &mut l.r11,
-        ] {
-            s(v);
-        }
-        ds = ldexp(d, k);
-        ms = ldexp(m, k);
-    }
+    // Scaling up by a power of two is exact.
+    let sc = |v: V<f64>| if k == 0 { v } else { v.map(|x| ldexp(x, k)) };
+    let (ds, ms) = if k == 0 {
+        (d, m)
+    } else {
+        (ldexp(d, k), ldexp(m, k))
+    };
     let dd = ds * ds;
     let pw = Powers::new(if decide { ms.max(ds) } else { ms });
-    let n = cross(&l.u, &l.v);
+    let u = sc(sub3(a1, a0));
+    let v = sc(sub3(b1, b0));
+    let r = sc(sub3(a0, b0));
+    let n = cross(&u, &v);
     let lines = if decide {
         // Early exit: the lines are farther apart than `d`.
-        let q = plane_q(&n, &l.r, &dd);
+        let q = plane_q(&n, &r, &dd);
         if q > pw.of(PLANE) {
             return None;
         }
@@ -368,33 +407,75 @@ fn fast(e: [&[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64,
     } else {
         f64::NAN
     };
+    let l = Leaves {
+        u,
+        v,
+        r,
+        r01: sc(sub3(a0, b1)),
+        r10: sc(sub3(a1, b0)),
+        r11: sc(sub3(a1, b1)),
+    };
     let dots = l.dots();
-    // A non-finite input makes `uu`, `vv` or `ru` non-finite (u, v and r hold every input).
-    if !(dots[0] + dots[1] + dots[3]).is_finite() {
+    // A non-finite input makes `uu` or `vv` non-finite (u and v hold every input).
+    if !(dots[0] + dots[1]).is_finite() {
         return None;
     }
-    let mut f = Fast {
-        l,
-        d: dots,
-        dd,
-        lines,
+    let ty = match classify_certified(&l, &dots, &pw) {
+        Some(ty) => ty,
+        None => classify_uncertain(&l, &dots, pw, e),
+    };
+    if decide {
+        let q = Q::Dist(ty);
+        let v = match ty {
+            Ee::EaEb => lines,
+            _ => quantity(&l, &dots, &dd, q),
+        };
+        let s = match certified(v, pw.of(bound(q))) {
+            Some(s) => s,
+            None => exact_sign(e, d, q),
+        };
+        if s > 0 {
+            return None;
+        }
+    }
+    let v = match value(&l, &n, ty) {
+        Some(v) if k == 0 => v,
+        Some(v) => ldexp(v, -2 * k),
+        None => exact_distance(e, ty),
+    };
+    Some((v, ty))
+}
+
+/// [`classify`] with the float signs, exact where uncertain (cold: a near-tie).
+#[cold]
+#[inline(never)]
+fn classify_uncertain(l: &Leaves<f64>, dots: &[f64; 5], pw: Powers, e: [&[f64; 3]; 4]) -> Ee {
+    classify(&mut Fast {
+        l: l.clone(),
+        d: *dots,
         pw,
         lazy: Lazy {
             e,
-            d: if decide { d } else { 0.0 },
+            d: 0.0,
             ex: None,
         },
-    };
-    let ty = classify(&mut f);
-    if decide && f.sign(Q::Dist(ty)) > 0 {
-        return None;
-    }
-    let v = match value(&f.l, &n, ty) {
-        Some(v) if k == 0 => v,
-        Some(v) => ldexp(v, -2 * k),
-        None => f.lazy.get().distance(ty),
-    };
-    Some((v, ty))
+    })
+}
+
+/// The correctly rounded squared distance between the features of `ty` (cold).
+#[cold]
+#[inline(never)]
+fn exact_distance(e: [&[f64; 3]; 4], ty: Ee) -> f64 {
+    let [a0, a1, b0, b1] = e;
+    Exact::new(a0, a1, b0, b1, 0.0).distance(ty)
+}
+
+/// The exact sign of one quantity (cold: a near-tie).
+#[cold]
+#[inline(never)]
+fn exact_sign(e: [&[f64; 3]; 4], d: f64, q: Q) -> i8 {
+    let [a0, a1, b0, b1] = e;
+    Exact::new(a0, a1, b0, b1, d).sign(q)
 }
 
 /// The exact path: extents beyond the filter's range, and non-finite input (`None`).

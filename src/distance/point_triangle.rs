@@ -264,13 +264,11 @@ impl Lazy<'_> {
 // ---------------------------------------------------------------------------------------------
 // Float.
 
-/// The float evaluation: each sign certified by its bound, else exact.
+/// The float classification of the uncertain case: each sign certified by its bound, else
+/// exact.
 struct Fast<'a> {
     l: Leaves<f64>,
     d: [f64; 6],
-    dd: f64,
-    /// `plane_q` (when deciding).
-    plane: f64,
     pw: Powers,
     lazy: Lazy<'a>,
 }
@@ -278,10 +276,8 @@ struct Fast<'a> {
 impl Signs for Fast<'_> {
     #[inline(always)]
     fn sign(&mut self, q: Q) -> i8 {
-        let v = match q {
-            Q::Dist(Pt::Face) => self.plane,
-            _ => quantity(&self.l, &self.d, &self.dd, q),
-        };
+        // Classification only (no `Q::Dist`): `dd` is not used.
+        let v = quantity(&self.l, &self.d, &0.0, q);
         match certified(v, self.pw.of(bound(q))) {
             Some(s) => s,
             None => self.lazy.sign(q),
@@ -308,19 +304,56 @@ fn value(l: &Leaves<f64>, n: &V<f64>, ty: Pt) -> Option<f64> {
 
 /// The largest side of the box of the points (exact extents, rounded once), and whether a
 /// coordinate gap already exceeds `d` (`far`: decided exactly, since rounding is monotone and
-/// `d` is a float).
+/// `d` is a float). PERF: plain comparisons (`minsd`), not `f64::min`'s NaN handling; a NaN
+/// input is caught later (see [`fast`]).
 #[inline(always)]
 fn extent(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64) -> (f64, bool) {
+    let mn = |a: f64, b: f64| if a < b { a } else { b };
+    let mx = |a: f64, b: f64| if a > b { a } else { b };
     let mut m = 0.0f64;
     let mut far = false;
     for k in 0..3 {
         let (a, b, c) = (t[0][k], t[1][k], t[2][k]);
-        let lo = a.min(b).min(c);
-        let hi = a.max(b).max(c);
-        far |= lo - p[k] > d || p[k] - hi > d;
-        m = m.max(hi.max(p[k]) - lo.min(p[k]));
+        let lo = mn(mn(a, b), c);
+        let hi = mx(mx(a, b), c);
+        far |= (lo - p[k] > d) | (p[k] - hi > d);
+        m = mx(m, mx(hi, p[k]) - mn(lo, p[k]));
     }
     (m, far)
+}
+
+/// The type from the float signs when every sign [`classify`] may read is certified (all
+/// nonzero then), branch-free; `None` otherwise. PERF: the types of neighbouring candidates
+/// are unpredictable, and the branchy [`classify`] paid a misprediction per test.
+#[inline(always)]
+fn classify_certified(l: &Leaves<f64>, d: &[f64; 6], pw: &Powers) -> Option<Pt> {
+    let q = |q: Q| quantity(l, d, &0.0, q);
+    let (d1, d2, d3, d6) = (d[0], d[1], d[2], d[5]);
+    let (d43, d56) = (q(Q::D43), q(Q::D56));
+    let (va, vb, vc) = (q(Q::Va), q(Q::Vb), q(Q::Vc));
+    let (b2, b2d, b4) = (pw.of(DOT), pw.of(DOT2), pw.of(LAGRANGE));
+    let sure = (d1.abs() > b2)
+        & (d2.abs() > b2)
+        & (d3.abs() > b2)
+        & (d6.abs() > b2)
+        & (d43.abs() > b2d)
+        & (d56.abs() > b2d)
+        & (va.abs() > b4)
+        & (vb.abs() > b4)
+        & (vc.abs() > b4);
+    if !sure {
+        return None;
+    }
+    let (p1, p2, p3, p6) = (d1 > 0.0, d2 > 0.0, d3 > 0.0, d6 > 0.0);
+    let (p43, p56) = (d43 > 0.0, d56 > 0.0);
+    let mask = u32::from(!p1 & !p2)
+        | u32::from(p3 & !p43) << 1
+        | u32::from(p6 & !p56) << 2
+        | u32::from(p1 & !p3 & (vc < 0.0)) << 3
+        | u32::from(p43 & p56 & (va < 0.0)) << 4
+        | u32::from(p2 & !p6 & (vb < 0.0)) << 5
+        | 1 << 6;
+    Some(Pt::ALL[mask.trailing_zeros() as usize])
 }
 
 /// The float path for extents in the filter's range (`k`: the leaves' scaling exponent).
@@ -335,25 +368,23 @@ fn fast(
     k: i32,
     decide: bool,
 ) -> Option<(f64, Pt)> {
-    let mut l = Leaves::new(p, t);
-    let (mut ds, mut ms) = (d, m);
-    if k != 0 {
-        // Scaling up by a power of two is exact.
-        let s = |v: &mut V<f64>| v.iter_mut().for_each(|x| *x = ldexp(*x, k));
-        for v in [
-            &mut l.ab, &mut l.ac, &mut l.bc, &mut l.ap, &mut l.bp, &mut l.cp,
-        ] {
-            s(v);
-        }
-        ds = ldexp(d, k);
-        ms = ldexp(m, k);
-    }
+    // Scaling up by a power of two is exact.
+    let sc = |v: V<f64>| if k == 0 { v } else { v.map(|x| ldexp(x, k)) };
+    let (ds, ms) = if k == 0 {
+        (d, m)
+    } else {
+        (ldexp(d, k), ldexp(m, k))
+    };
     let dd = ds * ds;
     let pw = Powers::new(if decide { ms.max(ds) } else { ms });
-    let n = cross(&l.ab, &l.ac);
+    // The plane test's leaves first (PERF: most far pairs leave there).
+    let ab = sc(sub3(&t[1], &t[0]));
+    let ac = sc(sub3(&t[2], &t[0]));
+    let ap = sc(sub3(p, &t[0]));
+    let n = cross(&ab, &ac);
     let plane = if decide {
         // Early exit: farther than `d` from the triangle's plane.
-        let q = plane_q(&n, &l.ap, &dd);
+        let q = plane_q(&n, &ap, &dd);
         if q > pw.of(PLANE) {
             return None;
         }
@@ -361,34 +392,80 @@ fn fast(
     } else {
         f64::NAN
     };
+    let l = Leaves {
+        ab,
+        ac,
+        bc: sc(sub3(&t[2], &t[1])),
+        ap,
+        bp: sc(sub3(p, &t[1])),
+        cp: sc(sub3(p, &t[2])),
+    };
     let dots = l.dots();
     // A non-finite input makes some dot product non-finite (every input is in one).
     if !(dots[0] + dots[1] + dots[2] + dots[3] + dots[4] + dots[5]).is_finite() {
         return None;
     }
-    let mut f = Fast {
-        l,
-        d: dots,
-        dd,
-        plane,
+    let ty = match classify_certified(&l, &dots, &pw) {
+        Some(ty) => ty,
+        None => classify_uncertain(&l, &dots, pw, p, t),
+    };
+    if decide {
+        let q = Q::Dist(ty);
+        let v = match ty {
+            Pt::Face => plane,
+            _ => quantity(&l, &dots, &dd, q),
+        };
+        let s = match certified(v, pw.of(bound(q))) {
+            Some(s) => s,
+            None => exact_sign(p, t, d, q),
+        };
+        if s > 0 {
+            return None;
+        }
+    }
+    let v = match value(&l, &n, ty) {
+        Some(v) if k == 0 => v,
+        Some(v) => ldexp(v, -2 * k),
+        None => exact_distance(p, t, ty),
+    };
+    Some((v, ty))
+}
+
+/// [`classify`] with the float signs, exact where uncertain (cold: a near-tie).
+#[cold]
+#[inline(never)]
+fn classify_uncertain(
+    l: &Leaves<f64>,
+    dots: &[f64; 6],
+    pw: Powers,
+    p: &[f64; 3],
+    t: &[[f64; 3]; 3],
+) -> Pt {
+    classify(&mut Fast {
+        l: l.clone(),
+        d: *dots,
         pw,
         lazy: Lazy {
             p,
             t,
-            d: if decide { d } else { 0.0 },
+            d: 0.0,
             ex: None,
         },
-    };
-    let ty = classify(&mut f);
-    if decide && f.sign(Q::Dist(ty)) > 0 {
-        return None;
-    }
-    let v = match value(&f.l, &n, ty) {
-        Some(v) if k == 0 => v,
-        Some(v) => ldexp(v, -2 * k),
-        None => f.lazy.get().distance(ty),
-    };
-    Some((v, ty))
+    })
+}
+
+/// The correctly rounded squared distance to the feature `ty` (cold).
+#[cold]
+#[inline(never)]
+fn exact_distance(p: &[f64; 3], t: &[[f64; 3]; 3], ty: Pt) -> f64 {
+    Exact::new(p, t, 0.0).distance(ty)
+}
+
+/// The exact sign of one quantity (cold: a near-tie).
+#[cold]
+#[inline(never)]
+fn exact_sign(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64, q: Q) -> i8 {
+    Exact::new(p, t, d).sign(q)
 }
 
 /// The exact path: extents beyond the filter's range, and non-finite input (`None`).
