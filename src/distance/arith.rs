@@ -316,7 +316,7 @@ pub(crate) const SLIVER: f64 = 1.0 / (1u64 << 40) as f64;
 /// ([`has_tiny`]).
 #[inline(always)]
 pub(crate) fn plane_value(x: &V<f64>, y: &V<f64>, n: &V<f64>, w: &V<f64>) -> Option<f64> {
-    if has_tiny(&[x, y, w]) {
+    if has_tiny([x, y, w]) {
         return None;
     }
     let (s, nn) = plane_parts(n, w);
@@ -330,7 +330,7 @@ pub(crate) fn plane_value(x: &V<f64>, y: &V<f64>, n: &V<f64>, w: &V<f64>) -> Opt
 /// `|e x w|^2 / |e|^2`, or `None` when a leaf is too small ([`has_tiny`]).
 #[inline(always)]
 pub(crate) fn line_value(e: &V<f64>, w: &V<f64>) -> Option<f64> {
-    if has_tiny(&[e, w]) {
+    if has_tiny([e, w]) {
         return None;
     }
     let (num, den) = line_parts(e, w);
@@ -338,12 +338,48 @@ pub(crate) fn line_value(e: &V<f64>, w: &V<f64>) -> Option<f64> {
 }
 
 /// Whether a value formula over these leaf components could underflow (some component is
-/// nonzero and below [`VALUE_TINY`]).
+/// nonzero and below [`VALUE_TINY`]). PERF: integer compares on the magnitudes' bits, no
+/// iterator.
 #[inline(always)]
-pub(crate) fn has_tiny(vs: &[&V<f64>]) -> bool {
-    vs.iter()
-        .flat_map(|v| v.iter())
-        .any(|&x| x != 0.0 && x.abs() < VALUE_TINY)
+pub(crate) fn has_tiny<const N: usize>(vs: [&V<f64>; N]) -> bool {
+    const ABS: u64 = !(1 << 63);
+    let limit = VALUE_TINY.to_bits() - 1;
+    let mut any = false;
+    for v in vs {
+        for x in v {
+            // 0 < |x| < VALUE_TINY  <=>  |x|'s bits - 1 < VALUE_TINY's bits - 1 (wrapping).
+            any |= (x.to_bits() & ABS).wrapping_sub(1) < limit;
+        }
+    }
+    any
+}
+
+/// Elementwise minimum (plain comparisons: `minsd`/`minpd`).
+#[inline(always)]
+pub(crate) fn min3(a: &V<f64>, b: &V<f64>) -> V<f64> {
+    let m = |x: f64, y: f64| if x < y { x } else { y };
+    [m(a[0], b[0]), m(a[1], b[1]), m(a[2], b[2])]
+}
+
+/// Elementwise maximum.
+#[inline(always)]
+pub(crate) fn max3(a: &V<f64>, b: &V<f64>) -> V<f64> {
+    let m = |x: f64, y: f64| if x > y { x } else { y };
+    [m(a[0], b[0]), m(a[1], b[1]), m(a[2], b[2])]
+}
+
+/// The largest component.
+#[inline(always)]
+pub(crate) fn hmax(a: &V<f64>) -> f64 {
+    let m = |x: f64, y: f64| if x > y { x } else { y };
+    m(m(a[0], a[1]), a[2])
+}
+
+/// Whether some component of `a - b` exceeds `d` (exact: rounding is monotone and `d` is a
+/// float, so `fl(a - b) > d` iff `a - b > d`).
+#[inline(always)]
+pub(crate) fn gap_exceeds(a: &V<f64>, b: &V<f64>, d: f64) -> bool {
+    (a[0] - b[0] > d) | (a[1] - b[1] > d) | (a[2] - b[2] > d)
 }
 
 // ---------------------------------------------------------------------------------------------

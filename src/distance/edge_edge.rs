@@ -28,9 +28,9 @@
 use num_bigint::BigInt;
 
 use super::arith::{
-    certified, cross, dot, lagrange, ldexp, line_parts, line_q, line_value, plane_parts, plane_q,
-    plane_value, point_q, ratio_to_f64, scale_of, sign_of, sub3, to_grid, Bound, Powers, Ring, DOT,
-    DOT2, DOT3, LAGRANGE, LAGRANGE2, LINE, PLANE, POINT, V,
+    certified, cross, dot, gap_exceeds, hmax, lagrange, ldexp, line_parts, line_q, line_value,
+    max3, min3, plane_parts, plane_q, plane_value, point_q, ratio_to_f64, scale_of, sign_of, sub3,
+    to_grid, Bound, Powers, Ring, DOT, DOT2, DOT3, LAGRANGE, LAGRANGE2, LINE, PLANE, POINT, V,
 };
 use super::EdgeEdge as Ee;
 
@@ -258,13 +258,13 @@ impl Signs for Exact {
 }
 
 /// The exact context, built on the first sign the filter cannot certify.
-struct Lazy<'a> {
-    e: [&'a [f64; 3]; 4],
+struct Lazy {
+    e: [[f64; 3]; 4],
     d: f64,
     ex: Option<Box<Exact>>,
 }
 
-impl Lazy<'_> {
+impl Lazy {
     #[cold]
     #[inline(never)]
     fn sign(&mut self, q: Q) -> i8 {
@@ -275,7 +275,7 @@ impl Lazy<'_> {
     fn get(&mut self) -> &mut Exact {
         let ([a0, a1, b0, b1], d) = (self.e, self.d);
         self.ex
-            .get_or_insert_with(|| Box::new(Exact::new(a0, a1, b0, b1, d)))
+            .get_or_insert_with(|| Box::new(Exact::new(&a0, &a1, &b0, &b1, d)))
     }
 }
 
@@ -284,14 +284,14 @@ impl Lazy<'_> {
 
 /// The float classification of the uncertain case: each sign certified by its bound, else
 /// exact.
-struct Fast<'a> {
+struct Fast {
     l: Leaves<f64>,
     d: [f64; 5],
     pw: Powers,
-    lazy: Lazy<'a>,
+    lazy: Lazy,
 }
 
-impl Signs for Fast<'_> {
+impl Signs for Fast {
     #[inline(always)]
     fn sign(&mut self, q: Q) -> i8 {
         // Classification only (no `Q::Dist`): `dd` is not used.
@@ -324,17 +324,12 @@ fn value(l: &Leaves<f64>, n: &V<f64>, ty: Ee) -> Option<f64> {
 /// farther apart than `d` along an axis (exact: rounding is monotone and `d` is a float).
 /// PERF: plain comparisons, as in the point-triangle twin.
 #[inline(always)]
-fn extent(a0: &[f64; 3], a1: &[f64; 3], b0: &[f64; 3], b1: &[f64; 3], d: f64) -> (f64, bool) {
-    let mn = |a: f64, b: f64| if a < b { a } else { b };
-    let mx = |a: f64, b: f64| if a > b { a } else { b };
-    let mut m = 0.0f64;
-    let mut far = false;
-    for k in 0..3 {
-        let (alo, ahi) = (mn(a0[k], a1[k]), mx(a0[k], a1[k]));
-        let (blo, bhi) = (mn(b0[k], b1[k]), mx(b0[k], b1[k]));
-        far |= (blo - ahi > d) | (alo - bhi > d);
-        m = mx(m, mx(ahi, bhi) - mn(alo, blo));
-    }
+fn extent(e: [[f64; 3]; 4], d: f64) -> (f64, bool) {
+    let [a0, a1, b0, b1] = e;
+    let (alo, ahi) = (min3(&a0, &a1), max3(&a0, &a1));
+    let (blo, bhi) = (min3(&b0, &b1), max3(&b0, &b1));
+    let far = gap_exceeds(&blo, &ahi, d) | gap_exceeds(&alo, &bhi, d);
+    let m = hmax(&sub3(&max3(&ahi, &bhi), &min3(&alo, &blo)));
     (m, far)
 }
 
@@ -382,7 +377,7 @@ fn classify_certified(l: &Leaves<f64>, d: &[f64; 5], pw: &Powers) -> Option<Ee> 
 
 /// The float path for extents in the filter's range (see the point-triangle twin).
 #[inline(always)]
-fn fast(e: [&[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, Ee)> {
+fn fast(e: [[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, Ee)> {
     let [a0, a1, b0, b1] = e;
     // Scaling up by a power of two is exact.
     let sc = |v: V<f64>| if k == 0 { v } else { v.map(|x| ldexp(x, k)) };
@@ -393,9 +388,9 @@ fn fast(e: [&[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64,
     };
     let dd = ds * ds;
     let pw = Powers::new(if decide { ms.max(ds) } else { ms });
-    let u = sc(sub3(a1, a0));
-    let v = sc(sub3(b1, b0));
-    let r = sc(sub3(a0, b0));
+    let u = sc(sub3(&a1, &a0));
+    let v = sc(sub3(&b1, &b0));
+    let r = sc(sub3(&a0, &b0));
     let n = cross(&u, &v);
     let lines = if decide {
         // Early exit: the lines are farther apart than `d`.
@@ -411,9 +406,9 @@ fn fast(e: [&[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64,
         u,
         v,
         r,
-        r01: sc(sub3(a0, b1)),
-        r10: sc(sub3(a1, b0)),
-        r11: sc(sub3(a1, b1)),
+        r01: sc(sub3(&a0, &b1)),
+        r10: sc(sub3(&a1, &b0)),
+        r11: sc(sub3(&a1, &b1)),
     };
     let dots = l.dots();
     // A non-finite input makes `uu` or `vv` non-finite (u and v hold every input).
@@ -449,7 +444,7 @@ fn fast(e: [&[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64,
 /// [`classify`] with the float signs, exact where uncertain (cold: a near-tie).
 #[cold]
 #[inline(never)]
-fn classify_uncertain(l: &Leaves<f64>, dots: &[f64; 5], pw: Powers, e: [&[f64; 3]; 4]) -> Ee {
+fn classify_uncertain(l: &Leaves<f64>, dots: &[f64; 5], pw: Powers, e: [[f64; 3]; 4]) -> Ee {
     classify(&mut Fast {
         l: l.clone(),
         d: *dots,
@@ -465,29 +460,29 @@ fn classify_uncertain(l: &Leaves<f64>, dots: &[f64; 5], pw: Powers, e: [&[f64; 3
 /// The correctly rounded squared distance between the features of `ty` (cold).
 #[cold]
 #[inline(never)]
-fn exact_distance(e: [&[f64; 3]; 4], ty: Ee) -> f64 {
+fn exact_distance(e: [[f64; 3]; 4], ty: Ee) -> f64 {
     let [a0, a1, b0, b1] = e;
-    Exact::new(a0, a1, b0, b1, 0.0).distance(ty)
+    Exact::new(&a0, &a1, &b0, &b1, 0.0).distance(ty)
 }
 
 /// The exact sign of one quantity (cold: a near-tie).
 #[cold]
 #[inline(never)]
-fn exact_sign(e: [&[f64; 3]; 4], d: f64, q: Q) -> i8 {
+fn exact_sign(e: [[f64; 3]; 4], d: f64, q: Q) -> i8 {
     let [a0, a1, b0, b1] = e;
-    Exact::new(a0, a1, b0, b1, d).sign(q)
+    Exact::new(&a0, &a1, &b0, &b1, d).sign(q)
 }
 
 /// The exact path: extents beyond the filter's range, and non-finite input (`None`).
 #[cold]
 #[inline(never)]
-fn slow(e: [&[f64; 3]; 4], d: Option<f64>) -> Option<(f64, Ee)> {
+fn slow(e: [[f64; 3]; 4], d: Option<f64>) -> Option<(f64, Ee)> {
     let finite = e.iter().flat_map(|p| p.iter()).all(|x| x.is_finite());
     if !finite || d.is_some_and(|d| !d.is_finite()) {
         return None;
     }
     let [a0, a1, b0, b1] = e;
-    let mut ex = Exact::new(a0, a1, b0, b1, d.unwrap_or(0.0));
+    let mut ex = Exact::new(&a0, &a1, &b0, &b1, d.unwrap_or(0.0));
     let ty = classify(&mut ex);
     if d.is_some() && ex.sign(Q::Dist(ty)) > 0 {
         return None;
@@ -497,23 +492,16 @@ fn slow(e: [&[f64; 3]; 4], d: Option<f64>) -> Option<(f64, Ee)> {
 
 /// See [`super::edge_edge_within`].
 #[inline]
-pub(crate) fn within(
-    a0: &[f64; 3],
-    a1: &[f64; 3],
-    b0: &[f64; 3],
-    b1: &[f64; 3],
-    d: f64,
-) -> Option<(f64, Ee)> {
+pub(crate) fn within(e: [[f64; 3]; 4], d: f64) -> Option<(f64, Ee)> {
     if d.is_nan() || d < 0.0 {
         return None;
     }
-    let (m, far) = extent(a0, a1, b0, b1, d);
+    let (m, far) = extent(e, d);
     if far {
         return None;
     }
     // The distance is at most |a0 - b0| <= sqrt(3) m_exact < 2 m.
     let decide = d < 2.0 * m;
-    let e = [a0, a1, b0, b1];
     match scale_of(m) {
         Some(k) => fast(e, d, m, k, decide),
         None => slow(e, decide.then_some(d)),
@@ -522,16 +510,14 @@ pub(crate) fn within(
 
 /// See [`super::edge_edge_distance_sq`].
 #[inline]
-pub(crate) fn distance(a0: &[f64; 3], a1: &[f64; 3], b0: &[f64; 3], b1: &[f64; 3]) -> (f64, Ee) {
-    let (m, _) = extent(a0, a1, b0, b1, f64::INFINITY);
-    let e = [a0, a1, b0, b1];
+pub(crate) fn distance(e: [[f64; 3]; 4]) -> (f64, Ee) {
+    let (m, _) = extent(e, f64::INFINITY);
     match scale_of(m) {
         Some(k) => fast(e, 0.0, m, k, false),
         None => slow(e, None),
     }
     .unwrap_or((f64::NAN, Ee::Ea0Eb0))
 }
-
 #[cfg(test)]
 mod tests {
     use super::super::arith::count::Count;

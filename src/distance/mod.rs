@@ -188,7 +188,7 @@ impl EdgeEdge {
 /// the ties).
 #[inline]
 pub fn point_triangle_distance_sq(p: [f64; 3], t: [[f64; 3]; 3]) -> (f64, PointTriangle) {
-    point_triangle::distance(&p, &t)
+    point_triangle::distance(p, t)
 }
 
 /// Squared distance between the closed segments `[a0, a1]` and `[b0, b1]` (possibly of zero
@@ -200,7 +200,7 @@ pub fn edge_edge_distance_sq(
     b0: [f64; 3],
     b1: [f64; 3],
 ) -> (f64, EdgeEdge) {
-    edge_edge::distance(&a0, &a1, &b0, &b1)
+    edge_edge::distance([a0, a1, b0, b1])
 }
 
 /// `Some((distance_sq, type))` iff the distance between `p` and the closed triangle `t` is
@@ -213,7 +213,7 @@ pub fn point_triangle_within(
     t: [[f64; 3]; 3],
     d: f64,
 ) -> Option<(f64, PointTriangle)> {
-    point_triangle::within(&p, &t, d)
+    point_triangle::within(p, t, d)
 }
 
 /// `Some((distance_sq, type))` iff the distance between the closed segments `[a0, a1]` and
@@ -226,5 +226,5 @@ pub fn edge_edge_within(
     b1: [f64; 3],
     d: f64,
 ) -> Option<(f64, EdgeEdge)> {
-    edge_edge::within(&a0, &a1, &b0, &b1, d)
+    edge_edge::within([a0, a1, b0, b1], d)
 }

@@ -27,9 +27,9 @@
 use num_bigint::BigInt;
 
 use super::arith::{
-    certified, cross, dot, lagrange, ldexp, line_parts, line_q, line_value, plane_parts, plane_q,
-    plane_value, point_q, ratio_to_f64, scale_of, sign_of, sub3, to_grid, Bound, Powers, Ring, DOT,
-    DOT2, LAGRANGE, LINE, PLANE, POINT, V,
+    certified, cross, dot, gap_exceeds, hmax, lagrange, ldexp, line_parts, line_q, line_value,
+    max3, min3, plane_parts, plane_q, plane_value, point_q, ratio_to_f64, scale_of, sign_of, sub3,
+    to_grid, Bound, Powers, Ring, DOT, DOT2, LAGRANGE, LINE, PLANE, POINT, V,
 };
 use super::PointTriangle as Pt;
 
@@ -240,14 +240,14 @@ impl Signs for Exact {
 }
 
 /// The exact context, built on the first sign the filter cannot certify.
-struct Lazy<'a> {
-    p: &'a [f64; 3],
-    t: &'a [[f64; 3]; 3],
+struct Lazy {
+    p: [f64; 3],
+    t: [[f64; 3]; 3],
     d: f64,
     ex: Option<Box<Exact>>,
 }
 
-impl Lazy<'_> {
+impl Lazy {
     #[cold]
     #[inline(never)]
     fn sign(&mut self, q: Q) -> i8 {
@@ -257,7 +257,8 @@ impl Lazy<'_> {
     #[cold]
     fn get(&mut self) -> &mut Exact {
         let (p, t, d) = (self.p, self.t, self.d);
-        self.ex.get_or_insert_with(|| Box::new(Exact::new(p, t, d)))
+        self.ex
+            .get_or_insert_with(|| Box::new(Exact::new(&p, &t, d)))
     }
 }
 
@@ -266,14 +267,14 @@ impl Lazy<'_> {
 
 /// The float classification of the uncertain case: each sign certified by its bound, else
 /// exact.
-struct Fast<'a> {
+struct Fast {
     l: Leaves<f64>,
     d: [f64; 6],
     pw: Powers,
-    lazy: Lazy<'a>,
+    lazy: Lazy,
 }
 
-impl Signs for Fast<'_> {
+impl Signs for Fast {
     #[inline(always)]
     fn sign(&mut self, q: Q) -> i8 {
         // Classification only (no `Q::Dist`): `dd` is not used.
@@ -304,21 +305,14 @@ fn value(l: &Leaves<f64>, n: &V<f64>, ty: Pt) -> Option<f64> {
 
 /// The largest side of the box of the points (exact extents, rounded once), and whether a
 /// coordinate gap already exceeds `d` (`far`: decided exactly, since rounding is monotone and
-/// `d` is a float). PERF: plain comparisons (`minsd`), not `f64::min`'s NaN handling; a NaN
-/// input is caught later (see [`fast`]).
+/// `d` is a float). PERF: plain comparisons (`minsd`), not `f64::min`'s NaN handling, in
+/// whole vectors; a NaN input is caught later (see [`fast`]).
 #[inline(always)]
-fn extent(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64) -> (f64, bool) {
-    let mn = |a: f64, b: f64| if a < b { a } else { b };
-    let mx = |a: f64, b: f64| if a > b { a } else { b };
-    let mut m = 0.0f64;
-    let mut far = false;
-    for k in 0..3 {
-        let (a, b, c) = (t[0][k], t[1][k], t[2][k]);
-        let lo = mn(mn(a, b), c);
-        let hi = mx(mx(a, b), c);
-        far |= (lo - p[k] > d) | (p[k] - hi > d);
-        m = mx(m, mx(hi, p[k]) - mn(lo, p[k]));
-    }
+fn extent(p: [f64; 3], t: [[f64; 3]; 3], d: f64) -> (f64, bool) {
+    let lo = min3(&min3(&t[0], &t[1]), &t[2]);
+    let hi = max3(&max3(&t[0], &t[1]), &t[2]);
+    let far = gap_exceeds(&lo, &p, d) | gap_exceeds(&p, &hi, d);
+    let m = hmax(&sub3(&max3(&hi, &p), &min3(&lo, &p)));
     (m, far)
 }
 
@@ -360,14 +354,7 @@ fn classify_certified(l: &Leaves<f64>, d: &[f64; 6], pw: &Powers) -> Option<Pt> 
 /// `decide`: test the distance against `d` (else only classify and measure). `None`: not
 /// within `d`, or an input is not finite.
 #[inline(always)]
-fn fast(
-    p: &[f64; 3],
-    t: &[[f64; 3]; 3],
-    d: f64,
-    m: f64,
-    k: i32,
-    decide: bool,
-) -> Option<(f64, Pt)> {
+fn fast(p: [f64; 3], t: [[f64; 3]; 3], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, Pt)> {
     // Scaling up by a power of two is exact.
     let sc = |v: V<f64>| if k == 0 { v } else { v.map(|x| ldexp(x, k)) };
     let (ds, ms) = if k == 0 {
@@ -380,7 +367,7 @@ fn fast(
     // The plane test's leaves first (PERF: most far pairs leave there).
     let ab = sc(sub3(&t[1], &t[0]));
     let ac = sc(sub3(&t[2], &t[0]));
-    let ap = sc(sub3(p, &t[0]));
+    let ap = sc(sub3(&p, &t[0]));
     let n = cross(&ab, &ac);
     let plane = if decide {
         // Early exit: farther than `d` from the triangle's plane.
@@ -397,8 +384,8 @@ fn fast(
         ac,
         bc: sc(sub3(&t[2], &t[1])),
         ap,
-        bp: sc(sub3(p, &t[1])),
-        cp: sc(sub3(p, &t[2])),
+        bp: sc(sub3(&p, &t[1])),
+        cp: sc(sub3(&p, &t[2])),
     };
     let dots = l.dots();
     // A non-finite input makes some dot product non-finite (every input is in one).
@@ -438,8 +425,8 @@ fn classify_uncertain(
     l: &Leaves<f64>,
     dots: &[f64; 6],
     pw: Powers,
-    p: &[f64; 3],
-    t: &[[f64; 3]; 3],
+    p: [f64; 3],
+    t: [[f64; 3]; 3],
 ) -> Pt {
     classify(&mut Fast {
         l: l.clone(),
@@ -457,26 +444,26 @@ fn classify_uncertain(
 /// The correctly rounded squared distance to the feature `ty` (cold).
 #[cold]
 #[inline(never)]
-fn exact_distance(p: &[f64; 3], t: &[[f64; 3]; 3], ty: Pt) -> f64 {
-    Exact::new(p, t, 0.0).distance(ty)
+fn exact_distance(p: [f64; 3], t: [[f64; 3]; 3], ty: Pt) -> f64 {
+    Exact::new(&p, &t, 0.0).distance(ty)
 }
 
 /// The exact sign of one quantity (cold: a near-tie).
 #[cold]
 #[inline(never)]
-fn exact_sign(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64, q: Q) -> i8 {
-    Exact::new(p, t, d).sign(q)
+fn exact_sign(p: [f64; 3], t: [[f64; 3]; 3], d: f64, q: Q) -> i8 {
+    Exact::new(&p, &t, d).sign(q)
 }
 
 /// The exact path: extents beyond the filter's range, and non-finite input (`None`).
 #[cold]
 #[inline(never)]
-fn slow(p: &[f64; 3], t: &[[f64; 3]; 3], d: Option<f64>) -> Option<(f64, Pt)> {
+fn slow(p: [f64; 3], t: [[f64; 3]; 3], d: Option<f64>) -> Option<(f64, Pt)> {
     let finite = p.iter().chain(t.as_flattened()).all(|x| x.is_finite());
     if !finite || d.is_some_and(|d| !d.is_finite()) {
         return None;
     }
-    let mut ex = Exact::new(p, t, d.unwrap_or(0.0));
+    let mut ex = Exact::new(&p, &t, d.unwrap_or(0.0));
     let ty = classify(&mut ex);
     if d.is_some() && ex.sign(Q::Dist(ty)) > 0 {
         return None;
@@ -486,7 +473,7 @@ fn slow(p: &[f64; 3], t: &[[f64; 3]; 3], d: Option<f64>) -> Option<(f64, Pt)> {
 
 /// See [`super::point_triangle_within`].
 #[inline]
-pub(crate) fn within(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64) -> Option<(f64, Pt)> {
+pub(crate) fn within(p: [f64; 3], t: [[f64; 3]; 3], d: f64) -> Option<(f64, Pt)> {
     if d.is_nan() || d < 0.0 {
         return None;
     }
@@ -504,7 +491,7 @@ pub(crate) fn within(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64) -> Option<(f64, Pt
 
 /// See [`super::point_triangle_distance_sq`].
 #[inline]
-pub(crate) fn distance(p: &[f64; 3], t: &[[f64; 3]; 3]) -> (f64, Pt) {
+pub(crate) fn distance(p: [f64; 3], t: [[f64; 3]; 3]) -> (f64, Pt) {
     let (m, _) = extent(p, t, f64::INFINITY);
     match scale_of(m) {
         Some(k) => fast(p, t, 0.0, m, k, false),
