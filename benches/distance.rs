@@ -7,12 +7,14 @@
 //!
 //! - `far`: farther than `d` (what most culled candidates are);
 //! - `near`: farther than `d` by at most 10% (near misses: the filter works hardest);
-//! - `within`: at most `d` (the pairs a proximity query reports, value and type computed).
+//! - `within`: at most `d` (the pairs a proximity query reports, value and type computed);
+//! - `tie`: exact ties the float filter cannot decide (a point exactly above a triangle's
+//!   edge, parallel overlapping edges; integer coordinates), the exact fallback's cost.
 //!
 //! The points are stored once in a position array and each call gathers its 4 points by
 //! index, as a proximity query's inner loop does (`x[v]`, `x[t[0]]`, ...).
 //!
-//! Ids: `distance/{point_triangle,edge_edge}/{far,near,within}`, throughput in calls, so
+//! Ids: `distance/{point_triangle,edge_edge}/{far,near,within,tie}`, throughput in calls, so
 //! criterion prints the time per call. Run: `cargo bench --bench distance`.
 
 use std::hint::black_box;
@@ -114,6 +116,51 @@ fn edge_edge_sets() -> [Vec<[P; 4]>; 3] {
     sets
 }
 
+/// Exact ties, which the float filter cannot decide and the exact fallback does: a point
+/// exactly above an edge of an axis-aligned right triangle (integer coordinates), with `d`
+/// near its distance.
+fn point_triangle_ties() -> Vec<(P, [P; 3], f64)> {
+    let mut rng = Rng(0x1234_5678_9abc_def1);
+    let mut int = |lo: f64, hi: f64| rng.range(lo, hi).floor();
+    (0..N)
+        .map(|_| {
+            let (a, b) = (int(2.0, 100.0), int(2.0, 100.0));
+            let (x, h) = (int(1.0, a), int(1.0, 10.0));
+            let o = [int(-50.0, 50.0), int(-50.0, 50.0), int(-50.0, 50.0)];
+            let at = |v: P| [v[0] + o[0], v[1] + o[1], v[2] + o[2]];
+            let t = [at([0.0, 0.0, 0.0]), at([a, 0.0, 0.0]), at([0.0, b, 0.0])];
+            let d = h * int(5.0, 20.0) / 10.0;
+            (at([x, 0.0, h]), t, d)
+        })
+        .collect()
+}
+
+/// Exact ties for edges: parallel overlapping edges at an integer distance.
+fn edge_edge_ties() -> Vec<([P; 4], f64)> {
+    let mut rng = Rng(0x0fed_cba9_8765_4321);
+    let mut int = |lo: f64, hi: f64| rng.range(lo, hi).floor();
+    (0..N)
+        .map(|_| {
+            let (l, s, l2, h) = (
+                int(2.0, 50.0),
+                int(-20.0, 20.0),
+                int(2.0, 50.0),
+                int(1.0, 10.0),
+            );
+            let d = h * int(5.0, 20.0) / 10.0;
+            (
+                [
+                    [0.0, 0.0, 0.0],
+                    [l, 0.0, 0.0],
+                    [s, h, 0.0],
+                    [s + l2, h, 0.0],
+                ],
+                d,
+            )
+        })
+        .collect()
+}
+
 const NAMES: [&str; 3] = ["far", "near", "within"];
 
 /// A set of calls as a position array and the 4 point indices of each call.
@@ -154,6 +201,17 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    let ties = point_triangle_ties();
+    g.throughput(Throughput::Elements(ties.len() as u64));
+    g.bench_function("tie", |b| {
+        b.iter(|| {
+            let mut hits = 0usize;
+            for (p, t, d) in &ties {
+                hits += usize::from(point_triangle_within(*p, *t, black_box(*d)).is_some());
+            }
+            hits
+        })
+    });
     g.finish();
     let mut g = c.benchmark_group("distance/edge_edge");
     for (name, set) in NAMES.iter().zip(edge_edge_sets()) {
@@ -171,10 +229,27 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    let ties = edge_edge_ties();
+    g.throughput(Throughput::Elements(ties.len() as u64));
+    g.bench_function("tie", |b| {
+        b.iter(|| {
+            let mut hits = 0usize;
+            for ([a0, a1, b0, b1], d) in &ties {
+                hits += usize::from(edge_edge_within(*a0, *a1, *b0, *b1, black_box(*d)).is_some());
+            }
+            hits
+        })
+    });
     g.finish();
 }
 
 criterion_group!(benches, bench);
+
+/// The primitive out of line, to read its code (`objdump -d`, `pt_probe`).
+#[inline(never)]
+fn pt_probe(p: P, t: [P; 3], d: f64) -> Option<(f64, dhcd::distance::PointTriangle)> {
+    point_triangle_within(p, t, d)
+}
 
 /// `DISTANCE_CALLS=<set> <reps>` (e.g. `point_triangle/far 10`) runs the set's calls `reps`
 /// times and exits, for counting instructions under valgrind (`valgrind --tool=cachegrind
@@ -200,9 +275,7 @@ fn main() {
                 for &[i, a, b, c] in &calls.idx {
                     let x = &calls.x;
                     let t = [x[a as usize], x[b as usize], x[c as usize]];
-                    hits += usize::from(
-                        point_triangle_within(x[i as usize], t, black_box(D)).is_some(),
-                    );
+                    hits += usize::from(pt_probe(x[i as usize], t, black_box(D)).is_some());
                 }
             }
         } else {

@@ -522,6 +522,7 @@ pub(crate) fn distance(e: [[f64; 3]; 4]) -> (f64, Ee) {
 mod tests {
     use super::super::arith::count::Count;
     use super::*;
+    use proptest::prelude::*;
 
     #[test]
     fn bounds_fit_every_quantity() {
@@ -554,6 +555,65 @@ mod tests {
         for q in all {
             let shape = quantity(&l, &d, &dd, q);
             assert!(shape.fits(bound(q)), "{q:?}: {shape:?} vs {:?}", bound(q));
+        }
+    }
+
+    /// Inputs near every region boundary: small integers, nudged by an ulp, scaled.
+    fn nearly_tied() -> impl Strategy<Value = ([[f64; 3]; 4], f64)> {
+        (
+            prop::array::uniform4(prop::array::uniform3(-4i32..=4)),
+            prop::array::uniform4(prop::array::uniform3(-1i32..=1)),
+            -40i32..40,
+        )
+            .prop_map(|(pts, nudge, e)| {
+                let mut out = [[0.0; 3]; 4];
+                for i in 0..4 {
+                    for k in 0..3 {
+                        let x = f64::from(pts[i][k]) * 2f64.powi(e);
+                        out[i][k] = match nudge[i][k] {
+                            1 => x.next_up(),
+                            -1 => x.next_down(),
+                            _ => x,
+                        };
+                    }
+                }
+                (out, 2f64.powi(e))
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(20000))]
+
+        /// Every sign the filter certifies is the exact sign; so is every type the branch-free
+        /// classification returns, and every decision.
+        #[test]
+        fn certified_signs_are_exact((e, unit) in nearly_tied(), d in 0.0f64..6.0) {
+            let [a0, a1, b0, b1] = e;
+            let d = d * unit;
+            let (m, _) = extent(e, d);
+            prop_assume!(m > 0.0 && scale_of(m) == Some(0));
+            let l = Leaves::new(&a0, &a1, &b0, &b1);
+            let dots = l.dots();
+            let dd = d * d;
+            let pw = Powers::new(m.max(d));
+            let mut ex = Exact::new(&a0, &a1, &b0, &b1, d);
+            let mut all = vec![
+                Q::Ru, Q::Rv, Q::R01u, Q::R01v, Q::R10u, Q::R10v, Q::R11u, Q::R11v, Q::L0, Q::L1,
+                Q::M0, Q::M1,
+            ];
+            all.extend(Ee::ALL.map(Q::Dist));
+            for q in all {
+                if let Some(s) = certified(quantity(&l, &dots, &dd, q), pw.of(bound(q))) {
+                    prop_assert_eq!(s, ex.sign(q), "{:?}", q);
+                }
+            }
+            let exact = classify(&mut ex);
+            if let Some(ty) = classify_certified(&l, &dots, &pw) {
+                prop_assert_eq!(ty, exact);
+            }
+            prop_assert_eq!(classify_uncertain(&l, &dots, pw, e), exact);
+            let within = ex.sign(Q::Dist(exact)) <= 0;
+            prop_assert_eq!(super::within(e, d).map(|r| r.1), within.then_some(exact));
         }
     }
 }
