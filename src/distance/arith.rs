@@ -78,39 +78,75 @@ pub(crate) fn lagrange<R: Ring>(a: &R, b: &R, c: &R, d: &R) -> R {
     a.mul(b).sub(&c.mul(d))
 }
 
-/// Squared distance from a point to a corner, minus `dd = d^2`: `|r|^2 - dd`.
+/// A squared distance as the parts its decision and value are computed from.
+#[derive(Clone, Debug)]
+pub(crate) enum Parts<R> {
+    /// `|r|^2`, from a point to a corner.
+    Point(R),
+    /// `(N, E)`, `D = N / E`, from a point to a line.
+    Line(R, R),
+    /// `(s, nn)`, `D = s^2 / nn`, from a point to a plane.
+    Plane(R, R),
+}
+
+impl<R: Ring> Parts<R> {
+    /// `num - dd den`: nonpositive iff the distance is at most `d` (`den > 0`).
+    #[inline(always)]
+    pub(crate) fn q(&self, dd: &R) -> R {
+        match self {
+            Parts::Point(r2) => r2.sub(dd),
+            Parts::Line(n, e) => n.sub(&dd.mul(e)),
+            Parts::Plane(s, nn) => s.mul(s).sub(&dd.mul(nn)),
+        }
+    }
+}
+
+/// Squared distance from a point to a corner: `|r|^2`.
 #[inline(always)]
+pub(crate) fn point_parts<R: Ring>(r: &V<R>) -> Parts<R> {
+    Parts::Point(dot(r, r))
+}
+
+/// [`point_parts`]`(r).q(dd)` = `|r|^2 - dd` (the filter's bound is checked on it).
+#[cfg(test)]
 pub(crate) fn point_q<R: Ring>(r: &V<R>, dd: &R) -> R {
-    dot(r, r).sub(dd)
+    point_parts(r).q(dd)
 }
 
 /// The squared distance from a point to a line as `N / E`: `N = |e x w|^2`, `E = |e|^2`,
 /// for the line through `o` with direction `e` and `w = x - o`.
 #[inline(always)]
-pub(crate) fn line_parts<R: Ring>(e: &V<R>, w: &V<R>) -> (R, R) {
+pub(crate) fn line_parts<R: Ring>(e: &V<R>, w: &V<R>) -> Parts<R> {
     let c = cross(e, w);
-    (dot(&c, &c), dot(e, e))
+    Parts::Line(dot(&c, &c), dot(e, e))
 }
 
 /// `N - dd E`: nonpositive iff the line is within `d` (`E > 0`).
-#[inline(always)]
+#[cfg(test)]
 pub(crate) fn line_q<R: Ring>(e: &V<R>, w: &V<R>, dd: &R) -> R {
-    let (n, ee) = line_parts(e, w);
-    n.sub(&dd.mul(&ee))
+    line_parts(e, w).q(dd)
 }
 
 /// The squared distance from a point to a plane as `s^2 / nn`: `s = n . w`, `nn = |n|^2`,
 /// for the plane through `o` with normal `n` and `w = x - o`.
 #[inline(always)]
-pub(crate) fn plane_parts<R: Ring>(n: &V<R>, w: &V<R>) -> (R, R) {
-    (dot(n, w), dot(n, n))
+pub(crate) fn plane_parts<R: Ring>(n: &V<R>, w: &V<R>) -> Parts<R> {
+    Parts::Plane(dot(n, w), dot(n, n))
 }
 
 /// `s^2 - dd nn`: nonpositive iff the plane is within `d` (`nn > 0`).
 #[inline(always)]
 pub(crate) fn plane_q<R: Ring>(n: &V<R>, w: &V<R>, dd: &R) -> R {
-    let (s, nn) = plane_parts(n, w);
-    s.mul(&s).sub(&dd.mul(&nn))
+    plane_parts(n, w).q(dd)
+}
+
+/// The exact squared distance `num / den` of exact parts.
+pub(crate) fn exact_ratio(parts: Parts<BigInt>) -> (BigInt, BigInt) {
+    match parts {
+        Parts::Point(r2) => (r2, BigInt::from(1)),
+        Parts::Line(n, e) => (n, e),
+        Parts::Plane(s, nn) => (s.mul(&s), nn),
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -311,30 +347,32 @@ pub(crate) fn ldexp(mut x: f64, mut e: i32) -> f64 {
 /// nearly parallel edges take the exact value.
 pub(crate) const SLIVER: f64 = 1.0 / (1u64 << 40) as f64;
 
-/// `s (s / nn)` for `(s, nn) = plane_parts(x cross y, w)`, or `None` when the
-/// configuration is too thin for the float value ([`SLIVER`]) or a leaf too small
-/// ([`has_tiny`]).
+/// The float value of a squared distance from its parts: `|r|^2`, `N / E`, `s (s / nn)`
+/// (not `s^2 / nn`, so that `s^2` cannot underflow); `None` when the formula's accuracy is
+/// not assured: a leaf too small ([`has_tiny`]) among `leaves` (the ones the parts are made
+/// of), or for a plane a configuration too thin ([`SLIVER`]; `x, y` the two vectors whose
+/// cross product is the normal).
 #[inline(always)]
-pub(crate) fn plane_value(x: &V<f64>, y: &V<f64>, n: &V<f64>, w: &V<f64>) -> Option<f64> {
-    if has_tiny([x, y, w]) {
-        return None;
+pub(crate) fn float_value<const N: usize>(
+    parts: &Parts<f64>,
+    leaves: [&V<f64>; N],
+    sliver: Option<(&V<f64>, &V<f64>)>,
+) -> Option<f64> {
+    match *parts {
+        Parts::Point(r2) => Some(r2),
+        Parts::Line(n, e) => (!has_tiny(leaves)).then(|| n / e),
+        Parts::Plane(s, nn) => {
+            if has_tiny(leaves) {
+                return None;
+            }
+            if let Some((x, y)) = sliver {
+                if nn.is_nan() || nn <= SLIVER * (dot(x, x) * dot(y, y)) {
+                    return None;
+                }
+            }
+            Some(s * (s / nn))
+        }
     }
-    let (s, nn) = plane_parts(n, w);
-    if nn.is_nan() || nn <= SLIVER * (dot(x, x) * dot(y, y)) {
-        return None;
-    }
-    // s (s / nn), not s^2 / nn, so that s^2 cannot underflow.
-    Some(s * (s / nn))
-}
-
-/// `|e x w|^2 / |e|^2`, or `None` when a leaf is too small ([`has_tiny`]).
-#[inline(always)]
-pub(crate) fn line_value(e: &V<f64>, w: &V<f64>) -> Option<f64> {
-    if has_tiny([e, w]) {
-        return None;
-    }
-    let (num, den) = line_parts(e, w);
-    Some(num / den)
 }
 
 /// Whether a value formula over these leaf components could underflow (some component is

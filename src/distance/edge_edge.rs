@@ -28,9 +28,10 @@
 use num_bigint::BigInt;
 
 use super::arith::{
-    certified, cross, dot, gap_exceeds, hmax, lagrange, ldexp, line_parts, line_q, line_value,
-    max3, min3, plane_parts, plane_q, plane_value, point_q, ratio_to_f64, scale_of, sign_of, sub3,
-    to_grid, Bound, Powers, Ring, DOT, DOT2, DOT3, LAGRANGE, LAGRANGE2, LINE, PLANE, POINT, V,
+    certified, cross, dot, exact_ratio, float_value, gap_exceeds, hmax, lagrange, ldexp,
+    line_parts, max3, min3, plane_parts, plane_q, point_parts, ratio_to_f64, scale_of, sign_of,
+    sub3, to_grid, Bound, Parts, Powers, Ring, DOT, DOT2, DOT3, LAGRANGE, LAGRANGE2, LINE, PLANE,
+    POINT, V,
 };
 use super::EdgeEdge as Ee;
 
@@ -149,14 +150,21 @@ fn quantity<R: Ring>(l: &Leaves<R>, d: &[R; 5], dd: &R, q: Q) -> R {
         Q::L1 => lagrange(uu, &rv.sub(vv), uv, &ru.sub(uv)),
         Q::M0 => lagrange(vv, ru, uv, rv),
         Q::M1 => lagrange(vv, &ru.add(uu), uv, &rv.add(uv)),
-        Q::Dist(ty @ (Ee::Ea0Eb0 | Ee::Ea0Eb1 | Ee::Ea1Eb0 | Ee::Ea1Eb1)) => {
-            point_q(l.corners(ty), dd)
-        }
-        Q::Dist(ty @ (Ee::EaEb0 | Ee::EaEb1 | Ee::Ea0Eb | Ee::Ea1Eb)) => {
+        Q::Dist(ty) => parts(l, ty).q(dd),
+    }
+}
+
+/// The squared distance between the features of `ty` as [`Parts`] (see the point-triangle
+/// twin).
+#[inline(always)]
+fn parts<R: Ring>(l: &Leaves<R>, ty: Ee) -> Parts<R> {
+    match ty {
+        Ee::Ea0Eb0 | Ee::Ea0Eb1 | Ee::Ea1Eb0 | Ee::Ea1Eb1 => point_parts(l.corners(ty)),
+        Ee::EaEb0 | Ee::EaEb1 | Ee::Ea0Eb | Ee::Ea1Eb => {
             let (e, w) = l.corner_edge(ty);
-            line_q(e, w, dd)
+            line_parts(e, w)
         }
-        Q::Dist(Ee::EaEb) => plane_q(&cross(&l.u, &l.v), &l.r, dd),
+        Ee::EaEb => plane_parts(&cross(&l.u, &l.v), &l.r),
     }
 }
 
@@ -228,21 +236,7 @@ impl Exact {
     /// The squared distance between the features of `ty` (the closest ones), correctly
     /// rounded.
     pub(crate) fn distance(&self, ty: Ee) -> f64 {
-        let l = &self.l;
-        let (num, den) = match ty {
-            Ee::Ea0Eb0 | Ee::Ea0Eb1 | Ee::Ea1Eb0 | Ee::Ea1Eb1 => {
-                let r = l.corners(ty);
-                (dot(r, r), BigInt::from(1))
-            }
-            Ee::EaEb0 | Ee::EaEb1 | Ee::Ea0Eb | Ee::Ea1Eb => {
-                let (e, w) = l.corner_edge(ty);
-                line_parts(e, w)
-            }
-            Ee::EaEb => {
-                let (s, nn) = plane_parts(&cross(&l.u, &l.v), &l.r);
-                (s.mul(&s), nn)
-            }
-        };
+        let (num, den) = exact_ratio(parts(&self.l, ty));
         ratio_to_f64(&num, &den, 2 * i64::from(self.unit))
     }
 }
@@ -303,20 +297,17 @@ impl Signs for Fast {
     }
 }
 
-/// The float value of the squared distance between the features of `ty`, or `None` when
-/// the formula's accuracy is not assured (see [`plane_value`], [`line_value`]).
+/// The float value of the squared distance between the features of `ty`, from its parts,
+/// or `None` when the formula's accuracy is not assured (see [`float_value`]).
 #[inline(always)]
-fn value(l: &Leaves<f64>, n: &V<f64>, ty: Ee) -> Option<f64> {
+fn value(l: &Leaves<f64>, parts: &Parts<f64>, ty: Ee) -> Option<f64> {
     match ty {
-        Ee::Ea0Eb0 | Ee::Ea0Eb1 | Ee::Ea1Eb0 | Ee::Ea1Eb1 => {
-            let r = l.corners(ty);
-            Some(dot(r, r))
-        }
+        Ee::Ea0Eb0 | Ee::Ea0Eb1 | Ee::Ea1Eb0 | Ee::Ea1Eb1 => float_value(parts, [], None),
         Ee::EaEb0 | Ee::EaEb1 | Ee::Ea0Eb | Ee::Ea1Eb => {
             let (e, w) = l.corner_edge(ty);
-            line_value(e, w)
+            float_value(parts, [e, w], None)
         }
-        Ee::EaEb => plane_value(&l.u, &l.v, n, &l.r),
+        Ee::EaEb => float_value(parts, [&l.u, &l.v, &l.r], Some((&l.u, &l.v))),
     }
 }
 
@@ -419,11 +410,12 @@ fn fast(e: [[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, 
         Some(ty) => ty,
         None => classify_uncertain(&l, &dots, pw, e),
     };
+    let parts = parts(&l, ty);
     if decide {
         let q = Q::Dist(ty);
         let v = match ty {
             Ee::EaEb => lines,
-            _ => quantity(&l, &dots, &dd, q),
+            _ => parts.q(&dd),
         };
         let s = match certified(v, pw.of(bound(q))) {
             Some(s) => s,
@@ -433,7 +425,7 @@ fn fast(e: [[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, 
             return None;
         }
     }
-    let v = match value(&l, &n, ty) {
+    let v = match value(&l, &parts, ty) {
         Some(v) if k == 0 => v,
         Some(v) => ldexp(v, -2 * k),
         None => exact_distance(e, ty),

@@ -27,9 +27,9 @@
 use num_bigint::BigInt;
 
 use super::arith::{
-    certified, cross, dot, gap_exceeds, hmax, lagrange, ldexp, line_parts, line_q, line_value,
-    max3, min3, plane_parts, plane_q, plane_value, point_q, ratio_to_f64, scale_of, sign_of, sub3,
-    to_grid, Bound, Powers, Ring, DOT, DOT2, LAGRANGE, LINE, PLANE, POINT, V,
+    certified, cross, dot, exact_ratio, float_value, gap_exceeds, hmax, lagrange, ldexp,
+    line_parts, max3, min3, plane_parts, plane_q, point_parts, ratio_to_f64, scale_of, sign_of,
+    sub3, to_grid, Bound, Parts, Powers, Ring, DOT, DOT2, LAGRANGE, LINE, PLANE, POINT, V,
 };
 use super::PointTriangle as Pt;
 
@@ -137,12 +137,21 @@ fn quantity<R: Ring>(l: &Leaves<R>, d: &[R; 6], dd: &R, q: Q) -> R {
         Q::Va => lagrange(d3, d6, d5, d4),
         Q::Vb => lagrange(d5, d2, d1, d6),
         Q::Vc => lagrange(d1, d4, d3, d2),
-        Q::Dist(ty @ (Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2)) => point_q(l.corner(ty), dd),
-        Q::Dist(ty @ (Pt::Edge0 | Pt::Edge1 | Pt::Edge2)) => {
+        Q::Dist(ty) => parts(l, ty).q(dd),
+    }
+}
+
+/// The squared distance to the feature `ty` as [`Parts`] (a [`point_parts`], [`line_parts`]
+/// or [`plane_parts`]: their `q` is [`point_q`], [`line_q`], [`plane_q`]).
+#[inline(always)]
+fn parts<R: Ring>(l: &Leaves<R>, ty: Pt) -> Parts<R> {
+    match ty {
+        Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2 => point_parts(l.corner(ty)),
+        Pt::Edge0 | Pt::Edge1 | Pt::Edge2 => {
             let (e, w) = l.edge(ty);
-            line_q(e, w, dd)
+            line_parts(e, w)
         }
-        Q::Dist(Pt::Face) => plane_q(&cross(&l.ab, &l.ac), &l.ap, dd),
+        Pt::Face => plane_parts(&cross(&l.ab, &l.ac), &l.ap),
     }
 }
 
@@ -208,21 +217,7 @@ impl Exact {
 
     /// The squared distance to the feature `ty` (the closest one), correctly rounded.
     pub(crate) fn distance(&self, ty: Pt) -> f64 {
-        let l = &self.l;
-        let (num, den) = match ty {
-            Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2 => {
-                let r = l.corner(ty);
-                (dot(r, r), BigInt::from(1))
-            }
-            Pt::Edge0 | Pt::Edge1 | Pt::Edge2 => {
-                let (e, w) = l.edge(ty);
-                line_parts(e, w)
-            }
-            Pt::Face => {
-                let (s, nn) = plane_parts(&cross(&l.ab, &l.ac), &l.ap);
-                (s.mul(&s), nn)
-            }
-        };
+        let (num, den) = exact_ratio(parts(&self.l, ty));
         ratio_to_f64(&num, &den, 2 * i64::from(self.unit))
     }
 }
@@ -286,20 +281,18 @@ impl Signs for Fast {
     }
 }
 
-/// The float value of the squared distance to the feature `ty` (unscaled by the caller), or
-/// `None` when the formula's accuracy is not assured (see [`plane_value`], [`line_value`]).
+/// The float value of the squared distance to the feature `ty`, from its parts (unscaled
+/// by the caller), or `None` when the formula's accuracy is not assured (see
+/// [`float_value`]).
 #[inline(always)]
-fn value(l: &Leaves<f64>, n: &V<f64>, ty: Pt) -> Option<f64> {
+fn value(l: &Leaves<f64>, parts: &Parts<f64>, ty: Pt) -> Option<f64> {
     match ty {
-        Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2 => {
-            let r = l.corner(ty);
-            Some(dot(r, r))
-        }
+        Pt::Vertex0 | Pt::Vertex1 | Pt::Vertex2 => float_value(parts, [], None),
         Pt::Edge0 | Pt::Edge1 | Pt::Edge2 => {
             let (e, w) = l.edge(ty);
-            line_value(e, w)
+            float_value(parts, [e, w], None)
         }
-        Pt::Face => plane_value(&l.ab, &l.ac, n, &l.ap),
+        Pt::Face => float_value(parts, [&l.ab, &l.ac, &l.ap], Some((&l.ab, &l.ac))),
     }
 }
 
@@ -396,11 +389,12 @@ fn fast(p: [f64; 3], t: [[f64; 3]; 3], d: f64, m: f64, k: i32, decide: bool) -> 
         Some(ty) => ty,
         None => classify_uncertain(&l, &dots, pw, p, t),
     };
+    let parts = parts(&l, ty);
     if decide {
         let q = Q::Dist(ty);
         let v = match ty {
             Pt::Face => plane,
-            _ => quantity(&l, &dots, &dd, q),
+            _ => parts.q(&dd),
         };
         let s = match certified(v, pw.of(bound(q))) {
             Some(s) => s,
@@ -410,7 +404,7 @@ fn fast(p: [f64; 3], t: [[f64; 3]; 3], d: f64, m: f64, k: i32, decide: bool) -> 
             return None;
         }
     }
-    let v = match value(&l, &n, ty) {
+    let v = match value(&l, &parts, ty) {
         Some(v) if k == 0 => v,
         Some(v) => ldexp(v, -2 * k),
         None => exact_distance(p, t, ty),
