@@ -461,6 +461,55 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(20000))]
+
+    /// Scaling every coordinate and `d` by a power of two (exact) keeps the decision and the
+    /// type, and scales the value by its square when nothing underflows: the scaled (tiny
+    /// extents), filtered and exact (huge extents) paths agree. No oracle needed, so many
+    /// more cases.
+    #[test]
+    fn power_of_two_scaling_is_invariant(
+        pts in prop::array::uniform4(prop::array::uniform3(prop_oneof![
+            3 => (-6i32..=6).prop_map(f64::from),
+            2 => -8.0f64..8.0,
+        ])),
+        d in 0.0f64..6.0,
+        k in prop_oneof![-1000i32..-900, -300i32..300, 900i32..960],
+    ) {
+        let s = 2f64.powi(k / 2) * 2f64.powi(k - k / 2);
+        let scaled = pts.map(|p| p.map(|x| x * s));
+        prop_assume!(finite(&scaled) && scaled.iter().flatten().zip(pts.iter().flatten()).all(|(a, b)| a / s == *b));
+        let ds = d * s;
+        prop_assume!(ds.is_finite() && ds / s == d);
+        let [p, a, b, c] = pts;
+        let [ps, as_, bs, cs] = scaled;
+        let (v, ty) = point_triangle_distance_sq(p, [a, b, c]);
+        let (vs, tys) = point_triangle_distance_sq(ps, [as_, bs, cs]);
+        prop_assert_eq!(ty, tys);
+        prop_assert_eq!(
+            point_triangle_within(p, [a, b, c], d).is_some(),
+            point_triangle_within(ps, [as_, bs, cs], ds).is_some()
+        );
+        // Values: equal up to the bound's slack (different paths may round differently).
+        let expect = v * s * s;
+        if expect.is_normal() && vs.is_normal() {
+            prop_assert!((vs - expect).abs() <= 1e-9 * expect.max(vs) + 1e-12 * s * s, "{} vs {}", vs, expect);
+        }
+        let (v, ty) = edge_edge_distance_sq(p, a, b, c);
+        let (vs, tys) = edge_edge_distance_sq(ps, as_, bs, cs);
+        prop_assert_eq!(ty, tys);
+        prop_assert_eq!(
+            edge_edge_within(p, a, b, c, d).is_some(),
+            edge_edge_within(ps, as_, bs, cs, ds).is_some()
+        );
+        let expect = v * s * s;
+        if expect.is_normal() && vs.is_normal() {
+            prop_assert!((vs - expect).abs() <= 1e-9 * expect.max(vs) + 1e-12 * s * s, "{} vs {}", vs, expect);
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Distances equal to d to the last bit, and one ulp either side.
 // ---------------------------------------------------------------------------------------

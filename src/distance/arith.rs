@@ -165,11 +165,12 @@ pub(crate) fn exact_ratio(parts: Parts<BigInt>) -> (BigInt, BigInt) {
 /// `(1 + theta_depth)`, `|theta_k| <= gamma_k = k eps / (1 - k eps)`), and `P <= terms *
 /// M^degree`. [`Bound::factor`] is `((depth + 1) terms + 1) eps`, above `gamma_depth terms`
 /// with room for the roundings of `M^degree` and of the product, and for the `M` being the
-/// rounded extent (`M >= M_exact (1 - eps)`). Underflow is handled by [`crate::distance`]'s
-/// range (see the module doc): there the leaves' magnitudes and `M` lie in
-/// `[0, 2^62]` and `M >= 2^-61`, a product that underflows adds at most `2^-1075`, whose
-/// propagation through the rest of any formula here stays below `2^-700`, far below the
-/// bound's slack `eps M^degree >= 2^-53 2^-61*8`.
+/// rounded extent (`M >= M_exact (1 - eps)`). Overflow and underflow: the filter runs only
+/// with `2^-60 <= M <= 2^61` (after an exact scaling, see [`scale_of`]) and every leaf at most
+/// `M`, so no value overflows (degree <= 6: below `48 * 2^366`), and a product that
+/// underflows adds at most `2^-1075` absolute, which the rest of a formula multiplies by at
+/// most about `2^260`: below `2^-800` in all, while the constant's slack (the `+ 1` and the
+/// `depth + 1`) is at least `eps M^degree >= 2^-413`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Bound {
     pub(crate) degree: u32,
