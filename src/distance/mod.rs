@@ -95,7 +95,7 @@
 //! - Exact ties and near-ties (a point on an edge's line or on a region boundary, parallel
 //!   edges whose closest pair involves an edge's interior, coplanar features with `d = 0`,
 //!   zero-length edges, degenerate triangles, a distance equal to `d` to about `1e-13`
-//!   relative) reach the exact fallback: about 1.5 microseconds a call on small integer
+//!   relative) reach the exact fallback: 1-2 microseconds a call on small integer
 //!   coordinates (`tie` in the bench), more for coordinates spread over many binades.
 //! - Extents above `2^60` (about `1.15e18`) are always exact and slow; no input is rejected,
 //!   so there is no range check to call.
