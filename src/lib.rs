@@ -30,6 +30,7 @@ pub mod any;
 pub mod bv;
 pub mod counters;
 pub mod detail;
+pub mod distance;
 pub mod error;
 pub mod hierarchy;
 pub mod io;

@@ -2,6 +2,7 @@
 //! suites live in `cli/tests/`, the C ABI's in `capi/tests/`.)
 
 mod central;
+mod distance;
 mod fixtures;
 mod fuzz;
 mod hierarchies;
