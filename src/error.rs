@@ -67,6 +67,9 @@ pub enum Error {
     UnknownCentral(String),
     #[error("unknown precision {0:?} (expected f32 or f64)")]
     UnknownPrecision(String),
+    /// A query distance that is negative, NaN or infinite.
+    #[error("distance {0} is not a finite number >= 0")]
+    InvalidDistance(f64),
     /// A node id (e.g. given to `refit_nodes`) beyond the hierarchy's nodes.
     #[error("node {node} out of range (the hierarchy has {node_count} nodes)")]
     NodeOutOfRange { node: u32, node_count: usize },

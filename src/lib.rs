@@ -55,8 +55,9 @@ pub use par::Par;
 pub use scene::{ObjectId, Scene, SceneContacts};
 
 pub use query::{
-    broad_phase, collide, collide_with, narrow_phase, self_broad_phase, self_collide,
-    self_collide_with, BroadPhase, Contacts,
+    broad_phase, collide, collide_with, narrow_phase, proximity, proximity_with, self_broad_phase,
+    self_collide, self_collide_with, self_proximity, self_proximity_with, BroadPhase, Contacts,
+    Proximity,
 };
 pub use tree::RegionTree;
 pub use walk::{Workspace, DEFAULT_GRAIN};

@@ -12,6 +12,7 @@ mod memory;
 mod mutation;
 mod narrow;
 mod precision;
+mod proximity;
 mod real_frames;
 mod scene;
 mod self_collision;

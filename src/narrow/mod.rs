@@ -29,7 +29,9 @@ mod oracle;
 mod predicates;
 mod tritri;
 
-pub use oracle::{brute_force_pairs, brute_force_self_pairs};
+pub use oracle::{
+    brute_force_pairs, brute_force_proximity, brute_force_self_pairs, brute_force_self_proximity,
+};
 
 /// Whether the closed triangles share at least one point, decided exactly for the f32 inputs.
 #[inline]

@@ -96,3 +96,128 @@ fn self_pairs<C: Coordinate>(m: &Mesh, t: &Tris<C>) -> Vec<[u32; 2]> {
     }
     out
 }
+
+/// Brute-force proximity oracle: every vertex of `a` against every triangle of `b` and the
+/// other way, and every unique edge of `a` against every unique edge of `b`, through the
+/// exact tests of [`crate::distance`] at distance `d`; in the order and form of
+/// [`crate::query::proximity`]'s result (vertices and edges of triangles only; `counters`
+/// zero but `contacts`). `O(|a| |b|)`.
+pub fn brute_force_proximity(a: &Mesh, b: &Mesh, d: f64) -> crate::query::Proximity {
+    use crate::distance::{edge_edge_within, point_triangle_within};
+    use crate::query::{EdgePair, FaceVertex, Proximity, VertexFace};
+    let (pa, pb) = (a.to_f64_positions(), b.to_f64_positions());
+    let mut out = Proximity::default();
+    let tri = |m: &Mesh, p: &[[f64; 3]], t: usize| m.triangles()[t].map(|v| p[v as usize]);
+    for v in used_vertices(a) {
+        for t in 0..b.triangle_count() {
+            if let Some((d2, kind)) = point_triangle_within(pa[v as usize], tri(b, &pb, t), d) {
+                out.vertex_face.push(VertexFace {
+                    vertex: v,
+                    triangle: t as u32,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    for t in 0..a.triangle_count() {
+        for v in used_vertices(b) {
+            if let Some((d2, kind)) = point_triangle_within(pb[v as usize], tri(a, &pa, t), d) {
+                out.face_vertex.push(FaceVertex {
+                    triangle: t as u32,
+                    vertex: v,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    out.face_vertex
+        .sort_unstable_by_key(|x| (x.triangle, x.vertex));
+    for ea in unique_edges(a) {
+        for eb in unique_edges(b) {
+            let (p, q) = (ea.map(|v| pa[v as usize]), eb.map(|v| pb[v as usize]));
+            if let Some((d2, kind)) = edge_edge_within(p[0], p[1], q[0], q[1], d) {
+                out.edge_edge.push(EdgePair {
+                    a: ea,
+                    b: eb,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    out.counters.contacts =
+        (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
+    out
+}
+
+/// Brute-force self-proximity oracle: every vertex against every triangle not containing
+/// it, every pair of unique edges sharing no vertex (`a < b`), as
+/// [`crate::query::self_proximity`] reports them. `O(n^2)`.
+pub fn brute_force_self_proximity(m: &Mesh, d: f64) -> crate::query::Proximity {
+    use crate::distance::{edge_edge_within, point_triangle_within};
+    use crate::query::{EdgePair, Proximity, VertexFace};
+    let p = m.to_f64_positions();
+    let mut out = Proximity::default();
+    for v in used_vertices(m) {
+        for (t, corners) in m.triangles().iter().enumerate() {
+            if corners.contains(&v) {
+                continue;
+            }
+            let tri = corners.map(|c| p[c as usize]);
+            if let Some((d2, kind)) = point_triangle_within(p[v as usize], tri, d) {
+                out.vertex_face.push(VertexFace {
+                    vertex: v,
+                    triangle: t as u32,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    let edges = unique_edges(m);
+    for (i, ea) in edges.iter().enumerate() {
+        for eb in &edges[i + 1..] {
+            if ea.iter().any(|v| eb.contains(v)) {
+                continue;
+            }
+            let (x, y) = (ea.map(|v| p[v as usize]), eb.map(|v| p[v as usize]));
+            if let Some((d2, kind)) = edge_edge_within(x[0], x[1], y[0], y[1], d) {
+                out.edge_edge.push(EdgePair {
+                    a: *ea,
+                    b: *eb,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    out.counters.contacts = (out.vertex_face.len() + out.edge_edge.len()) as u64;
+    out
+}
+
+/// The vertices some triangle uses, ascending.
+fn used_vertices(m: &Mesh) -> Vec<u32> {
+    let mut used = vec![false; m.vertex_count()];
+    for t in m.triangles() {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    (0..m.vertex_count() as u32)
+        .filter(|&v| used[v as usize])
+        .collect()
+}
+
+/// The unique edges of the triangles, each as its vertices smaller first, ascending.
+fn unique_edges(m: &Mesh) -> Vec<[u32; 2]> {
+    let mut e: Vec<[u32; 2]> = m
+        .triangles()
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])]))
+        .collect();
+    e.sort_unstable();
+    e.dedup();
+    e
+}

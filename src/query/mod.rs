@@ -1,18 +1,25 @@
 //! The queries: each one is an implementation of the walk engine's [`Query`] (a node test and
 //! a leaf action), with its public entry points.
 //!
-//! - [`contacts`](self::contacts): exact intersecting triangle pairs ([`collide`],
-//!   [`self_collide`]), and the split of that query into [`broad_phase`] (overlapping leaf
-//!   pairs) and [`narrow_phase`] for calibration and benchmarks.
+//! - `contacts.rs`: exact intersecting triangle pairs ([`collide`], [`self_collide`]), and
+//!   the split of that query into [`broad_phase`] (overlapping leaf pairs) and
+//!   [`narrow_phase`] for calibration and benchmarks;
+//! - `proximity.rs`: every vertex-triangle and edge-edge pair within a distance
+//!   ([`proximity`], [`self_proximity`]), with distances and closest sub-features.
 //!
 //! Queries on the current pose share [`Posed`]: two hierarchies' lazily fitted volumes and a
 //! node test ([`Overlap`], or [`Within`] a distance); they differ in the leaf action.
 
 pub(crate) mod contacts;
+pub(crate) mod proximity;
 
 pub use contacts::{
     broad_phase, collide, collide_with, narrow_phase, self_broad_phase, self_collide,
     self_collide_with, BroadPhase, Contacts,
+};
+pub use proximity::{
+    proximity, proximity_with, self_proximity, self_proximity_with, EdgePair, FaceVertex,
+    Proximity, VertexFace,
 };
 
 use pulp::Simd;
@@ -56,12 +63,10 @@ impl NodeTest for Overlap {
 /// The volumes come within a distance: `margin`, an `f32` at least the query's distance
 /// (rounded up), by which entry `i`'s volume is grown ([`BvKind::test_within`]).
 #[derive(Clone, Copy, Debug)]
-#[allow(dead_code)] // the proximity query's node test
 pub(crate) struct Within {
     pub(crate) margin: f32,
 }
 
-#[allow(dead_code)]
 impl Within {
     /// The test for distance `d` (finite, `>= 0`): the least `f32` not below `d`.
     pub(crate) fn distance(d: f64) -> Self {
