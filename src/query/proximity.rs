@@ -231,10 +231,8 @@ fn grown(b: &Bounds, m: f32) -> Bounds {
 fn points_box<const N: usize>(p: [[f32; 3]; N], rounded: bool) -> Bounds {
     let mut b = (p[0], p[0]);
     for q in &p[1..] {
-        for k in 0..3 {
-            b.0[k] = b.0[k].min(q[k]);
-            b.1[k] = b.1[k].max(q[k]);
-        }
+        b.0 = std::array::from_fn(|k| b.0[k].min(q[k]));
+        b.1 = std::array::from_fn(|k| b.1[k].max(q[k]));
     }
     if rounded {
         (b.0.map(f32::next_down), b.1.map(f32::next_up))
