@@ -10,8 +10,8 @@ use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
 use crate::mesh::{Mesh, Precision};
 use crate::par::Par;
 use crate::query::{
-    broad_phase, collide_with, narrow_phase, self_broad_phase, self_collide_with, BroadPhase,
-    Contacts,
+    broad_phase, collide_with, narrow_phase, proximity_with, self_broad_phase, self_collide_with,
+    self_proximity_with, BroadPhase, Contacts, Proximity,
 };
 use crate::tree::RegionTree;
 use crate::walk::Workspace;
@@ -97,6 +97,24 @@ impl AnyHierarchy {
     /// Self-contacts of this object (see [`self_collide`](crate::self_collide())).
     pub fn self_collide(&self, ws: &mut Workspace, par: Par) -> Contacts {
         each!(self, h => self_collide_with(h, ws, par))
+    }
+
+    /// Feature pairs within `d` between two hierarchies of the same kind (see
+    /// [`proximity`](crate::proximity())); an error if the kinds differ or `d` is invalid.
+    pub fn proximity(
+        &self,
+        other: &AnyHierarchy,
+        d: f64,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<Proximity> {
+        pairwise!(self, other, a, b => proximity_with(a, b, d, ws, par)?)
+    }
+
+    /// Feature pairs within `d` of this object (see
+    /// [`self_proximity`](crate::self_proximity())).
+    pub fn self_proximity(&self, d: f64, ws: &mut Workspace, par: Par) -> Result<Proximity> {
+        each!(self, h => self_proximity_with(h, d, ws, par))
     }
 
     /// Intersection segments of contacts between `self` and `other` (see

@@ -52,7 +52,7 @@ pub use error::{Error, Result};
 pub use hierarchy::{CentralVertex, Hierarchy, InvariantError, Options, Refit};
 pub use mesh::{Mesh, Precision};
 pub use par::Par;
-pub use scene::{ObjectId, Scene, SceneContacts};
+pub use scene::{ObjectId, PairProximity, Scene, SceneContacts, SceneProximity};
 
 pub use query::{
     broad_phase, collide, collide_with, narrow_phase, proximity, proximity_with, self_broad_phase,

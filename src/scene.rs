@@ -30,7 +30,8 @@ use crate::kinds::{kinds, match_kind, with_kind};
 use crate::mesh::{check_positions, Mesh, Precision};
 use crate::par::Par;
 use crate::query::contacts::contacts;
-use crate::query::{Contacts, Overlap, Posed};
+use crate::query::proximity::{self, check_distance};
+use crate::query::{Contacts, Overlap, Posed, Proximity, Within};
 use crate::walk::Workspace;
 
 /// Identifies an object of a [`Scene`]. Ids are handed out in increasing order from 0 and
@@ -65,6 +66,28 @@ pub struct SceneContacts {
     /// BV work and are not listed.
     pub per_pair: Vec<PairCounters>,
     /// Sum of `per_pair`.
+    pub counters: Counters,
+    /// Object pairs whose root boxes were compared in the broad phase.
+    pub broad_phase_tests: u64,
+}
+
+/// The proximity of one object pair that passed the broad phase (`a < b`: vertices and
+/// edges of `a` first, see [`Proximity`]), or of one object with itself (`a == b`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairProximity {
+    pub a: ObjectId,
+    pub b: ObjectId,
+    /// Each object's original vertex, triangle and edge indices.
+    pub proximity: Proximity,
+}
+
+/// Result of [`Scene::proximity`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneProximity {
+    /// Every object pair whose root boxes came within the distance (and every object with
+    /// self-collision on), sorted by `(a, b)`, each with its pairs and counters.
+    pub per_pair: Vec<PairProximity>,
+    /// Sum of the pairs' counters.
     pub counters: Counters,
     /// Object pairs whose root boxes were compared in the broad phase.
     pub broad_phase_tests: u64,
@@ -303,6 +326,16 @@ impl Scene {
         each!(&mut self.objects, v => par.install(|| contacts_of(v, par.is_parallel())))
     }
 
+    /// Every vertex-triangle and edge-edge pair within distance `d` (finite, `>= 0`, else
+    /// [`Error::InvalidDistance`]) between every two objects whose root boxes come within
+    /// `d`, and inside every object with self-collision on ([`crate::self_proximity`]). The
+    /// result does not depend on `par`; refits are credited as in [`Scene::contacts`].
+    pub fn proximity(&mut self, d: f64, par: Par) -> Result<SceneProximity> {
+        check_distance(d)?;
+        let parallel = par.is_parallel();
+        Ok(each!(&mut self.objects, v => par.install(|| proximity_of(v, d, parallel))))
+    }
+
     /// Intersection segments of `contacts` (from [`Scene::contacts`] in the current poses),
     /// in the order of `contacts.pairs`. Errors if an object is gone, an index is out of
     /// range, or a pair no longer intersects.
@@ -339,6 +372,37 @@ impl Scene {
         each!(&self.objects, v => v.binary_search_by_key(&id.0, |o| o.id))
             .map_err(|_| Error::UnknownObject(id.0))
     }
+}
+
+fn proximity_of<K: BvKind>(objects: &mut [Object<K>], d: f64, parallel: bool) -> SceneProximity {
+    let within = Within::distance(d);
+    let (jobs, broad_phase_tests) = jobs_of(objects, within.margin);
+    let results = run_jobs(
+        objects,
+        &jobs,
+        parallel,
+        |ws, a, b, par| {
+            let posed = match b {
+                None => Posed::single(a, within),
+                Some(b) => Posed::pair(a, b, within),
+            };
+            proximity::run(posed, d, ws, par)
+        },
+        |p: &mut Proximity| &mut p.counters,
+    );
+    let mut out = SceneProximity {
+        broad_phase_tests,
+        ..SceneProximity::default()
+    };
+    for (&(a, b), p) in jobs.iter().zip(results) {
+        out.counters += p.counters;
+        out.per_pair.push(PairProximity {
+            a: ObjectId(objects[a].id),
+            b: ObjectId(objects[b].id),
+            proximity: p,
+        });
+    }
+    out
 }
 
 /// Sweep-and-prune on the root boxes along x: the index pairs `(i, j)`, `i < j`, of objects
@@ -411,11 +475,23 @@ fn update_objects<K: BvKind>(
     Ok(())
 }
 
-fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
-    let bounds: Vec<_> = objects.iter().map(|o| o.bounds).collect();
-    let (candidates, broad_phase_tests) = broad_phase(&bounds);
-    // Jobs in (a, b) order; a self job is (a, a).
-    let mut jobs: Vec<(usize, usize)> = candidates;
+/// The jobs of a query: the object pairs whose root boxes, grown by `margin`, overlap, and
+/// the objects with self-collision on (`(a, a)`), sorted; and the broad phase's box tests.
+fn jobs_of<K: BvKind>(objects: &[Object<K>], margin: f32) -> (Vec<(usize, usize)>, u64) {
+    let bounds: Vec<_> = objects
+        .iter()
+        .map(|o| {
+            if margin == 0.0 {
+                o.bounds
+            } else {
+                [
+                    o.bounds[0].map(|x| (x - margin).next_down()),
+                    o.bounds[1].map(|x| (x + margin).next_up()),
+                ]
+            }
+        })
+        .collect();
+    let (mut jobs, tests) = broad_phase(&bounds);
     jobs.extend(
         objects
             .iter()
@@ -424,20 +500,27 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
             .map(|(i, _)| (i, i)),
     );
     jobs.sort_unstable();
+    (jobs, tests)
+}
 
-    // Every job at once on shared hierarchies (the lazy refit fits each group once, whoever
-    // needs it first); each query may also split its own walk on the same pool.
+/// Runs `query` on every job at once on the shared hierarchies (the lazy refit fits each
+/// group once, whoever needs it first; each query may also split its own walk on the same
+/// pool), and credits each object's refits (the nodes fitted on it in every job, plus its
+/// eager refits) to its first job: results in job order, each with its counters.
+fn run_jobs<K: BvKind, R: Send>(
+    objects: &mut [Object<K>],
+    jobs: &[(usize, usize)],
+    parallel: bool,
+    query: impl Fn(&mut Workspace, &Hierarchy<K>, Option<&Hierarchy<K>>, Par) -> (R, [u64; 2]) + Sync,
+    counters: impl Fn(&mut R) -> &mut Counters,
+) -> Vec<R> {
     let inner = if parallel { Par::Rayon(0) } else { Par::Seq };
     let shared: &[Object<K>] = objects;
     let run = |ws: &mut Workspace, (a, b): (usize, usize)| {
-        let posed = if a == b {
-            Posed::single(&shared[a].h, Overlap)
-        } else {
-            Posed::pair(&shared[a].h, &shared[b].h, Overlap)
-        };
-        contacts(posed, ws, inner)
+        let other = (a != b).then(|| &shared[b].h);
+        query(ws, &shared[a].h, other, inner)
     };
-    let mut results: Vec<(Contacts, [u64; 2])> = if parallel && jobs.len() > 1 {
+    let mut results: Vec<(R, [u64; 2])> = if parallel && jobs.len() > 1 {
         // One workspace per worker thread, reused across jobs.
         jobs.par_iter()
             .map_init(Workspace::default, |ws, &job| run(ws, job))
@@ -459,20 +542,37 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
         first_job[a] = Some(k);
         first_job[b] = Some(k);
     }
-    for (c, _) in &mut results {
-        c.counters.bv_updates = 0;
+    for (r, _) in &mut results {
+        counters(r).bv_updates = 0;
     }
     for ((o, first), lazy) in objects.iter_mut().zip(first_job).zip(refitted) {
         if let Some(k) = first {
-            results[k].0.counters.bv_updates += lazy + std::mem::take(&mut o.refitted);
+            counters(&mut results[k].0).bv_updates += lazy + std::mem::take(&mut o.refitted);
         }
     }
+    results.into_iter().map(|(r, _)| r).collect()
+}
 
+fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
+    let (jobs, broad_phase_tests) = jobs_of(objects, 0.0);
+    let results = run_jobs(
+        objects,
+        &jobs,
+        parallel,
+        |ws, a, b, par| {
+            let posed = match b {
+                None => Posed::single(a, Overlap),
+                Some(b) => Posed::pair(a, b, Overlap),
+            };
+            contacts(posed, ws, par)
+        },
+        |c: &mut Contacts| &mut c.counters,
+    );
     let mut out = SceneContacts {
         broad_phase_tests,
         ..SceneContacts::default()
     };
-    for (&(a, b), (c, _)) in jobs.iter().zip(results) {
+    for (&(a, b), c) in jobs.iter().zip(results) {
         let (ida, idb) = (objects[a].id, objects[b].id);
         out.pairs.extend(
             c.pairs

@@ -167,3 +167,44 @@ fn bad_distances_are_typed_errors() {
     assert!(dhcd::self_proximity(&h, 0.0).is_ok());
     assert!(dhcd::self_proximity(&h, -0.0).is_ok());
 }
+
+/// A scene's proximity: the pairs of every object pair within the distance and of the
+/// objects with self-collision on, each equal to the two-object (or self) query, for every
+/// thread count; far objects cost one box test; refits credited to each object's first job.
+#[test]
+fn scene_proximity_equals_pair_queries() {
+    use dhcd::scene::Scene;
+    use dhcd::Method;
+    let ball = icosphere(2, 1.0, [0.0; 3]);
+    let at = |o: [f32; 3]| with_positions(&ball, wave(ball.positions(), o[0], 0.05, o));
+    let meshes = [at([0.0; 3]), at([2.06, 0.0, 0.0]), at([50.0, 0.0, 0.0])];
+    let d = 0.1;
+    for method in Method::ALL {
+        let mut firsts = None;
+        for par in [Par::Seq, Par::Rayon(2)] {
+            let mut scene = Scene::new(method, Options::default());
+            let ids: Vec<_> = meshes.iter().map(|m| scene.add(m).unwrap()).collect();
+            scene.set_self_collision(ids[0], true).unwrap();
+            let p = scene.proximity(d, par).unwrap();
+            let keys: Vec<_> = p.per_pair.iter().map(|x| (x.a, x.b)).collect();
+            assert_eq!(keys, [(ids[0], ids[0]), (ids[0], ids[1])], "{method}");
+            let self_want = brute_force_self_proximity(&meshes[0], d);
+            let pair_want = brute_force_proximity(&meshes[0], &meshes[1], d);
+            assert_same(&p.per_pair[0].proximity, &self_want, "scene self");
+            assert_same(&p.per_pair[1].proximity, &pair_want, "scene pair");
+            assert!(!pair_want.vertex_face.is_empty());
+            let sum: dhcd::Counters = p.per_pair.iter().map(|x| x.proximity.counters).sum();
+            assert_eq!(sum, p.counters);
+            match &firsts {
+                None => firsts = Some(p),
+                Some(f) => assert_eq!(f, &p, "{method}: threads change nothing"),
+            }
+        }
+        let mut scene = Scene::new(method, Options::default());
+        scene.add(&meshes[0]).unwrap();
+        assert!(matches!(
+            scene.proximity(f64::NAN, Par::Seq),
+            Err(Error::InvalidDistance(_))
+        ));
+    }
+}
