@@ -10,6 +10,7 @@ use crate::points::Points;
 use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
 use dhcd_kernels::lazy::LazyTiles;
 use dhcd_kernels::narrow::TriSoa;
+use dhcd_kernels::overlap::BoxRows;
 use dhcd_kernels::{refit, Soa3, Tile};
 
 /// When bounding volumes follow a deformation.
@@ -169,6 +170,9 @@ pub struct Hierarchy<K: BvKind> {
     refit: Refit,
     /// Triangle corners and boxes in the current pose, refreshed lazily per leaf.
     tris: TriCache,
+    /// The boxes of each leaf's own edges in the current pose, refreshed lazily per leaf;
+    /// allocated by the first query on features (proximity).
+    edges: std::sync::OnceLock<EdgeCache>,
 }
 
 /// Every triangle's corners and closed box in the current pose, refreshed lazily one leaf at
@@ -179,6 +183,31 @@ pub struct Hierarchy<K: BvKind> {
 #[derive(Clone, Debug)]
 pub(crate) struct TriCache {
     tiles: LazyTiles,
+}
+
+/// The boxes of every leaf's own edges (`tree/edges.rs`) in the current pose, refreshed
+/// lazily one leaf at a time: a leaf meets several leaves in a query on features. One group
+/// per leaf rank: six rows (min x, y, z, max x, y, z) of its own edges.
+#[derive(Clone, Debug)]
+struct EdgeCache {
+    tiles: LazyTiles,
+}
+
+impl EdgeCache {
+    fn new(tree: &RegionTree) -> Self {
+        let table = tree.leaf_edges();
+        let mut start = 0;
+        let groups = (0..tree.leaf_count())
+            .map(|r| {
+                let n = 6 * table.of_rank(r).len();
+                start += n;
+                start - n..start
+            })
+            .collect();
+        Self {
+            tiles: LazyTiles::new(start, groups),
+        }
+    }
 }
 
 /// Fields per triangle of the cache tiles.
@@ -323,6 +352,7 @@ impl<K: BvKind> Hierarchy<K> {
         let nodes = K::build(&tree, &points, &options);
         Ok(Self {
             tris: TriCache::new(&tree),
+            edges: std::sync::OnceLock::new(),
             tree,
             points,
             exact,
@@ -400,6 +430,9 @@ impl<K: BvKind> Hierarchy<K> {
     pub fn invalidate(&mut self) {
         K::invalidate(&mut self.nodes);
         self.tris.tiles.invalidate();
+        if let Some(edges) = self.edges.get_mut() {
+            edges.tiles.invalidate();
+        }
     }
 
     /// Refits the stale sibling groups of the nodes `ids` (each group once), as the lazy
@@ -463,6 +496,33 @@ impl<K: BvKind> Hierarchy<K> {
     #[inline]
     pub(crate) fn leaf_tris(&self, leaf: usize) -> LeafTris<'_> {
         self.tris.leaf(&self.tree, &self.points, leaf)
+    }
+
+    /// The closed boxes of leaf `leaf`'s own edges in the current pose (rounded outward for
+    /// an `f64` hierarchy), as six rows, computed first if stale.
+    #[inline]
+    pub(crate) fn leaf_edge_boxes(&self, leaf: usize) -> BoxRows<'_> {
+        let cache = self.edges.get_or_init(|| EdgeCache::new(&self.tree));
+        let r = self.tree.leaf_rank(leaf).expect("a leaf");
+        let edges = self.tree.leaf_edges().of_rank(r);
+        let n = edges.len();
+        let p = &self.points;
+        let (tile, _) = cache.tiles.get_or_fill(r, |rows| {
+            for (i, &[u, v]) in edges.iter().enumerate() {
+                let (a, b) = (p.get(u as usize), p.get(v as usize));
+                for k in 0..3 {
+                    let (lo, hi) = (a[k].min(b[k]), a[k].max(b[k]));
+                    let (lo, hi) = if p.is_rounded() {
+                        (lo.next_down(), hi.next_up())
+                    } else {
+                        (lo, hi)
+                    };
+                    rows[k * n + i] = lo;
+                    rows[(3 + k) * n + i] = hi;
+                }
+            }
+        });
+        std::array::from_fn(|f| &tile[f * n..(f + 1) * n])
     }
 
     /// Checks that every fitted node's volume encloses every vertex of its region in the

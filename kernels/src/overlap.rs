@@ -325,3 +325,89 @@ pub(crate) fn low_bits(n: usize) -> u32 {
         (1u32 << n) - 1
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// boxes_meet
+
+/// Closed boxes as six rows of one length: minima x, y, z, then maxima x, y, z (a leaf's
+/// triangle or edge boxes). Rows longer than the entries tested are allowed (padding).
+pub type BoxRows<'a> = [&'a [f32]; 6];
+
+/// The longest block [`boxes_meet_with`] tests: the bits of a `u64`.
+pub const MAX_BOX_ROW: usize = 64;
+
+/// Scalar reference of [`boxes_meet_with`].
+pub fn boxes_meet_scalar(lo: [f32; 3], hi: [f32; 3], rows: BoxRows, n: usize) -> u64 {
+    box_rows_len(&rows, n);
+    let mut bits = 0;
+    for k in 0..n {
+        let b = (
+            [rows[0][k], rows[1][k], rows[2][k]],
+            [rows[3][k], rows[4][k], rows[5][k]],
+        );
+        bits |= u64::from(aabbs_overlap((lo, hi), b)) << k;
+    }
+    bits
+}
+
+fn box_rows_len(rows: &BoxRows, n: usize) -> usize {
+    assert!(n <= MAX_BOX_ROW, "at most {MAX_BOX_ROW} boxes a call");
+    let len = rows[0].len();
+    assert!(
+        rows.iter().all(|r| r.len() == len) && n <= len,
+        "six rows of one length, at least n"
+    );
+    len
+}
+
+/// The box `(lo, hi)` against the first `n <= 64` boxes of `rows`: bit `k` set iff they
+/// meet (closed boxes; a NaN bound never meets). Comparisons only, so the mask is the
+/// same on every backend as [`boxes_meet_scalar`].
+#[inline(always)]
+pub fn boxes_meet_with<S: Simd>(
+    simd: S,
+    lo: [f32; 3],
+    hi: [f32; 3],
+    rows: BoxRows,
+    n: usize,
+) -> u64 {
+    let len = box_rows_len(&rows, n);
+    let plo = [
+        simd.splat_f32s(lo[0]),
+        simd.splat_f32s(lo[1]),
+        simd.splat_f32s(lo[2]),
+    ];
+    let phi = [
+        simd.splat_f32s(hi[0]),
+        simd.splat_f32s(hi[1]),
+        simd.splat_f32s(hi[2]),
+    ];
+    let mut bits = 0u64;
+    let mut base = 0;
+    while base < n {
+        let end = (base + S::F32_LANES).min(len);
+        let mut hit = simd.less_than_or_equal_f32s(plo[0], load_prefix(simd, &rows[3][base..end]));
+        hit = simd.and_m32s(
+            hit,
+            simd.less_than_or_equal_f32s(load_prefix(simd, &rows[0][base..end]), phi[0]),
+        );
+        for k in 1..3 {
+            hit = simd.and_m32s(
+                hit,
+                simd.less_than_or_equal_f32s(plo[k], load_prefix(simd, &rows[3 + k][base..end])),
+            );
+            hit = simd.and_m32s(
+                hit,
+                simd.less_than_or_equal_f32s(load_prefix(simd, &rows[k][base..end]), phi[k]),
+            );
+        }
+        let valid = if n - base >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << (n - base)) - 1
+        };
+        bits |= (u64::from(mask_bits(simd, hit)) & valid) << base;
+        base = end;
+    }
+    bits
+}

@@ -233,6 +233,42 @@ fn blocks_match_reference_on_all_backends() {
     on_all_backends!(check_blocks);
 }
 
+/// `boxes_meet_with`: the scalar reference's bits on every backend, for rows of 0 to 64
+/// boxes with padding past `n`, special values (NaN, infinities, +-0, touching boxes).
+fn check_box_rows<S: Simd>(simd: S) {
+    let mut rng = Rng::new(12);
+    for every in [0, 5, 3] {
+        for n in block_sizes(S::F32_LANES, overlap::MAX_BOX_ROW) {
+            for len in [n, (n + 3).min(overlap::MAX_BOX_ROW), n.next_multiple_of(8)] {
+                let b = boxes(&mut rng, len, every);
+                let p = boxes(&mut rng, 1, every);
+                let rows = [&b[0][..], &b[1], &b[2], &b[3], &b[4], &b[5]];
+                let (lo, hi) = ([p[0][0], p[1][0], p[2][0]], [p[3][0], p[4][0], p[5][0]]);
+                let want = overlap::boxes_meet_scalar(lo, hi, rows, n);
+                let got = overlap::boxes_meet_with(simd, lo, hi, rows, n);
+                assert_eq!(got, want, "{simd:?} n={n} len={len} every={every}");
+                if n < 64 {
+                    assert_eq!(got >> n, 0, "bits past n");
+                }
+                // Touching: a probe equal to an entry's box meets it.
+                if n > 0 {
+                    let k = rng.below(n);
+                    let (lo, hi) = ([b[0][k], b[1][k], b[2][k]], [b[0][k], b[1][k], b[2][k]]);
+                    let bits = overlap::boxes_meet_with(simd, lo, hi, rows, n);
+                    assert_eq!(bits, overlap::boxes_meet_scalar(lo, hi, rows, n));
+                    let finite = (0..6).all(|f| b[f][k].is_finite());
+                    assert!(!finite || bits >> k & 1 == 1, "a touching box meets");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn box_rows_match_reference_on_all_backends() {
+    on_all_backends!(check_box_rows);
+}
+
 #[test]
 fn dispatched_blocks_match_reference() {
     let mut rng = Rng::new(2);

@@ -26,6 +26,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
 use crate::walk::{self, Workspace};
+use dhcd_kernels::overlap::{boxes_meet_with, BoxRows, MAX_BOX_ROW};
 
 /// A vertex within the distance of a triangle: in a pair query, a vertex of the first
 /// hierarchy and a triangle of the second (see [`FaceVertex`] for the other way round); in a
@@ -159,55 +160,32 @@ struct Features {
     margin: f32,
 }
 
-/// What a proximity walk task produces: its pairs, and scratch for edge boxes.
+/// What a proximity walk task produces.
 struct FeatureOut {
     result: Proximity,
-    edges: [Boxes; 2],
-}
-
-/// Closed boxes in structure-of-arrays form (scratch).
-#[derive(Default)]
-struct Boxes {
-    lo: [Vec<f32>; 3],
-    hi: [Vec<f32>; 3],
 }
 
 type Bounds = ([f32; 3], [f32; 3]);
 
-impl Boxes {
-    fn clear(&mut self) {
-        for k in 0..3 {
-            self.lo[k].clear();
-            self.hi[k].clear();
+/// The union of the first `n` boxes of `rows` (empty: `+inf..-inf`).
+fn union_of(rows: &BoxRows, n: usize) -> Bounds {
+    let mut u = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for k in 0..3 {
+        for i in 0..n {
+            u.0[k] = u.0[k].min(rows[k][i]);
+            u.1[k] = u.1[k].max(rows[3 + k][i]);
         }
     }
+    u
+}
 
-    fn push(&mut self, (lo, hi): Bounds) {
-        for k in 0..3 {
-            self.lo[k].push(lo[k]);
-            self.hi[k].push(hi[k]);
-        }
-    }
-
-    #[inline(always)]
-    fn get(&self, i: usize) -> Bounds {
-        (
-            [self.lo[0][i], self.lo[1][i], self.lo[2][i]],
-            [self.hi[0][i], self.hi[1][i], self.hi[2][i]],
-        )
-    }
-
-    /// The union of the boxes (empty: `+inf..-inf`).
-    fn union(&self) -> Bounds {
-        let mut u = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        for k in 0..3 {
-            for (&l, &h) in self.lo[k].iter().zip(&self.hi[k]) {
-                u.0[k] = u.0[k].min(l);
-                u.1[k] = u.1[k].max(h);
-            }
-        }
-        u
-    }
+/// The bits of boxes `base..base + 64` of the first `n` of `rows` that meet `probe` (bit
+/// `j` for box `base + j`).
+#[inline(always)]
+fn meeting<S: Simd>(simd: S, probe: &Bounds, rows: &BoxRows, base: usize, n: usize) -> u64 {
+    let m = (n - base).min(MAX_BOX_ROW);
+    let part: BoxRows = std::array::from_fn(|f| &rows[f][base..]);
+    boxes_meet_with(simd, probe.0, probe.1, part, m)
 }
 
 /// Whether two closed boxes meet.
@@ -248,20 +226,11 @@ struct Leaf<'h, K: BvKind> {
     node: usize,
 }
 
-impl<K: BvKind> Leaf<'_, K> {
-    fn own_edges(&self) -> &[[u32; 2]] {
+impl<'h, K: BvKind> Leaf<'h, K> {
+    fn own_edges(&self) -> &'h [[u32; 2]] {
         let tree = self.h.tree();
         tree.leaf_edges()
             .of_rank(tree.leaf_rank(self.node).expect("a leaf"))
-    }
-
-    /// The closed boxes of the leaf's own edges, into `out`.
-    fn edge_boxes(&self, out: &mut Boxes) {
-        out.clear();
-        let (p, rounded) = (self.h.points(), self.h.is_rounded());
-        for &[u, v] in self.own_edges() {
-            out.push(points_box([p.get(u as usize), p.get(v as usize)], rounded));
-        }
     }
 }
 
@@ -271,7 +240,6 @@ impl<'h, K: BvKind> LeafAction<'h, K> for Features {
     fn out(&self) -> FeatureOut {
         FeatureOut {
             result: Proximity::default(),
-            edges: Default::default(),
         }
     }
 
@@ -279,7 +247,7 @@ impl<'h, K: BvKind> LeafAction<'h, K> for Features {
     fn leaf_pair<S: Simd, T: NodeTest>(
         &self,
         posed: &Posed<'h, K, T>,
-        _simd: S,
+        simd: S,
         x: usize,
         y: usize,
         counters: &mut Counters,
@@ -298,7 +266,7 @@ impl<'h, K: BvKind> LeafAction<'h, K> for Features {
         let self_query = posed.self_query;
         let res = &mut out.result;
         // Vertices of x against triangles of y, and (but for a leaf with itself) the other way.
-        self.vertices_vs_triangles(lx, ly, self_query, counters, |v, t, d2, kind| {
+        self.vertices_vs_triangles(simd, lx, ly, self_query, counters, |v, t, d2, kind| {
             res.vertex_face.push(VertexFace {
                 vertex: v,
                 triangle: t,
@@ -307,7 +275,7 @@ impl<'h, K: BvKind> LeafAction<'h, K> for Features {
             })
         });
         if !(self_query && x == y) {
-            self.vertices_vs_triangles(ly, lx, self_query, counters, |v, t, d2, kind| {
+            self.vertices_vs_triangles(simd, ly, lx, self_query, counters, |v, t, d2, kind| {
                 if self_query {
                     res.vertex_face.push(VertexFace {
                         vertex: v,
@@ -325,14 +293,7 @@ impl<'h, K: BvKind> LeafAction<'h, K> for Features {
                 }
             });
         }
-        self.edges_vs_edges(
-            lx,
-            ly,
-            self_query,
-            &mut out.edges,
-            counters,
-            &mut res.edge_edge,
-        );
+        self.edges_vs_edges(simd, lx, ly, self_query, counters, &mut res.edge_edge);
     }
 
     fn merge(&self, out: &mut FeatureOut, other: FeatureOut) {
@@ -347,8 +308,9 @@ impl Features {
     /// The own vertices of leaf `lv` against the triangles of leaf `lt`: `emit(vertex,
     /// triangle, distance_sq, kind)` for each pair within the distance (original indices).
     #[inline(always)]
-    fn vertices_vs_triangles<K: BvKind>(
+    fn vertices_vs_triangles<S: Simd, K: BvKind>(
         &self,
+        simd: S,
         lv: Leaf<'_, K>,
         lt: Leaf<'_, K>,
         self_query: bool,
@@ -358,44 +320,42 @@ impl Features {
         let (tv, tt) = (lv.h.tree(), lt.h.tree());
         let tris = lt.h.leaf_tris(lt.node);
         let soa = &tris.soa;
-        let tri_box = |j: usize| -> Bounds {
-            (
-                [soa.lo(0)[j], soa.lo(1)[j], soa.lo(2)[j]],
-                [soa.hi(0)[j], soa.hi(1)[j], soa.hi(2)[j]],
-            )
-        };
-        let mut union = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        for j in 0..tris.len {
-            let b = tri_box(j);
-            for k in 0..3 {
-                union.0[k] = union.0[k].min(b.0[k]);
-                union.1[k] = union.1[k].max(b.1[k]);
-            }
-        }
-        let near = grown(&union, self.margin);
+        let n = tris.len;
+        let rows: BoxRows = [
+            soa.lo(0),
+            soa.lo(1),
+            soa.lo(2),
+            soa.hi(0),
+            soa.hi(1),
+            soa.hi(2),
+        ];
+        let near = grown(&union_of(&rows, n), self.margin);
         let (p, rounded) = (lv.h.points(), lv.h.is_rounded());
-        let tri_range = tt.tri_range(lt.node);
+        let first = tt.tri_range(lt.node).start;
+        let corners_of = tt.triangles();
         for v in tv.vert_run(lv.node) {
             let vbox = points_box([p.get(v)], rounded);
             if !meet(&vbox, &near) {
                 continue;
             }
             let probe = grown(&vbox, self.margin);
-            let mut point = None;
-            for j in 0..tris.len {
-                if !meet(&probe, &tri_box(j)) {
-                    continue;
-                }
-                let t = tri_range.start + j;
-                let corners = tt.triangles()[t];
-                if self_query && corners.contains(&(v as u32)) {
-                    continue;
-                }
-                counters.prim_tests += 1;
-                let pv = *point.get_or_insert_with(|| lv.h.position_f64(v));
-                let tri = corners.map(|c| lt.h.position_f64(c as usize));
-                if let Some((d2, kind)) = distance::point_triangle_within(pv, tri, self.d) {
-                    emit(tv.vert_order()[v], tt.tri_order()[t], d2, kind);
+            let pv = lv.h.position_f64(v);
+            // PERF: mask loops, not closures: a closure may be compiled without the
+            // dispatched target features (the kernel then calls every intrinsic).
+            for base in (0..n).step_by(MAX_BOX_ROW) {
+                let mut bits = meeting(simd, &probe, &rows, base, n);
+                while bits != 0 {
+                    let t = first + base + bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let corners = corners_of[t];
+                    if self_query && corners.contains(&(v as u32)) {
+                        continue;
+                    }
+                    counters.prim_tests += 1;
+                    let tri = corners.map(|c| lt.h.position_f64(c as usize));
+                    if let Some((d2, kind)) = distance::point_triangle_within(pv, tri, self.d) {
+                        emit(tv.vert_order()[v], tt.tri_order()[t], d2, kind);
+                    }
                 }
             }
         }
@@ -404,70 +364,75 @@ impl Features {
     /// The own edges of leaf `la` against those of `lb` (a leaf with itself: each unordered
     /// pair once): each pair within the distance into `out`.
     #[inline(always)]
-    fn edges_vs_edges<K: BvKind>(
+    fn edges_vs_edges<S: Simd, K: BvKind>(
         &self,
+        simd: S,
         la: Leaf<'_, K>,
         lb: Leaf<'_, K>,
         self_query: bool,
-        scratch: &mut [Boxes; 2],
         counters: &mut Counters,
         out: &mut Vec<EdgePair>,
     ) {
         let same = self_query && la.node == lb.node;
-        let [ba, bb] = scratch;
-        la.edge_boxes(ba);
-        let bb: &Boxes = if same {
-            ba
-        } else {
-            lb.edge_boxes(bb);
-            bb
-        };
-        let near = grown(&bb.union(), self.margin);
         let (ea, eb) = (la.own_edges(), lb.own_edges());
+        let (ra, rb) = (la.h.leaf_edge_boxes(la.node), lb.h.leaf_edge_boxes(lb.node));
+        let near = grown(&union_of(&rb, eb.len()), self.margin);
         let (oa, ob) = (la.h.tree().vert_order(), lb.h.tree().vert_order());
-        for (i, &[u0, u1]) in ea.iter().enumerate() {
-            let abox = ba.get(i);
-            if !meet(&abox, &near) {
-                continue;
+        // Original indices, smaller first, and the internal ones in that order.
+        let ordered = |o: &[u32], [s, t]: [u32; 2]| {
+            let (os, ot) = (o[s as usize], o[t as usize]);
+            if os < ot {
+                ([os, ot], [s, t])
+            } else {
+                ([ot, os], [t, s])
             }
-            let probe = grown(&abox, self.margin);
-            let first = if same { i + 1 } else { 0 };
-            for (j, &[w0, w1]) in eb.iter().enumerate().skip(first) {
-                if !meet(&probe, &bb.get(j)) {
-                    continue;
-                }
-                if self_query && (u0 == w0 || u0 == w1 || u1 == w0 || u1 == w1) {
-                    continue;
-                }
-                counters.prim_tests += 1;
-                // Original indices, each edge smaller first; in a self query the smaller edge
-                // first. The exact test takes the endpoints in that order, so its type names
-                // them as reported.
-                let e = |o: &[u32], s: u32, t: u32| {
-                    let (os, ot) = (o[s as usize], o[t as usize]);
-                    if os < ot {
-                        ([os, ot], [s, t])
-                    } else {
-                        ([ot, os], [t, s])
+        };
+        for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
+            let mut near_bits = meeting(simd, &near, &ra, base_a, ea.len());
+            while near_bits != 0 {
+                let i = base_a + near_bits.trailing_zeros() as usize;
+                near_bits &= near_bits - 1;
+                let [u0, u1] = ea[i];
+                let abox = (
+                    [ra[0][i], ra[1][i], ra[2][i]],
+                    [ra[3][i], ra[4][i], ra[5][i]],
+                );
+                let probe = grown(&abox, self.margin);
+                let (a_ids, a_int) = ordered(oa, ea[i]);
+                let pa = a_int.map(|v| la.h.position_f64(v as usize));
+                // A leaf with itself: only j > i.
+                let from = if same { i + 1 } else { 0 };
+                for base in (from..eb.len()).step_by(MAX_BOX_ROW) {
+                    let mut bits = meeting(simd, &probe, &rb, base, eb.len());
+                    while bits != 0 {
+                        let j = base + bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        let [w0, w1] = eb[j];
+                        if self_query && (u0 == w0 || u0 == w1 || u1 == w0 || u1 == w1) {
+                            continue;
+                        }
+                        counters.prim_tests += 1;
+                        let (b_ids, b_int) = ordered(ob, eb[j]);
+                        let pb = b_int.map(|v| lb.h.position_f64(v as usize));
+                        // In a self query the smaller edge first; the exact test takes the
+                        // endpoints in the reported order, so its type names them as reported.
+                        let swap = self_query && b_ids < a_ids;
+                        let (x, y, px, py) = if swap {
+                            (b_ids, a_ids, pb, pa)
+                        } else {
+                            (a_ids, b_ids, pa, pb)
+                        };
+                        if let Some((d2, kind)) =
+                            distance::edge_edge_within(px[0], px[1], py[0], py[1], self.d)
+                        {
+                            out.push(EdgePair {
+                                a: x,
+                                b: y,
+                                distance_sq: d2,
+                                kind,
+                            });
+                        }
                     }
-                };
-                let (mut a, mut b) = ((e(oa, u0, u1), la.h), (e(ob, w0, w1), lb.h));
-                if self_query && b.0 .0 < a.0 .0 {
-                    std::mem::swap(&mut a, &mut b);
-                }
-                let pos = |((_, ids), h): &(([u32; 2], [u32; 2]), &Hierarchy<K>)| {
-                    ids.map(|v| h.position_f64(v as usize))
-                };
-                let (pa, pb) = (pos(&a), pos(&b));
-                if let Some((d2, kind)) =
-                    distance::edge_edge_within(pa[0], pa[1], pb[0], pb[1], self.d)
-                {
-                    out.push(EdgePair {
-                        a: a.0 .0,
-                        b: b.0 .0,
-                        distance_sq: d2,
-                        kind,
-                    });
                 }
             }
         }

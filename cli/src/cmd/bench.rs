@@ -1,5 +1,6 @@
-//! `dhcd bench self FRAME...` and `dhcd bench collide --a FRAME... --b FRAME...`: the
-//! microbenchmark users run on their own meshes. Builds once on the first frame, then
+//! `dhcd bench self FRAME...`, `dhcd bench collide --a FRAME... --b FRAME...` and
+//! `dhcd bench proximity FRAME... (--distance D | --relative R)`: the microbenchmark users
+//! run on their own meshes. Builds once on the first frame, then
 //! cycles `update_positions` through the frames, timing each step (update + query); reports
 //! the build time, the median and least step time over all steps and per frame (frames of
 //! different work make the overall median fall between them), and each frame's contacts and
@@ -12,7 +13,7 @@ use dhcd::error::escaped_path;
 use dhcd::{AnyHierarchy, CentralVertex, Counters, Mesh, Method, Options, Par, Workspace};
 use serde_json::json;
 
-use super::input::InputArgs;
+use super::input::{update, InputArgs};
 
 /// Most passes over the frames (`--repeat`): a typo must not start a day-long run.
 const MAX_REPEAT: usize = 10_000;
@@ -33,6 +34,24 @@ enum What {
         /// The poses (OBJ, STL or PLY), in order.
         #[arg(required = true)]
         frames: Vec<PathBuf>,
+        #[command(flatten)]
+        opts: Opts,
+    },
+    /// Self-proximity of one deforming mesh: every vertex-triangle and edge-edge pair within
+    /// a distance (`--distance`, or `--relative` times the first frame's bounding-box
+    /// diagonal); FRAME... are its poses.
+    #[command(group(clap::ArgGroup::new("how_far").required(true).args(["distance", "relative"])))]
+    Proximity {
+        /// The poses (OBJ, STL or PLY), in order.
+        #[arg(required = true)]
+        frames: Vec<PathBuf>,
+        /// The distance.
+        #[arg(long)]
+        distance: Option<f64>,
+        /// The distance as a fraction of the first frame's bounding-box diagonal (IPC's
+        /// default contact distance is 1e-3).
+        #[arg(long)]
+        relative: Option<f64>,
         #[command(flatten)]
         opts: Opts,
     },
@@ -95,7 +114,9 @@ struct Run {
 
 pub fn run(args: BenchArgs) -> Result<(), String> {
     let opts = match &args.what {
-        What::SelfCollide { opts, .. } | What::Collide { opts, .. } => opts,
+        What::SelfCollide { opts, .. }
+        | What::Collide { opts, .. }
+        | What::Proximity { opts, .. } => opts,
     };
     let methods: Vec<Method> = if opts.method.eq_ignore_ascii_case("all") {
         Method::ALL.to_vec()
@@ -111,12 +132,37 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     let par = Par::threads(opts.threads).map_err(|e| e.to_string())?;
     let threads = par.thread_count();
     // Options are checked above, before any file is read.
+    if let What::Proximity {
+        distance, relative, ..
+    } = &args.what
+    {
+        let (name, x) = match (distance, relative) {
+            (Some(d), _) => ("--distance", *d),
+            (_, Some(r)) => ("--relative", *r),
+            _ => unreachable!("clap requires one"),
+        };
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(format!("{name} must be a finite number >= 0, got {x}"));
+        }
+    }
     let (a, b) = match &args.what {
-        What::SelfCollide { frames, .. } => (load_frames(&opts.input, frames)?, None),
+        What::SelfCollide { frames, .. } | What::Proximity { frames, .. } => {
+            (load_frames(&opts.input, frames)?, None)
+        }
         What::Collide { a, b, .. } => (
             load_frames(&opts.input, a)?,
             Some(load_frames(&opts.input, b)?),
         ),
+    };
+    // The proximity distance, in the units of the mesh.
+    let distance = match &args.what {
+        What::Proximity {
+            distance: Some(d), ..
+        } => Some(*d),
+        What::Proximity {
+            relative: Some(r), ..
+        } => Some(r * diagonal(&a[0])),
+        _ => None,
     };
     let options = Options {
         levels: opts.levels,
@@ -140,12 +186,10 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         for _ in 0..opts.repeat {
             for (k, counters) in frames.iter_mut().enumerate() {
                 let t = Instant::now();
-                ha.update_positions(a[k % a.len()].positions())
-                    .map_err(|e| e.to_string())?;
+                update(&mut ha, &a[k % a.len()]).map_err(|e| e.to_string())?;
                 *counters = match (&mut hb, &b) {
                     (Some(hb), Some(b)) => {
-                        hb.update_positions(b[k % b.len()].positions())
-                            .map_err(|e| e.to_string())?;
+                        update(hb, &b[k % b.len()]).map_err(|e| e.to_string())?;
                         if opts.broad_only {
                             ha.broad_phase(hb, &mut ws, par).map(|b| b.counters)
                         } else {
@@ -154,7 +198,14 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
                         .map_err(|e| e.to_string())?
                     }
                     _ if opts.broad_only => ha.self_broad_phase(&mut ws, par).counters,
-                    _ => ha.self_collide(&mut ws, par).counters,
+                    _ => match distance {
+                        Some(d) => {
+                            ha.self_proximity(d, &mut ws, par)
+                                .map_err(|e| e.to_string())?
+                                .counters
+                        }
+                        None => ha.self_collide(&mut ws, par).counters,
+                    },
                 };
                 steps_ms.push(t.elapsed().as_secs_f64() * 1e3);
             }
@@ -167,8 +218,10 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         });
     }
     let out = if opts.json {
-        let values: Vec<serde_json::Value> =
-            runs.iter().map(|r| to_json(r, threads, opts)).collect();
+        let values: Vec<serde_json::Value> = runs
+            .iter()
+            .map(|r| to_json(r, threads, opts, distance))
+            .collect();
         let v = if methods.len() == 1 {
             values.into_iter().next().unwrap_or_default()
         } else {
@@ -176,7 +229,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         };
         format!("{v}\n")
     } else {
-        text(&runs, opts, threads, &a, b.as_deref())
+        text(&runs, opts, threads, &a, b.as_deref(), distance)
     };
     super::emit(&out).map_err(|e| e.to_string())
 }
@@ -198,6 +251,19 @@ fn load_frames(input: &InputArgs, paths: &[PathBuf]) -> Result<Vec<Mesh>, String
         frames.push(m);
     }
     Ok(frames)
+}
+
+/// The diagonal of the bounding box of `m`'s positions (exact values, `f64`).
+fn diagonal(m: &Mesh) -> f64 {
+    let p = m.to_f64_positions();
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for q in &p {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
 }
 
 /// Median and least of `xs` (non-empty).
@@ -230,12 +296,14 @@ fn counters_json(c: &Counters) -> serde_json::Value {
     })
 }
 
-/// `{"method", "threads", "broad_only", "build_ms", "step_ms": {"median", "min"},
-/// "frames": [{"contacts", "counters", "step_ms": {"median", "min"}}...]}`.
-fn to_json(r: &Run, threads: usize, opts: &Opts) -> serde_json::Value {
+/// `{"method", "precision", "threads", "broad_only", ("distance",) "build_ms", "step_ms":
+/// {"median", "min"}, "frames": [{"contacts", "counters", "step_ms": {"median", "min"}}...]}`
+/// (`distance` for proximity; its `contacts` are the pairs within it).
+fn to_json(r: &Run, threads: usize, opts: &Opts, distance: Option<f64>) -> serde_json::Value {
     let (median, min) = median_min(&r.steps_ms);
-    json!({
+    let mut v = json!({
         "method": r.method.name(),
+        "precision": opts.input.precision.name(),
         "threads": threads,
         "broad_only": opts.broad_only,
         "build_ms": r.build_ms,
@@ -248,18 +316,39 @@ fn to_json(r: &Run, threads: usize, opts: &Opts) -> serde_json::Value {
                 "step_ms": { "median": median, "min": min },
             })
         }).collect::<Vec<_>>(),
-    })
+    });
+    if let (Some(d), Some(o)) = (distance, v.as_object_mut()) {
+        o.insert("distance".into(), d.into());
+    }
+    v
 }
 
-fn text(runs: &[Run], opts: &Opts, threads: usize, a: &[Mesh], b: Option<&[Mesh]>) -> String {
+fn text(
+    runs: &[Run],
+    opts: &Opts,
+    threads: usize,
+    a: &[Mesh],
+    b: Option<&[Mesh]>,
+    distance: Option<f64>,
+) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let what = match b {
-        None => format!("self-collision of {} triangles", a[0].triangle_count()),
-        Some(b) => format!(
-            "{} against {} triangles",
+    let what = match (b, distance) {
+        (None, Some(d)) => format!(
+            "self-proximity within {d} of {} triangles ({})",
             a[0].triangle_count(),
-            b[0].triangle_count()
+            opts.input.precision
+        ),
+        (None, None) => format!(
+            "self-collision of {} triangles ({})",
+            a[0].triangle_count(),
+            opts.input.precision
+        ),
+        (Some(b), _) => format!(
+            "{} against {} triangles ({})",
+            a[0].triangle_count(),
+            b[0].triangle_count(),
+            opts.input.precision
         ),
     };
     let _ = writeln!(

@@ -27,5 +27,11 @@ pub fn run(args: CollideArgs) -> dhcd::Result<()> {
     let b = AnyHierarchy::new(q.method, &mesh_b, q.options())?;
     let contacts = a.collide(&b, &mut Workspace::default(), Par::Seq)?;
     let levels = a.tree().levels().max(b.tree().levels());
-    q.report("contacts", levels, &contacts.pairs, contacts.counters)
+    q.report(
+        "contacts",
+        args.input.precision,
+        levels,
+        &contacts.pairs,
+        contacts.counters,
+    )
 }

@@ -4,6 +4,7 @@ mod bench;
 mod collide;
 mod experiment;
 mod input;
+mod proximity;
 mod query;
 mod scene;
 mod self_cmd;
@@ -36,6 +37,8 @@ enum Command {
     SelfCollide(self_cmd::SelfArgs),
     /// Contacts between every pair of several meshes.
     Scene(scene::SceneArgs),
+    /// Every vertex-triangle and edge-edge pair within a distance, in one mesh or between two.
+    Proximity(proximity::ProximityArgs),
     /// The paper's experiment (eight deforming pawns) and the cost-model report.
     Experiment(experiment::ExperimentArgs),
     /// Time the steps of a deforming mesh (or pair) given as frames: build once, then
@@ -61,6 +64,7 @@ pub fn run() -> i32 {
         Command::Collide(args) => collide::run(args).map_err(|e| e.to_string()),
         Command::SelfCollide(args) => self_cmd::run(args).map_err(|e| e.to_string()),
         Command::Scene(args) => scene::run(args).map_err(|e| e.to_string()),
+        Command::Proximity(args) => proximity::run(args).map_err(|e| e.to_string()),
         Command::Experiment(args) => experiment::run(args),
         Command::Bench(args) => bench::run(args),
     };

@@ -3,7 +3,7 @@
 
 use std::io::Write;
 
-use dhcd::{CentralVertex, Counters, Method, Options};
+use dhcd::{CentralVertex, Counters, Method, Options, Precision};
 
 #[derive(clap::Args, Debug)]
 pub struct QueryArgs {
@@ -45,13 +45,14 @@ impl QueryArgs {
     pub fn report<const N: usize, T: Copy + Into<u64>>(
         &self,
         what: &str,
+        precision: Precision,
         levels: usize,
         rows: &[[T; N]],
         counters: Counters,
     ) -> dhcd::Result<()> {
         super::emit_with(|out| {
             if self.json {
-                self.write_json(out, levels, rows, counters)
+                self.write_json(out, precision, levels, rows, counters)
             } else {
                 self.write_text(out, what, levels, rows, counters)
             }
@@ -91,17 +92,20 @@ impl QueryArgs {
         Ok(())
     }
 
-    /// One compact JSON object and a newline: `{"method", "levels", "bytes_per_node",
-    /// "pairs", "counters"}`, keys in this order, the bytes `serde_json` prints for it.
+    /// One compact JSON object and a newline: `{"method", "precision", "levels",
+    /// "bytes_per_node", "pairs", "counters"}`, keys in this order, the bytes `serde_json`
+    /// prints for it.
     fn write_json<const N: usize, T: Copy + Into<u64>>(
         &self,
         out: &mut dyn Write,
+        precision: Precision,
         levels: usize,
         rows: &[[T; N]],
         counters: Counters,
     ) -> std::io::Result<()> {
         out.write_all(b"{\"method\":")?;
         serde_json::to_writer(&mut *out, self.method.name())?;
+        write!(out, ",\"precision\":\"{}\"", precision.name())?;
         write!(
             out,
             ",\"levels\":{levels},\"bytes_per_node\":{},\"pairs\":[",

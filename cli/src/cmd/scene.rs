@@ -46,5 +46,11 @@ pub fn run(args: SceneArgs) -> dhcd::Result<()> {
     for id in scene.ids() {
         levels = levels.max(scene.tree(id)?.levels());
     }
-    q.report(&what, levels, &contacts.pairs, contacts.counters)
+    q.report(
+        &what,
+        args.input.precision,
+        levels,
+        &contacts.pairs,
+        contacts.counters,
+    )
 }
