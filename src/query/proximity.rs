@@ -169,14 +169,13 @@ type Bounds = ([f32; 3], [f32; 3]);
 
 /// The union of the first `n` boxes of `rows` (empty: `+inf..-inf`).
 fn union_of(rows: &BoxRows, n: usize) -> Bounds {
-    let mut u = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for k in 0..3 {
-        for i in 0..n {
-            u.0[k] = u.0[k].min(rows[k][i]);
-            u.1[k] = u.1[k].max(rows[3 + k][i]);
-        }
-    }
-    u
+    let lo = |k: usize| rows[k][..n].iter().fold(f32::INFINITY, |m, &x| m.min(x));
+    let hi = |k: usize| {
+        rows[3 + k][..n]
+            .iter()
+            .fold(f32::NEG_INFINITY, |m, &x| m.max(x))
+    };
+    ([lo(0), lo(1), lo(2)], [hi(0), hi(1), hi(2)])
 }
 
 /// The bits of boxes `base..base + 64` of the first `n` of `rows` that meet `probe` (bit
