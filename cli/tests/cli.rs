@@ -64,7 +64,14 @@ fn self_json_equals_brute_force() {
         let keys: Vec<&str> = v.as_object().unwrap().keys().map(|k| k.as_str()).collect();
         assert_eq!(
             keys,
-            ["method", "levels", "bytes_per_node", "pairs", "counters"]
+            [
+                "method",
+                "precision",
+                "levels",
+                "bytes_per_node",
+                "pairs",
+                "counters"
+            ]
         );
         assert_eq!(v["method"], method);
         assert_eq!(v["levels"], 4);

@@ -208,6 +208,7 @@ fn reference(
     };
     let value = json!({
         "method": method,
+        "precision": "f32",
         "levels": levels,
         "bytes_per_node": bytes_per_node,
         "pairs": rows,

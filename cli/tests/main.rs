@@ -4,6 +4,7 @@
 mod bench;
 mod cli;
 mod cli_collide;
+mod cli_proximity;
 mod experiment;
 // The mesh fixtures, the mutation fuzzer and the temporary directories are the library's
 // (one copy of each).
