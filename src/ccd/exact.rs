@@ -10,12 +10,9 @@
 
 use num_bigint::{BigInt, Sign};
 use num_integer::Integer;
-use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};
 
 use super::ring::{self, Ring, V3};
-
-type Q = BigRational;
 
 // ---------------------------------------------------------------------------------------
 // Integer polynomials in t (the ring of the formulas)
@@ -75,138 +72,236 @@ impl Ring for Poly {
 }
 
 // ---------------------------------------------------------------------------------------
-// Rational polynomials (Sturm sequences)
+// Integer polynomial remainder sequences, dyadic points
 // ---------------------------------------------------------------------------------------
+//
+// No rationals: every remainder is a pseudo-remainder (a known-sign multiple of the true
+// remainder) divided by its content, and every evaluation point is dyadic, `n / 2^k`, where
+// `2^(k deg p) p(n / 2^k)` is an integer of the sign of `p(n / 2^k)`. Positive scalings of
+// the members of a Sturm or Sturm-Tarski sequence change no sign, so no count.
 
-/// Rational coefficients, lowest degree first, no trailing zeros.
-type QPoly = Vec<Q>;
+/// A dyadic rational `n / 2^k`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Dy {
+    n: BigInt,
+    k: u64,
+}
 
-fn qtrim(mut v: QPoly) -> QPoly {
+impl Dy {
+    fn zero() -> Dy {
+        Dy {
+            n: BigInt::zero(),
+            k: 0,
+        }
+    }
+    /// The exact value of a finite, non-negative f64.
+    fn from_f64(x: f64) -> Dy {
+        let (m, e) = decompose(x);
+        if e >= 0 {
+            Dy { n: m << e as usize, k: 0 }
+        } else {
+            Dy { n: m, k: (-e) as u64 }
+        }
+    }
+    /// `self + (other - self) * num / 2^den_log2`.
+    fn lerp(&self, other: &Dy, num: i64, den_log2: u64) -> Dy {
+        let k = self.k.max(other.k) + den_log2;
+        let a = &self.n << (k - self.k) as usize;
+        let b = &other.n << (k - other.k) as usize;
+        let n = &a + (((&b - &a) * num) >> den_log2 as usize);
+        Dy { n, k }.normalized()
+    }
+    fn normalized(mut self) -> Dy {
+        if self.n.is_zero() {
+            self.k = 0;
+            return self;
+        }
+        let tz = self.n.trailing_zeros().unwrap_or(0).min(self.k);
+        self.n >>= tz as usize;
+        self.k -= tz;
+        self
+    }
+    fn cmp(&self, other: &Dy) -> std::cmp::Ordering {
+        let k = self.k.max(other.k);
+        (&self.n << (k - self.k) as usize).cmp(&(&other.n << (k - other.k) as usize))
+    }
+    /// `other - self <= 2^-tol_log2`.
+    fn within(&self, other: &Dy, tol_log2: u64) -> bool {
+        let k = self.k.max(other.k).max(tol_log2);
+        let d = (&other.n << (k - other.k) as usize) - (&self.n << (k - self.k) as usize);
+        d <= (BigInt::one() << (k - tol_log2) as usize)
+    }
+    /// The largest f64 not above this (non-negative) value.
+    fn round_down(&self) -> f64 {
+        debug_assert!(!self.n.is_negative());
+        if self.n.is_zero() {
+            return 0.0;
+        }
+        let bits = self.n.bits();
+        let drop = bits.saturating_sub(53);
+        let m = (&self.n >> drop as usize).to_u64().unwrap(); // floor: rounds down
+        let e = drop as i64 - self.k as i64;
+        if e < -1000 {
+            return 0.0; // below 2^-947: 0 is a lower bound within any tolerance
+        }
+        let mut x = m as f64;
+        let mut e = e as i32;
+        while e != 0 {
+            let s = e.clamp(-1000, 1000);
+            x *= 2f64.powi(s); // exact: a power of two, no under- or overflow here
+            e -= s;
+        }
+        x
+    }
+}
+
+/// The sign of `p` at the dyadic `x`.
+fn sign_at_dy(p: &[BigInt], x: &Dy) -> i8 {
+    let Some(d) = p.len().checked_sub(1) else {
+        return 0;
+    };
+    let mut acc = p[d].clone();
+    for i in (0..d).rev() {
+        acc = acc * &x.n + (&p[i] << (x.k as usize * (d - i)));
+    }
+    match acc.sign() {
+        Sign::Plus => 1,
+        Sign::Minus => -1,
+        Sign::NoSign => 0,
+    }
+}
+
+fn trimmed(mut v: Vec<BigInt>) -> Vec<BigInt> {
     while v.last().is_some_and(|c| c.is_zero()) {
         v.pop();
     }
     v
 }
 
-fn to_q(p: &Poly) -> QPoly {
-    p.0.iter().map(|c| Q::from_integer(c.clone())).collect()
-}
-
-fn qeval(p: &QPoly, x: &Q) -> Q {
-    let mut acc = Q::zero();
-    for c in p.iter().rev() {
-        acc = acc * x + c;
-    }
-    acc
-}
-
-fn qsign(p: &QPoly, x: &Q) -> i8 {
-    sign_of(&qeval(p, x))
-}
-
-fn sign_of(q: &Q) -> i8 {
-    if q.is_positive() {
-        1
-    } else if q.is_negative() {
-        -1
-    } else {
-        0
-    }
-}
-
-fn qderiv(p: &QPoly) -> QPoly {
-    qtrim(
+fn deriv(p: &[BigInt]) -> Vec<BigInt> {
+    trimmed(
         p.iter()
             .enumerate()
             .skip(1)
-            .map(|(i, c)| c * Q::from_integer(BigInt::from(i)))
+            .map(|(i, c)| c * BigInt::from(i))
             .collect(),
     )
 }
 
-fn qmul(a: &QPoly, b: &QPoly) -> QPoly {
+fn pmul(a: &[BigInt], b: &[BigInt]) -> Vec<BigInt> {
     if a.is_empty() || b.is_empty() {
         return Vec::new();
     }
-    let mut out = vec![Q::zero(); a.len() + b.len() - 1];
+    let mut out = vec![BigInt::zero(); a.len() + b.len() - 1];
     for (i, x) in a.iter().enumerate() {
         for (j, y) in b.iter().enumerate() {
             out[i + j] += x * y;
         }
     }
-    qtrim(out)
+    trimmed(out)
 }
 
-/// Quotient and remainder of `a / b`, `b` nonzero.
-fn qdivrem(a: &QPoly, b: &QPoly) -> (QPoly, QPoly) {
-    assert!(!b.is_empty(), "division by the zero polynomial");
-    let mut r = a.clone();
-    let db = b.len() - 1;
-    let lead = b[db].clone();
-    if r.len() < b.len() {
-        return (Vec::new(), r);
+/// `p` divided by the gcd of its coefficients (a positive number).
+fn primitive(p: Vec<BigInt>) -> Vec<BigInt> {
+    let mut g = BigInt::zero();
+    for c in &p {
+        g = g.gcd(c);
+        if g.is_one() {
+            return p;
+        }
     }
-    let mut quo = vec![Q::zero(); r.len() - db];
-    while r.len() >= b.len() {
+    if g.is_zero() {
+        return p;
+    }
+    p.into_iter().map(|c| c / &g).collect()
+}
+
+/// `(r, s)` with `r = c * rem(a, b)` for some `c` of sign `s` (+1 or -1), `b` nonzero.
+fn prem(a: &[BigInt], b: &[BigInt]) -> (Vec<BigInt>, i8) {
+    assert!(!b.is_empty(), "division by the zero polynomial");
+    let db = b.len() - 1;
+    let lb = &b[db];
+    let neg = lb.is_negative();
+    let mut r = a.to_vec();
+    let mut sign = 1i8;
+    while r.len() > db {
         let k = r.len() - 1 - db;
-        let c = &r[r.len() - 1] / &lead;
+        let lr = r[r.len() - 1].clone();
+        for c in r.iter_mut() {
+            *c *= lb;
+        }
+        for (i, bi) in b.iter().enumerate() {
+            r[k + i] -= &lr * bi;
+        }
+        debug_assert!(r[r.len() - 1].is_zero());
+        r.pop();
+        r = trimmed(r);
+        if neg {
+            sign = -sign;
+        }
+    }
+    (r, sign)
+}
+
+/// Exact quotient `a / b` (b divides a over the integers).
+fn pdiv_exact(a: &[BigInt], b: &[BigInt]) -> Vec<BigInt> {
+    let db = b.len() - 1;
+    let mut r = a.to_vec();
+    if r.len() <= db {
+        return Vec::new();
+    }
+    let mut q = vec![BigInt::zero(); r.len() - db];
+    while r.len() > db && !r.is_empty() {
+        let k = r.len() - 1 - db;
+        let (c, rest) = r[r.len() - 1].div_rem(&b[db]);
+        debug_assert!(rest.is_zero(), "inexact polynomial division");
         for (i, bi) in b.iter().enumerate() {
             r[k + i] -= &c * bi;
         }
-        quo[k] = c;
-        r.pop(); // the leading term cancelled exactly
-        r = qtrim(r);
+        q[k] = c;
+        r.pop();
+        r = trimmed(r);
     }
-    (qtrim(quo), r)
+    debug_assert!(r.is_empty(), "inexact polynomial division");
+    trimmed(q)
 }
 
-/// Monic gcd.
-fn qgcd(a: &QPoly, b: &QPoly) -> QPoly {
-    let (mut x, mut y) = (a.clone(), b.clone());
-    while !y.is_empty() {
-        let (_, r) = qdivrem(&x, &y);
-        x = y;
-        y = r;
-    }
-    monic(x)
-}
-
-fn monic(p: QPoly) -> QPoly {
-    match p.last() {
-        None => p,
-        Some(l) => {
-            let l = l.clone();
-            p.into_iter().map(|c| c / &l).collect()
-        }
-    }
-}
-
-/// The signed remainder sequence `p, q, -rem(p, q), ...` (up to the last nonzero term).
-fn srs(p: &QPoly, q: &QPoly) -> Vec<QPoly> {
-    let mut seq = vec![p.clone()];
+/// The signed remainder sequence `p, q, -rem(p, q), ...` up to positive factors.
+fn srs(p: &[BigInt], q: &[BigInt]) -> Vec<Vec<BigInt>> {
+    let mut seq = vec![primitive(p.to_vec())];
     if q.is_empty() {
         return seq;
     }
-    seq.push(q.clone());
+    seq.push(primitive(q.to_vec()));
     loop {
         let n = seq.len();
-        let (_, r) = qdivrem(&seq[n - 2], &seq[n - 1]);
+        let (r, s) = prem(&seq[n - 2], &seq[n - 1]);
         if r.is_empty() {
             return seq;
         }
-        // Keep the numbers small: a positive scale changes no sign.
-        let r: QPoly = r.into_iter().map(|c| -c).collect();
-        let l = r.last().unwrap().abs();
-        seq.push(r.into_iter().map(|c| c / &l).collect());
+        // -rem = -s * r up to a positive factor.
+        let r = if s > 0 { r.into_iter().map(|c| -c).collect() } else { r };
+        seq.push(primitive(r));
     }
 }
 
+/// Primitive gcd of two nonzero polynomials (up to sign).
+fn pgcd(a: &[BigInt], b: &[BigInt]) -> Vec<BigInt> {
+    let (mut x, mut y) = (primitive(a.to_vec()), primitive(b.to_vec()));
+    while !y.is_empty() {
+        let (r, _) = prem(&x, &y);
+        x = y;
+        y = primitive(r);
+    }
+    x
+}
+
 /// Sign variations of `seq` at `x` (zeros skipped).
-fn variations(seq: &[QPoly], x: &Q) -> i32 {
+fn variations(seq: &[Vec<BigInt>], x: &Dy) -> i32 {
     let mut last = 0i8;
     let mut v = 0;
     for p in seq {
-        let s = qsign(p, x);
+        let s = sign_at_dy(p, x);
         if s != 0 {
             if last != 0 && s != last {
                 v += 1;
@@ -224,43 +319,53 @@ fn variations(seq: &[QPoly], x: &Q) -> i32 {
 /// A real root of a polynomial in `[0, T]`.
 #[derive(Clone, Debug)]
 pub(crate) enum Root {
-    /// Exactly this rational (only `0` and `T` are reported this way).
-    Exact(Q),
+    /// Exactly this dyadic (only `0` and `T` are reported this way).
+    Exact(Dy),
     /// The only root of the square-free `p` in the open interval `(lo, hi)`, where `p` does
     /// not vanish at `lo` nor `hi`.
     Isolated {
-        p: std::rc::Rc<QPoly>,
-        lo: Q,
-        hi: Q,
+        p: std::rc::Rc<Vec<BigInt>>,
+        lo: Dy,
+        hi: Dy,
     },
 }
 
+impl Root {
+    fn lower(&self) -> &Dy {
+        match self {
+            Root::Exact(x) => x,
+            Root::Isolated { lo, .. } => lo,
+        }
+    }
+}
+
 /// The distinct real roots of the nonzero `poly` in `[0, t_max]`, in increasing order.
-pub(crate) fn roots(poly: &Poly, t_max: &Q) -> Vec<Root> {
+pub(crate) fn roots(poly: &Poly, t_max: &Dy) -> Vec<Root> {
     let mut out = Vec::new();
     if poly.0.len() <= 1 {
         return out; // a nonzero constant (or zero, which the caller never passes)
     }
-    let q = to_q(poly);
-    // Square-free part, monic.
-    let g = qgcd(&q, &qderiv(&q));
-    let mut p = monic(qdivrem(&q, &g).0);
-    let zero = Q::zero();
-    let at_zero = qsign(&p, &zero) == 0;
+    // Square-free part.
+    let q = primitive(poly.0.clone());
+    let g = pgcd(&q, &deriv(&q));
+    let mut p = if g.len() > 1 { pdiv_exact(&q, &g) } else { q };
+    let zero = Dy::zero();
+    let at_zero = sign_at_dy(&p, &zero) == 0;
     if at_zero {
         out.push(Root::Exact(zero.clone()));
-        // p = t * p' with p'(0) != 0 (p is square-free).
-        p = qdivrem(&p, &vec![Q::zero(), Q::one()]).0;
+        p.remove(0); // p = t p', p'(0) != 0 (p is square-free)
     }
-    if t_max.is_zero() {
+    if t_max.n.is_zero() {
         return out;
     }
-    let at_end = qsign(&p, t_max) == 0;
+    let at_end = sign_at_dy(&p, t_max) == 0;
     if at_end {
-        p = qdivrem(&p, &vec![-t_max.clone(), Q::one()]).0;
+        // Divide by the primitive (2^k t - n).
+        let lin = vec![-t_max.n.clone(), BigInt::one() << t_max.k as usize];
+        p = pdiv_exact(&p, &lin);
     }
     if p.len() > 1 {
-        let sturm = srs(&p, &qderiv(&p));
+        let sturm = srs(&p, &deriv(&p));
         let p = std::rc::Rc::new(p);
         isolate(&p, &sturm, zero, t_max.clone(), &mut out);
     }
@@ -271,7 +376,7 @@ pub(crate) fn roots(poly: &Poly, t_max: &Q) -> Vec<Root> {
 }
 
 /// Appends the roots of `p` in `(lo, hi)` (neither a root), in increasing order.
-fn isolate(p: &std::rc::Rc<QPoly>, sturm: &[QPoly], lo: Q, hi: Q, out: &mut Vec<Root>) {
+fn isolate(p: &std::rc::Rc<Vec<BigInt>>, sturm: &[Vec<BigInt>], lo: Dy, hi: Dy, out: &mut Vec<Root>) {
     let count = variations(sturm, &lo) - variations(sturm, &hi);
     debug_assert!(count >= 0);
     if count == 0 {
@@ -285,13 +390,12 @@ fn isolate(p: &std::rc::Rc<QPoly>, sturm: &[QPoly], lo: Q, hi: Q, out: &mut Vec<
         });
         return;
     }
-    // Split at a point that is not a root: of 1/2, 3/8, 5/8, 1/4, 3/4, ... of the way
-    // (more candidates than p has roots), the first that is not one.
-    let w = &hi - &lo;
+    // Split at a point that is not a root: of 1/2, 3/8, 5/8, 1/4, 3/4, 1/8, 7/8, ... of the
+    // way (more candidates than p has roots), the first that is not one.
     let mut split = None;
-    for k in [4, 3, 5, 2, 6, 1, 7, 9, 11, 13, 15] {
-        let m = &lo + &w * Q::new(BigInt::from(k), BigInt::from(if k < 8 { 8 } else { 16 }));
-        if qsign(p, &m) != 0 {
+    for (num, den) in [(8, 4), (3, 3), (5, 3), (1, 2), (3, 2), (1, 3), (7, 3), (9, 4), (11, 4), (13, 4), (15, 4)] {
+        let m = lo.lerp(&hi, num, den);
+        if sign_at_dy(p, &m) != 0 {
             split = Some(m);
             break;
         }
@@ -304,36 +408,36 @@ fn isolate(p: &std::rc::Rc<QPoly>, sturm: &[QPoly], lo: Q, hi: Q, out: &mut Vec<
 /// The sign of `s` at the root.
 fn sign_at(s: &Poly, root: &Root) -> i8 {
     match root {
-        Root::Exact(x) => qsign(&to_q(s), x),
+        Root::Exact(x) => sign_at_dy(&s.0, x),
         Root::Isolated { p, lo, hi } => {
             if s.is_zero() {
                 return 0;
             }
             // Sturm-Tarski: Var(SRS(p, p' s); lo, hi) = sum over the roots r of p in
-            // (lo, hi] of sign(s(r)); there is exactly one, and s may be reduced mod p.
-            let s = qdivrem(&to_q(s), p).1;
-            if s.is_empty() {
+            // (lo, hi] of sign(s(r)); there is exactly one, and s may be replaced by its
+            // remainder mod p (here a multiple of known sign).
+            let (r, m) = prem(&s.0, p);
+            if r.is_empty() {
                 return 0;
             }
-            let seq = srs(p, &qmul(&qderiv(p), &s));
+            let seq = srs(p, &pmul(&deriv(p), &r));
             let taq = variations(&seq, lo) - variations(&seq, hi);
             debug_assert!((-1..=1).contains(&taq));
-            taq.signum() as i8
+            taq.signum() as i8 * m
         }
     }
 }
 
-/// A lower bound of the root, at most `tol` below it (an exact root is itself).
-fn lower_bound(root: &Root, tol: &Q) -> Q {
+/// A lower bound of the root, at most `2^-tol_log2` below it (an exact root is itself).
+fn lower_bound(root: &Root, tol_log2: u64) -> Dy {
     match root {
         Root::Exact(x) => x.clone(),
         Root::Isolated { p, lo, hi } => {
             let (mut lo, mut hi) = (lo.clone(), hi.clone());
-            let s_lo = qsign(p, &lo);
-            let two = Q::from_integer(BigInt::from(2));
-            while &hi - &lo > *tol {
-                let m = (&lo + &hi) / &two;
-                let s = qsign(p, &m);
+            let s_lo = sign_at_dy(p, &lo);
+            while !lo.within(&hi, tol_log2) {
+                let m = lo.lerp(&hi, 1, 1);
+                let s = sign_at_dy(p, &m);
                 if s == 0 {
                     return m;
                 }
@@ -381,12 +485,6 @@ pub(crate) struct Formula {
     pub clauses: Vec<Vec<(usize, Cond)>>,
 }
 
-/// The time-of-impact tolerance: the earliest solution is returned as a lower bound at most
-/// this much below it (before rounding to f64).
-pub(crate) fn tolerance() -> Q {
-    Q::new(BigInt::one(), BigInt::one() << super::TOI_TOL_LOG2)
-}
-
 /// The earliest `t` in `[0, t_max]` where the formula holds, as a lower bound at most
 /// `tolerance()` below it; None if it holds nowhere there.
 ///
@@ -398,7 +496,14 @@ pub(crate) fn tolerance() -> Q {
 /// polynomials every sign, hence the clause, is locally constant, so it is a root of one
 /// of them. Checking the whole formula at every candidate of every clause and keeping the
 /// least that holds therefore yields min S.
-pub(crate) fn earliest(formula: &Formula, t_max: &Q) -> Option<Q> {
+///
+/// Open clauses: if every condition of clause c is strict (or holds identically), S_c is
+/// open in [0, t_max]. Let t* = min S > 0. Were t* only in open clauses' sets, one of them
+/// would hold on a neighbourhood of t*, below t* too: so t* lies in a clause that is not
+/// open, and is that clause's minimum. Open clauses therefore only need the candidate 0.
+/// (Coplanar motion is the case: with f identically 0, "strictly inside" and "properly
+/// crossing" are open, and the first contact is on an edge or at an endpoint.)
+pub(crate) fn earliest(formula: &Formula, t_max: &Dy) -> Option<Dy> {
     let n = formula.polys.len();
     // Which candidate groups: Some(j) = the roots of polynomial j; None = the point 0.
     let mut groups: Vec<Option<usize>> = Vec::new();
@@ -408,6 +513,16 @@ pub(crate) fn earliest(formula: &Formula, t_max: &Q) -> Option<Q> {
         }
     };
     for clause in &formula.clauses {
+        // A clause whose conditions are all strict inequalities (or hold identically) has
+        // an open solution set: its infimum, if > 0, lies outside it but in S, hence in
+        // another clause, so it only contributes the candidate 0 (see below).
+        let open = clause.iter().all(|&(j, c)| {
+            matches!(c, Cond::Pos | Cond::Neg) || formula.polys[j].is_zero()
+        });
+        if open {
+            push(None);
+            continue;
+        }
         let eq = clause
             .iter()
             .find(|(j, c)| *c == Cond::Zero && !formula.polys[*j].is_zero());
@@ -423,8 +538,8 @@ pub(crate) fn earliest(formula: &Formula, t_max: &Q) -> Option<Q> {
             }
         }
     }
-    let tol = tolerance();
-    let mut best: Option<Q> = None;
+    let tol = super::TOI_TOL_LOG2 as u64;
+    let mut best: Option<Dy> = None;
     let holds_at = |root: &Root| -> bool {
         let mut signs: Vec<Option<i8>> = vec![None; n];
         formula.clauses.iter().any(|clause| {
@@ -436,23 +551,17 @@ pub(crate) fn earliest(formula: &Formula, t_max: &Q) -> Option<Q> {
     };
     for g in groups {
         let cands = match g {
-            None => vec![Root::Exact(Q::zero())],
+            None => vec![Root::Exact(Dy::zero())],
             Some(j) => roots(&formula.polys[j], t_max),
         };
         for root in cands {
             // Candidates of one group come in increasing order: past the best, stop.
-            if let Some(b) = &best {
-                let lo = match &root {
-                    Root::Exact(x) => x,
-                    Root::Isolated { lo, .. } => lo,
-                };
-                if lo >= b {
-                    break;
-                }
+            if best.as_ref().is_some_and(|b| root.lower().cmp(b).is_ge()) {
+                break;
             }
             if holds_at(&root) {
-                let lb = lower_bound(&root, &tol);
-                if best.as_ref().is_none_or(|b| lb < *b) {
+                let lb = lower_bound(&root, tol);
+                if best.as_ref().is_none_or(|b| lb.cmp(b).is_lt()) {
                     best = Some(lb);
                 }
                 break;
@@ -460,26 +569,6 @@ pub(crate) fn earliest(formula: &Formula, t_max: &Q) -> Option<Q> {
         }
     }
     best
-}
-
-/// The largest f64 not above `q` (`q` in [0, 1]).
-pub(crate) fn round_down(q: &Q) -> f64 {
-    debug_assert!(!q.is_negative());
-    if q.is_zero() {
-        return 0.0;
-    }
-    // floor(q * 2^80) / 2^80 is within 2^-80 below q; then step to the exact answer.
-    let k = 80u32;
-    let scaled: BigInt = (q.numer() << k).div_floor(q.denom());
-    let mut x = scaled.to_f64().unwrap_or(0.0) * 2f64.powi(-(k as i32));
-    let exact = |x: f64| Q::from_float(x).expect("finite");
-    while x > 0.0 && exact(x) > *q {
-        x = x.next_down();
-    }
-    while exact(x.next_up()) <= *q {
-        x = x.next_up();
-    }
-    x
 }
 
 // ---------------------------------------------------------------------------------------
@@ -711,6 +800,5 @@ pub(crate) fn solve(kind: Kind, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f
             Kind::EdgeEdge => edge_edge_near_formula(&pts, &dd),
         }
     };
-    let t = Q::from_float(t_max).expect("t_max is finite");
-    earliest(&formula, &t).map(|q| round_down(&q))
+    earliest(&formula, &Dy::from_f64(t_max)).map(|t| t.round_down())
 }
