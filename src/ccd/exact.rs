@@ -802,3 +802,30 @@ pub(crate) fn solve(kind: Kind, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f
     };
     earliest(&formula, &Dy::from_f64(t_max)).map(|t| t.round_down())
 }
+
+/// The coplanarity polynomial f of the query (the same as the filter's, up to a positive
+/// power-of-two scale).
+/// For both kinds it is `det(x1 - x0, x2 - x0, x3 - x0)` of the four points in query
+/// order: `det(a - p, b - p, c - p)` and `det(a1 - a0, b0 - a0, b1 - a0)`.
+fn coplanarity(pts: &[V3<Poly>; 4]) -> Poly {
+    let [p, a, b, c] = pts;
+    let (aa, bb, cc) = (ring::sub3(a, p), ring::sub3(b, p), ring::sub3(c, p));
+    ring::dot(&aa, &ring::cross(&bb, &cc))
+}
+
+/// The only root of the coplanarity polynomial in `(s0, s1)`, where it changes sign
+/// (certified by the filter), as a lower bound at most 2^-40 below it.
+pub(crate) fn refine_root(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], s0: f64, s1: f64) -> f64 {
+    let (ints, _) = to_integers(x0, x1, &[]);
+    let f = coplanarity(&moving_points(&ints));
+    let root = Root::Isolated {
+        p: std::rc::Rc::new(f.0),
+        lo: Dy::from_f64(s0),
+        hi: Dy::from_f64(s1),
+    };
+    debug_assert!(match &root {
+        Root::Isolated { p, lo, hi } => sign_at_dy(p, lo) * sign_at_dy(p, hi) < 0,
+        _ => false,
+    });
+    lower_bound(&root, super::TOI_TOL_LOG2 as u64).round_down()
+}

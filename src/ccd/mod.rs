@@ -237,6 +237,7 @@ fn query(
         match verdict {
             filter::Verdict::Miss => None,
             filter::Verdict::Hit(t) => Some(t),
+            filter::Verdict::Refine(lo, hi) => Some(exact::refine_root(x0, x1, lo, hi)),
             filter::Verdict::Unknown => exact::solve(kind, x0, x1, options.t_max, 0.0),
         }
     } else {
