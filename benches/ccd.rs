@@ -25,9 +25,16 @@ fn root() -> PathBuf {
 
 /// num/den as f64, checked exact.
 fn value(num: &str, den: &str) -> f64 {
-    let q = BigRational::new(num.parse::<BigInt>().unwrap(), den.parse::<BigInt>().unwrap());
+    let q = BigRational::new(
+        num.parse::<BigInt>().unwrap(),
+        den.parse::<BigInt>().unwrap(),
+    );
     let x = q.to_f64().unwrap();
-    assert_eq!(BigRational::from_float(x).unwrap(), q, "{num}/{den} is not an f64");
+    assert_eq!(
+        BigRational::from_float(x).unwrap(),
+        q,
+        "{num}/{den} is not an f64"
+    );
     x
 }
 
@@ -107,18 +114,28 @@ fn stats(mut v: Vec<f64>) -> (f64, f64, f64) {
     } else {
         0.5 * (v[v.len() / 2 - 1] + v[v.len() / 2])
     };
-    (med, v.iter().sum::<f64>() / v.len() as f64, *v.last().unwrap())
+    (
+        med,
+        v.iter().sum::<f64>() / v.len() as f64,
+        *v.last().unwrap(),
+    )
 }
 
 fn table(all: &[(String, bool, Vec<Query>)]) {
     let o = CcdOptions::default();
-    println!("{:<42} {:>6} {:>10} {:>10} {:>12}", "set", "n", "median ns", "mean ns", "max ns");
+    println!(
+        "{:<42} {:>6} {:>10} {:>10} {:>12}",
+        "set", "n", "median ns", "mean ns", "max ns"
+    );
     let mut every = Vec::new();
     for (name, vf, qs) in all {
         let ts: Vec<f64> = qs.iter().map(|q| time_one(*vf, q, &o)).collect();
         every.extend_from_slice(&ts);
         let (med, mean, max) = stats(ts);
-        println!("{name:<42} {:>6} {med:>10.0} {mean:>10.0} {max:>12.0}", qs.len());
+        println!(
+            "{name:<42} {:>6} {med:>10.0} {mean:>10.0} {max:>12.0}",
+            qs.len()
+        );
     }
     let n = every.len();
     let (med, mean, max) = stats(every);

@@ -82,7 +82,7 @@ fn vertex_contact_at_the_ends_of_the_step() {
     assert_eq!(ccd::vertex_face(&a, &b, &opts(0.75, 0.0)), Some(0.75));
     vf(a, b, opts(0.5, 0.0), None); // after t_max
     vf(a, b, opts(0.7499999999999999, 0.0), None); // one ulp before the contact
-    // t_max = 0: only the configuration at t = 0 counts.
+                                                   // t_max = 0: only the configuration at t = 0 counts.
     vf(a, b, opts(0.0, 0.0), None);
     let (a, b) = vf_static_tri([0.5, 0.5, 0.0], [9.0, 9.0, 9.0]); // on the hypotenuse at t = 0
     vf(a, b, opts(0.0, 0.0), Some(0.0));
@@ -129,8 +129,18 @@ fn vertex_coplanar_motion() {
     // A rotating plane that carries the vertex along (vertex and triangle in the plane
     // z = s x at every t... here all four points move in the plane y = 0 rotated: the
     // triangle (0,0,0), (1,0,t), (0,1,0) and the vertex (1/4, 1/4, t/4) coplanar for all t).
-    let x0 = [[0.25, 0.25, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let x1 = [[0.25, 0.25, 0.25], [0.0, 0.0, 0.0], [1.0, 0.0, 1.0], [0.0, 1.0, 0.0]];
+    let x0 = [
+        [0.25, 0.25, 0.0],
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let x1 = [
+        [0.25, 0.25, 0.25],
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 1.0],
+        [0.0, 1.0, 0.0],
+    ];
     vf(x0, x1, D, Some(0.0));
 }
 
@@ -139,7 +149,8 @@ fn vertex_and_degenerate_triangles() {
     // Collinear corners on the x axis (a segment from 0 to 2): the vertex crosses it at
     // (1/2, 0, 0) at t = 1/2.
     let seg = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
-    let q = |p0: [f64; 3], p1: [f64; 3]| ([p0, seg[0], seg[1], seg[2]], [p1, seg[0], seg[1], seg[2]]);
+    let q =
+        |p0: [f64; 3], p1: [f64; 3]| ([p0, seg[0], seg[1], seg[2]], [p1, seg[0], seg[1], seg[2]]);
     let (a, b) = q([0.5, 1.0, 0.0], [0.5, -1.0, 0.0]);
     vf(a, b, D, Some(0.5));
     // Crossing the far part (x = 1.5, between b and c: the hull is the segment [0, 2]).
@@ -156,13 +167,26 @@ fn vertex_and_degenerate_triangles() {
     let (a, b) = ([[-1.0; 3], o[0], o[1], o[2]], [[1.0; 3], o[0], o[1], o[2]]);
     vf(a, b, D, Some(0.5));
     // ... or misses it: at t = 1/2 it is at (0, 0, 1/4).
-    let (a, b) = ([[-1.0; 3], o[0], o[1], o[2]], [[1.0, 1.0, 1.5], o[0], o[1], o[2]]);
+    let (a, b) = (
+        [[-1.0; 3], o[0], o[1], o[2]],
+        [[1.0, 1.0, 1.5], o[0], o[1], o[2]],
+    );
     vf(a, b, D, None);
     // A triangle that collapses to a segment at t = 1/2 while the vertex sits on it:
     // corner c goes (0, 1, 0) -> (0, -1, 0), so at t = 1/2 the triangle is the segment
     // [0, 1] of the x axis, and the vertex (1/2, 0, 1 - 2t) reaches it then.
-    let x0 = [[0.5, 0.0, 1.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let x1 = [[0.5, 0.0, -1.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]];
+    let x0 = [
+        [0.5, 0.0, 1.0],
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let x1 = [
+        [0.5, 0.0, -1.0],
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+    ];
     vf(x0, x1, D, Some(0.5));
 }
 
@@ -172,9 +196,19 @@ fn pairs_that_do_not_move() {
     vf(a, a, D, Some(0.0)); // inside, still
     let (a, _) = vf_static_tri([0.25, 0.25, 1e-300], [0.0; 3]);
     vf(a, a, D, None); // just above, still
-    let e = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, -1.0, 0.0], [0.5, 1.0, 0.0]];
+    let e = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, -1.0, 0.0],
+        [0.5, 1.0, 0.0],
+    ];
     ee(e, e, D, Some(0.0)); // crossing, still
-    let e = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, -1.0, 1e-300], [0.5, 1.0, 1e-300]];
+    let e = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, -1.0, 1e-300],
+        [0.5, 1.0, 1e-300],
+    ];
     ee(e, e, D, None);
 }
 
@@ -186,26 +220,47 @@ fn edges_crossing_and_missing() {
     let q = |b0: [[f64; 3]; 2], b1: [[f64; 3]; 2]| -> (Q, Q) {
         ([a[0], a[1], b0[0], b0[1]], [a[0], a[1], b1[0], b1[1]])
     };
-    let (x0, x1) = q([[0.0, -1.0, 1.0], [0.0, 1.0, 1.0]], [[0.0, -1.0, -1.0], [0.0, 1.0, -1.0]]);
+    let (x0, x1) = q(
+        [[0.0, -1.0, 1.0], [0.0, 1.0, 1.0]],
+        [[0.0, -1.0, -1.0], [0.0, 1.0, -1.0]],
+    );
     ee(x0, x1, D, Some(0.5));
     // Same at x = 2: beyond a's end.
-    let (x0, x1) = q([[2.0, -1.0, 1.0], [2.0, 1.0, 1.0]], [[2.0, -1.0, -1.0], [2.0, 1.0, -1.0]]);
+    let (x0, x1) = q(
+        [[2.0, -1.0, 1.0], [2.0, 1.0, 1.0]],
+        [[2.0, -1.0, -1.0], [2.0, 1.0, -1.0]],
+    );
     ee(x0, x1, D, None);
     // At x = 1: through a's endpoint (a T contact).
-    let (x0, x1) = q([[1.0, -1.0, 1.0], [1.0, 1.0, 1.0]], [[1.0, -1.0, -1.0], [1.0, 1.0, -1.0]]);
+    let (x0, x1) = q(
+        [[1.0, -1.0, 1.0], [1.0, 1.0, 1.0]],
+        [[1.0, -1.0, -1.0], [1.0, 1.0, -1.0]],
+    );
     ee(x0, x1, D, Some(0.5));
     // At x = next_up(1): misses by one ulp.
     let x = 1f64.next_up();
-    let (x0, x1) = q([[x, -1.0, 1.0], [x, 1.0, 1.0]], [[x, -1.0, -1.0], [x, 1.0, -1.0]]);
+    let (x0, x1) = q(
+        [[x, -1.0, 1.0], [x, 1.0, 1.0]],
+        [[x, -1.0, -1.0], [x, 1.0, -1.0]],
+    );
     ee(x0, x1, D, None);
     // b's endpoint b0 = (0, 0, 1 - 2t) comes down on a's interior at t = 1/2.
-    let (x0, x1) = q([[0.0, 0.0, 1.0], [0.0, 0.0, 2.0]], [[0.0, 0.0, -1.0], [0.0, 0.0, 0.0]]);
+    let (x0, x1) = q(
+        [[0.0, 0.0, 1.0], [0.0, 0.0, 2.0]],
+        [[0.0, 0.0, -1.0], [0.0, 0.0, 0.0]],
+    );
     ee(x0, x1, D, Some(0.5));
     // Touching at t = 0 (b0 on a), then leaving.
-    let (x0, x1) = q([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]], [[0.0, 0.0, 1.0], [0.0, 0.0, 2.0]]);
+    let (x0, x1) = q(
+        [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+        [[0.0, 0.0, 1.0], [0.0, 0.0, 2.0]],
+    );
     ee(x0, x1, D, Some(0.0));
     // Meeting exactly at t = 1.
-    let (x0, x1) = q([[0.0, -1.0, 1.0], [0.0, 1.0, 1.0]], [[0.0, -1.0, 0.0], [0.0, 1.0, 0.0]]);
+    let (x0, x1) = q(
+        [[0.0, -1.0, 1.0], [0.0, 1.0, 1.0]],
+        [[0.0, -1.0, 0.0], [0.0, 1.0, 0.0]],
+    );
     ee(x0, x1, D, Some(1.0));
     assert_eq!(ccd::edge_edge(&x0, &x1, &D), Some(1.0));
     ee(x0, x1, opts(0.5, 0.0), None);
@@ -219,22 +274,40 @@ fn parallel_and_collinear_edges() {
     };
     // b parallel to a in the plane y = 0, coming down: collinear and overlapping at t = 1/2
     // (coplanar all step: f = 0 identically).
-    let (x0, x1) = q([[-1.0, 0.0, 1.0], [1.0, 0.0, 1.0]], [[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0]]);
+    let (x0, x1) = q(
+        [[-1.0, 0.0, 1.0], [1.0, 0.0, 1.0]],
+        [[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0]],
+    );
     ee(x0, x1, D, Some(0.5));
     // Parallel but offset (y = 1/2): never.
-    let (x0, x1) = q([[-1.0, 0.5, 1.0], [1.0, 0.5, 1.0]], [[-1.0, 0.5, -1.0], [1.0, 0.5, -1.0]]);
+    let (x0, x1) = q(
+        [[-1.0, 0.5, 1.0], [1.0, 0.5, 1.0]],
+        [[-1.0, 0.5, -1.0], [1.0, 0.5, -1.0]],
+    );
     ee(x0, x1, D, None);
     // Collinear on the x axis, b sliding from [3, 4] to [1, 2]: b0 reaches a1 = 1 at t = 1.
-    let (x0, x1) = q([[3.0, 0.0, 0.0], [4.0, 0.0, 0.0]], [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]);
+    let (x0, x1) = q(
+        [[3.0, 0.0, 0.0], [4.0, 0.0, 0.0]],
+        [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]],
+    );
     ee(x0, x1, D, Some(1.0));
     // ... from [4, 5] to [2, 3]: stops short.
-    let (x0, x1) = q([[4.0, 0.0, 0.0], [5.0, 0.0, 0.0]], [[2.0, 0.0, 0.0], [3.0, 0.0, 0.0]]);
+    let (x0, x1) = q(
+        [[4.0, 0.0, 0.0], [5.0, 0.0, 0.0]],
+        [[2.0, 0.0, 0.0], [3.0, 0.0, 0.0]],
+    );
     ee(x0, x1, D, None);
     // ... from [5, 6] to [-3, -2]: b0 = 5 - 8t reaches 1 at t = 1/2.
-    let (x0, x1) = q([[5.0, 0.0, 0.0], [6.0, 0.0, 0.0]], [[-3.0, 0.0, 0.0], [-2.0, 0.0, 0.0]]);
+    let (x0, x1) = q(
+        [[5.0, 0.0, 0.0], [6.0, 0.0, 0.0]],
+        [[-3.0, 0.0, 0.0], [-2.0, 0.0, 0.0]],
+    );
     ee(x0, x1, D, Some(0.5));
     // Collinear and overlapping from the start.
-    let (x0, x1) = q([[0.5, 0.0, 0.0], [3.0, 0.0, 0.0]], [[0.5, 0.0, 0.0], [3.0, 0.0, 0.0]]);
+    let (x0, x1) = q(
+        [[0.5, 0.0, 0.0], [3.0, 0.0, 0.0]],
+        [[0.5, 0.0, 0.0], [3.0, 0.0, 0.0]],
+    );
     ee(x0, x1, D, Some(0.0));
 }
 
@@ -255,8 +328,18 @@ fn zero_length_edges() {
     let x1 = [[0.0; 3], [0.0; 3], [1.0, e, 0.0], [1.0, e, 0.0]];
     ee(x0, x1, D, None);
     // A segment that shrinks to a point while a point passes through its middle.
-    let x0 = [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
-    let x1 = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, -1.0, 0.0]];
+    let x0 = [
+        [-1.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let x1 = [
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, -1.0, 0.0],
+    ];
     ee(x0, x1, D, Some(0.5));
 }
 
@@ -278,8 +361,18 @@ fn exact_scalings_change_nothing() {
         },
         (
             false,
-            [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, -1.0, 1.0], [0.0, 1.0, 1.0]],
-            [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, -1.0, -2.0], [0.0, 1.0, -2.0]],
+            [
+                [-1.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, -1.0, 1.0],
+                [0.0, 1.0, 1.0],
+            ],
+            [
+                [-1.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, -1.0, -2.0],
+                [0.0, 1.0, -2.0],
+            ],
             Some(1.0 / 3.0),
         ),
     ];
@@ -329,14 +422,29 @@ fn minimum_distance() {
     // Already within the distance at t = 0.
     vf(a, b, opts(1.0, 2.0), Some(0.0));
     // Edges: b along y at height z = 1 - t/2, over a on the x axis; distance z.
-    let x0 = [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, -1.0, 1.0], [0.0, 1.0, 1.0]];
-    let x1 = [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.5], [0.0, 1.0, 0.5]];
+    let x0 = [
+        [-1.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, -1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ];
+    let x1 = [
+        [-1.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.5],
+        [0.0, 1.0, 0.5],
+    ];
     ee(x0, x1, D, None);
     ee(x0, x1, opts(1.0, 0.5), Some(1.0));
     ee(x0, x1, opts(1.0, 0.75), Some(0.5));
     ee(x0, x1, opts(1.0, 0.25), None);
     // Parallel edges 0.5 apart, still: within 0.5, not within less.
-    let x0 = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [3.0, 0.5, 0.0]];
+    let x0 = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 0.5, 0.0],
+        [3.0, 0.5, 0.0],
+    ];
     ee(x0, x0, opts(1.0, 0.5), Some(0.0));
     ee(x0, x0, opts(1.0, 0.4999999999999999), None);
     // A contact at delta = 0 is one for any delta, at an earlier or equal time.
@@ -348,11 +456,26 @@ fn minimum_distance() {
 #[test]
 fn invalid_input_is_a_typed_error() {
     assert_eq!(CcdOptions::new(1.5, 0.0), Err(Error::InvalidTimeLimit(1.5)));
-    assert!(matches!(CcdOptions::new(f64::NAN, 0.0), Err(Error::InvalidTimeLimit(_))));
-    assert_eq!(CcdOptions::new(-0.5, 0.0), Err(Error::InvalidTimeLimit(-0.5)));
-    assert_eq!(CcdOptions::new(1.0, -1.0), Err(Error::InvalidMinDistance(-1.0)));
-    assert!(matches!(CcdOptions::new(1.0, f64::INFINITY), Err(Error::InvalidMinDistance(_))));
-    assert!(matches!(CcdOptions::new(1.0, f64::NAN), Err(Error::InvalidMinDistance(_))));
+    assert!(matches!(
+        CcdOptions::new(f64::NAN, 0.0),
+        Err(Error::InvalidTimeLimit(_))
+    ));
+    assert_eq!(
+        CcdOptions::new(-0.5, 0.0),
+        Err(Error::InvalidTimeLimit(-0.5))
+    );
+    assert_eq!(
+        CcdOptions::new(1.0, -1.0),
+        Err(Error::InvalidMinDistance(-1.0))
+    );
+    assert!(matches!(
+        CcdOptions::new(1.0, f64::INFINITY),
+        Err(Error::InvalidMinDistance(_))
+    ));
+    assert!(matches!(
+        CcdOptions::new(1.0, f64::NAN),
+        Err(Error::InvalidMinDistance(_))
+    ));
     assert!(CcdOptions::new(0.0, 0.0).is_ok() && CcdOptions::new(1.0, 1e300).is_ok());
     assert_eq!(CcdOptions::default(), CcdOptions::new(1.0, 0.0).unwrap());
     let (a, mut b) = vf_static_tri([0.25, 0.25, 1.0], [0.25, 0.25, -1.0]);
@@ -362,13 +485,19 @@ fn invalid_input_is_a_typed_error() {
         Err(Error::NonFiniteCcdPoint { point: 6, .. })
     ));
     b[2][1] = f64::INFINITY;
-    assert!(matches!(ccd::try_edge_edge(&a, &b, &D), Err(Error::NonFiniteCcdPoint { point: 6, .. })));
+    assert!(matches!(
+        ccd::try_edge_edge(&a, &b, &D),
+        Err(Error::NonFiniteCcdPoint { point: 6, .. })
+    ));
     let bad = CcdOptions {
         t_max: 2.0,
         min_distance: 0.0,
     };
     let (a, b) = vf_static_tri([0.25, 0.25, 1.0], [0.25, 0.25, -1.0]);
-    assert_eq!(ccd::try_vertex_face(&a, &b, &bad), Err(Error::InvalidTimeLimit(2.0)));
+    assert_eq!(
+        ccd::try_vertex_face(&a, &b, &bad),
+        Err(Error::InvalidTimeLimit(2.0))
+    );
     assert!(ccd::try_vertex_face(&a, &b, &D).unwrap().is_some());
     let msg = Error::NonFiniteCcdPoint {
         point: 3,

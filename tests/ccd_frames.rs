@@ -73,10 +73,18 @@ pub fn read_ply(path: &Path) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
             if let Some(is64) = coord {
                 p[k] = if is64 {
                     let a: [u8; 8] = b.try_into().unwrap();
-                    if little { f64::from_le_bytes(a) } else { f64::from_be_bytes(a) }
+                    if little {
+                        f64::from_le_bytes(a)
+                    } else {
+                        f64::from_be_bytes(a)
+                    }
                 } else {
                     let a: [u8; 4] = b.try_into().unwrap();
-                    (if little { f32::from_le_bytes(a) } else { f32::from_be_bytes(a) }) as f64
+                    (if little {
+                        f32::from_le_bytes(a)
+                    } else {
+                        f32::from_be_bytes(a)
+                    }) as f64
                 };
                 k += 1;
             }
@@ -90,7 +98,11 @@ pub fn read_ply(path: &Path) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
         let mut t = [0u32; 3];
         for v in t.iter_mut() {
             let a: [u8; 4] = take(4).try_into().unwrap();
-            *v = if little { i32::from_le_bytes(a) } else { i32::from_be_bytes(a) } as u32;
+            *v = if little {
+                i32::from_le_bytes(a)
+            } else {
+                i32::from_be_bytes(a)
+            } as u32;
         }
         tris.push(t);
     }
@@ -136,7 +148,10 @@ fn frame_truth_labels_match() {
             total += 1;
             hits += got.is_some() as usize;
             if got.is_some() != label {
-                wrong.push(format!("{name} {} {ids:?}: label {label}, got {got:?}", w[0]));
+                wrong.push(format!(
+                    "{name} {} {ids:?}: label {label}, got {got:?}",
+                    w[0]
+                ));
             }
         }
         println!("{name}: {vf} vf + {ee} ee labels, {hits} colliding");
@@ -146,6 +161,14 @@ fn frame_truth_labels_match() {
         total - wrong.len(),
         start.elapsed().as_secs_f64()
     );
-    assert!(wrong.is_empty(), "{} mismatches:\n{}", wrong.len(), wrong.join("\n"));
-    assert_eq!(total, 4652 + 19313 + 19034 + 94825 + 9460 + 41036 + 801 + 4370);
+    assert!(
+        wrong.is_empty(),
+        "{} mismatches:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
+    assert_eq!(
+        total,
+        4652 + 19313 + 19034 + 94825 + 9460 + 41036 + 801 + 4370
+    );
 }

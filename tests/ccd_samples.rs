@@ -17,13 +17,19 @@ pub fn samples_root() -> PathBuf {
 
 /// The f64 equal to `num/den`; panics unless the rational is exactly an f64.
 pub fn exact_f64(num: &str, den: &str) -> f64 {
-    let q = BigRational::new(num.parse::<BigInt>().unwrap(), den.parse::<BigInt>().unwrap());
+    let q = BigRational::new(
+        num.parse::<BigInt>().unwrap(),
+        den.parse::<BigInt>().unwrap(),
+    );
     if q.is_zero() {
         return 0.0;
     }
     // Reduced: the denominator must be a power of two, the numerator at most 53 bits.
     let d = q.denom();
-    assert!((d & (d - BigInt::one())).is_zero(), "{num}/{den} is not dyadic");
+    assert!(
+        (d & (d - BigInt::one())).is_zero(),
+        "{num}/{den} is not dyadic"
+    );
     let k = d.bits() as i32 - 1;
     let n = q.numer().clone();
     let tz = n.abs().trailing_zeros().unwrap_or(0);
@@ -41,7 +47,11 @@ pub fn exact_f64(num: &str, den: &str) -> f64 {
         x *= 2f64.powi(-s);
         e += s;
     }
-    assert_eq!(BigRational::from_float(x).unwrap(), q, "{num}/{den} is not an f64");
+    assert_eq!(
+        BigRational::from_float(x).unwrap(),
+        q,
+        "{num}/{den} is not an f64"
+    );
     x
 }
 
@@ -89,7 +99,9 @@ pub fn all_samples() -> Vec<(String, &'static str, Vec<Query>)> {
     for f in folders {
         for kind in ["vertex-face", "edge-edge"] {
             let dir = root.join(&f).join(kind);
-            let Ok(rd) = std::fs::read_dir(&dir) else { continue };
+            let Ok(rd) = std::fs::read_dir(&dir) else {
+                continue;
+            };
             let mut files: Vec<_> = rd.filter_map(|e| e.ok()).map(|e| e.path()).collect();
             files.sort();
             let qs: Vec<Query> = files.iter().flat_map(|p| load(p)).collect();
@@ -114,14 +126,22 @@ fn sample_queries_match_ground_truth() {
         assert!(!qs.is_empty());
         for (i, (x0, x1, truth)) in qs.iter().enumerate() {
             let (fast, exact) = if kind == "vertex-face" {
-                (ccd::vertex_face(x0, x1, &opts), ccd::vertex_face_exact(x0, x1, &opts))
+                (
+                    ccd::vertex_face(x0, x1, &opts),
+                    ccd::vertex_face_exact(x0, x1, &opts),
+                )
             } else {
-                (ccd::edge_edge(x0, x1, &opts), ccd::edge_edge_exact(x0, x1, &opts))
+                (
+                    ccd::edge_edge(x0, x1, &opts),
+                    ccd::edge_edge_exact(x0, x1, &opts),
+                )
             };
             total += 1;
             colliding += *truth as usize;
             if fast.is_some() != *truth || exact.is_some() != *truth {
-                wrong.push(format!("{folder}/{kind} #{i}: truth {truth}, got {fast:?} / exact {exact:?}"));
+                wrong.push(format!(
+                    "{folder}/{kind} #{i}: truth {truth}, got {fast:?} / exact {exact:?}"
+                ));
             }
             if let (Some(a), Some(b)) = (fast, exact) {
                 assert!(
@@ -132,7 +152,15 @@ fn sample_queries_match_ground_truth() {
             }
         }
     }
-    println!("sample queries: {} matched of {total} ({colliding} colliding)", total - wrong.len());
-    assert!(wrong.is_empty(), "{} mismatches:\n{}", wrong.len(), wrong.join("\n"));
+    println!(
+        "sample queries: {} matched of {total} ({colliding} colliding)",
+        total - wrong.len()
+    );
+    assert!(
+        wrong.is_empty(),
+        "{} mismatches:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
     assert_eq!(total, 5279);
 }

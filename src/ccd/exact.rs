@@ -98,9 +98,15 @@ impl Dy {
     fn from_f64(x: f64) -> Dy {
         let (m, e) = decompose(x);
         if e >= 0 {
-            Dy { n: m << e as usize, k: 0 }
+            Dy {
+                n: m << e as usize,
+                k: 0,
+            }
         } else {
-            Dy { n: m, k: (-e) as u64 }
+            Dy {
+                n: m,
+                k: (-e) as u64,
+            }
         }
     }
     /// `self + (other - self) * num / 2^den_log2`.
@@ -280,7 +286,11 @@ fn srs(p: &[BigInt], q: &[BigInt]) -> Vec<Vec<BigInt>> {
             return seq;
         }
         // -rem = -s * r up to a positive factor.
-        let r = if s > 0 { r.into_iter().map(|c| -c).collect() } else { r };
+        let r = if s > 0 {
+            r.into_iter().map(|c| -c).collect()
+        } else {
+            r
+        };
         seq.push(primitive(r));
     }
 }
@@ -376,7 +386,13 @@ pub(crate) fn roots(poly: &Poly, t_max: &Dy) -> Vec<Root> {
 }
 
 /// Appends the roots of `p` in `(lo, hi)` (neither a root), in increasing order.
-fn isolate(p: &std::rc::Rc<Vec<BigInt>>, sturm: &[Vec<BigInt>], lo: Dy, hi: Dy, out: &mut Vec<Root>) {
+fn isolate(
+    p: &std::rc::Rc<Vec<BigInt>>,
+    sturm: &[Vec<BigInt>],
+    lo: Dy,
+    hi: Dy,
+    out: &mut Vec<Root>,
+) {
     let count = variations(sturm, &lo) - variations(sturm, &hi);
     debug_assert!(count >= 0);
     if count == 0 {
@@ -393,7 +409,19 @@ fn isolate(p: &std::rc::Rc<Vec<BigInt>>, sturm: &[Vec<BigInt>], lo: Dy, hi: Dy, 
     // Split at a point that is not a root: of 1/2, 3/8, 5/8, 1/4, 3/4, 1/8, 7/8, ... of the
     // way (more candidates than p has roots), the first that is not one.
     let mut split = None;
-    for (num, den) in [(8, 4), (3, 3), (5, 3), (1, 2), (3, 2), (1, 3), (7, 3), (9, 4), (11, 4), (13, 4), (15, 4)] {
+    for (num, den) in [
+        (8, 4),
+        (3, 3),
+        (5, 3),
+        (1, 2),
+        (3, 2),
+        (1, 3),
+        (7, 3),
+        (9, 4),
+        (11, 4),
+        (13, 4),
+        (15, 4),
+    ] {
         let m = lo.lerp(&hi, num, den);
         if sign_at_dy(p, &m) != 0 {
             split = Some(m);
@@ -516,9 +544,9 @@ pub(crate) fn earliest(formula: &Formula, t_max: &Dy) -> Option<Dy> {
         // A clause whose conditions are all strict inequalities (or hold identically) has
         // an open solution set: its infimum, if > 0, lies outside it but in S, hence in
         // another clause, so it only contributes the candidate 0 (see below).
-        let open = clause.iter().all(|&(j, c)| {
-            matches!(c, Cond::Pos | Cond::Neg) || formula.polys[j].is_zero()
-        });
+        let open = clause
+            .iter()
+            .all(|&(j, c)| matches!(c, Cond::Pos | Cond::Neg) || formula.polys[j].is_zero());
         if open {
             push(None);
             continue;
@@ -578,7 +606,11 @@ pub(crate) fn earliest(formula: &Formula, t_max: &Dy) -> Option<Dy> {
 /// `x = sign * mantissa * 2^exp` of a finite f64.
 fn decompose(x: f64) -> (BigInt, i32) {
     let bits = x.to_bits();
-    let sign = if bits >> 63 == 1 { Sign::Minus } else { Sign::Plus };
+    let sign = if bits >> 63 == 1 {
+        Sign::Minus
+    } else {
+        Sign::Plus
+    };
     let exp_bits = ((bits >> 52) & 0x7ff) as i32;
     let frac = bits & ((1u64 << 52) - 1);
     let (mant, exp) = if exp_bits == 0 {
@@ -598,7 +630,11 @@ fn decompose(x: f64) -> (BigInt, i32) {
 
 /// The query's eight points (and `extra` values, e.g. the minimum distance) as integers
 /// after one common exact scaling by a power of two.
-fn to_integers(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], extra: &[f64]) -> (Vec<BigInt>, Vec<BigInt>) {
+fn to_integers(
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    extra: &[f64],
+) -> (Vec<BigInt>, Vec<BigInt>) {
     let vals: Vec<f64> = x0
         .iter()
         .chain(x1.iter())
@@ -614,7 +650,13 @@ fn to_integers(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], extra: &[f64]) -> (Vec<Bi
         .unwrap_or(0);
     let ints: Vec<BigInt> = parts
         .into_iter()
-        .map(|(m, e)| if m.is_zero() { m } else { m << (e - emin) as usize })
+        .map(|(m, e)| {
+            if m.is_zero() {
+                m
+            } else {
+                m << (e - emin) as usize
+            }
+        })
         .collect();
     let (pts, rest) = ints.split_at(24);
     (pts.to_vec(), rest.to_vec())
@@ -662,7 +704,11 @@ pub(crate) fn vertex_face_formula(pts: &[V3<Poly>; 4]) -> Formula {
         cl.push((add(&mut polys, d.clone()), Cond::Pos));
     }
     clauses.push(cl);
-    let dots = [ring::dot(&aa, &bb), ring::dot(&bb, &cc), ring::dot(&cc, &aa)];
+    let dots = [
+        ring::dot(&aa, &bb),
+        ring::dot(&bb, &cc),
+        ring::dot(&cc, &aa),
+    ];
     for (cr, dt) in face.cross.iter().zip(dots) {
         let mut cl = vec![(0, Cond::Zero)];
         cl.extend(on_segment(&mut polys, cr, dt));
@@ -681,7 +727,11 @@ pub(crate) fn edge_edge_formula(pts: &[V3<Poly>; 4]) -> Formula {
     for (p, s0, s1) in [(a0, b0, b1), (a1, b0, b1), (b0, a0, a1), (b1, a0, a1)] {
         let (aa, bb) = (ring::sub3(s0, p), ring::sub3(s1, p));
         let mut cl = vec![(0, Cond::Zero)];
-        cl.extend(on_segment(&mut polys, &ring::cross(&aa, &bb), ring::dot(&aa, &bb)));
+        cl.extend(on_segment(
+            &mut polys,
+            &ring::cross(&aa, &bb),
+            ring::dot(&aa, &bb),
+        ));
         clauses.push(cl);
     }
     Formula { polys, clauses }
@@ -694,7 +744,12 @@ fn norm2(v: &V3<Poly>) -> Poly {
 /// Clauses "point p within sqrt(dd) of the closed segment [a, b]" (`A = a - p`,
 /// `B = b - p`): an endpoint within the distance, or the foot of the perpendicular inside
 /// the (non-degenerate) segment and the distance to the line within it.
-fn near_segment(polys: &mut Vec<Poly>, aa: &V3<Poly>, bb: &V3<Poly>, dd: &Poly) -> Vec<Vec<(usize, Cond)>> {
+fn near_segment(
+    polys: &mut Vec<Poly>,
+    aa: &V3<Poly>,
+    bb: &V3<Poly>,
+    dd: &Poly,
+) -> Vec<Vec<(usize, Cond)>> {
     let e = ring::sub3(bb, aa);
     let le = norm2(&e);
     let cr = ring::cross(aa, bb);
@@ -726,7 +781,10 @@ pub(crate) fn vertex_face_near_formula(pts: &[V3<Poly>; 4], dd: &Poly) -> Formul
     let mut polys = Vec::new();
     let nn = norm2(&face.n);
     let plane = face.f.mul(&face.f).sub(&dd.mul(&nn));
-    let mut cl = vec![(add(&mut polys, nn), Cond::Pos), (add(&mut polys, plane), Cond::NonPos)];
+    let mut cl = vec![
+        (add(&mut polys, nn), Cond::Pos),
+        (add(&mut polys, plane), Cond::NonPos),
+    ];
     for d in face.d.iter() {
         cl.push((add(&mut polys, d.clone()), Cond::NonNeg));
     }
@@ -784,7 +842,13 @@ pub(crate) enum Kind {
 }
 
 /// The exact earliest contact time (rounded down to f64, at most the tolerance early).
-pub(crate) fn solve(kind: Kind, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64, min_distance: f64) -> Option<f64> {
+pub(crate) fn solve(
+    kind: Kind,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    t_max: f64,
+    min_distance: f64,
+) -> Option<f64> {
     let (ints, extra) = to_integers(x0, x1, &[min_distance]);
     let pts = moving_points(&ints);
     let formula = if min_distance == 0.0 {

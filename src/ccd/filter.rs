@@ -210,7 +210,8 @@ struct RootIv {
 /// Isolates the roots of f in [0, 1] (in increasing order) or fails.
 fn isolate(p: &Piece, depth: u32, out: &mut [RootIv; 3], n: &mut usize) -> bool {
     let [c0, c1, c2, c3] = p.c;
-    if c0.pos() && c1.pos() && c2.pos() && c3.pos() || c0.neg() && c1.neg() && c2.neg() && c3.neg() {
+    if c0.pos() && c1.pos() && c2.pos() && c3.pos() || c0.neg() && c1.neg() && c2.neg() && c3.neg()
+    {
         return true;
     }
     let (e0, e1, e2) = (c1.sub(&c0), c2.sub(&c1), c3.sub(&c2));
@@ -277,13 +278,7 @@ fn ee_static(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t: Iv) -> Option<bool> {
 
 /// Stages 1 and 2 on the difference vectors.
 #[inline(always)]
-fn decide(
-    x0: &[[f64; 3]; 4],
-    x1: &[[f64; 3]; 4],
-    d: &Diffs,
-    t_max: f64,
-    test: Static,
-) -> Verdict {
+fn decide(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], d: &Diffs, t_max: f64, test: Static) -> Verdict {
     let Some((b, e)) = bernstein(d) else {
         return Verdict::Unknown;
     };
@@ -314,7 +309,11 @@ fn roots_and_test(
         sign0: 0,
     }; 3];
     let mut n = 0;
-    let whole = Piece { s0: 0.0, s1: 1.0, c };
+    let whole = Piece {
+        s0: 0.0,
+        s1: 1.0,
+        c,
+    };
     if !isolate(&whole, 0, &mut found, &mut n) {
         return Verdict::Unknown;
     }
