@@ -130,8 +130,8 @@ fn bernstein(d: &Diffs) -> Option<([f64; 4], f64)> {
             }
         }
     }
-    // NaN-safe: a NaN difference fails this too (max ignores NaN, so check every value).
-    if !(m <= MAX_MAGNITUDE) || d.iter().flatten().flatten().any(|x| x.is_nan()) {
+    // `max` ignores NaN, so a NaN difference (inf - inf) is looked for on its own.
+    if m > MAX_MAGNITUDE || d.iter().flatten().flatten().any(|x| x.is_nan()) {
         return None;
     }
     let [[p0, q0, r0], [p1, q1, r1]] = d;

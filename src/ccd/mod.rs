@@ -182,14 +182,9 @@ pub fn check_points(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> Result<()> {
 
 #[inline(always)]
 fn all_finite(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> bool {
-    // x - x is 0 for finite x and NaN otherwise; one comparison for all.
-    let mut s = 0.0;
-    for p in x0.iter().chain(x1.iter()) {
-        for &c in p {
-            s += c - c;
-        }
-    }
-    s == 0.0
+    x0.iter()
+        .chain(x1.iter())
+        .all(|p| p.iter().all(|c| c.is_finite()))
 }
 
 /// Vertex-face CCD: `x0 = [v, f0, f1, f2]` at t = 0 and `x1` the same points at t = 1.
