@@ -506,3 +506,28 @@ fn invalid_input_is_a_typed_error() {
     .to_string();
     assert!(msg.contains("point 3") && !msg.contains('\n'));
 }
+
+#[test]
+fn minimum_distance_filter_agrees_with_the_exact_path() {
+    // The delta > 0 filter only rejects: on the first queries of every sample set, at
+    // three distances, the filtered entry equals the exact path alone.
+    let mut counts = [0usize; 2];
+    for delta in [1e-6, 1e-3, 0.1] {
+        let o = opts(1.0, delta);
+        for (_, kind, qs) in super::ccd_samples::all_samples() {
+            for (x0, x1, _) in qs.iter().take(8) {
+                let (a, b) = if kind == "vertex-face" {
+                    (
+                        ccd::vertex_face(x0, x1, &o),
+                        ccd::vertex_face_exact(x0, x1, &o),
+                    )
+                } else {
+                    (ccd::edge_edge(x0, x1, &o), ccd::edge_edge_exact(x0, x1, &o))
+                };
+                assert_eq!(a, b, "{kind} delta {delta}: {x0:?} -> {x1:?}");
+                counts[a.is_some() as usize] += 1;
+            }
+        }
+    }
+    assert!(counts[0] > 0 && counts[1] > 0, "{counts:?}");
+}
