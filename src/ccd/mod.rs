@@ -16,10 +16,10 @@
 //!   collinear edges, contact at exactly t = 0 or t = t_max, pairs that do not move,
 //!   touching without crossing.
 //! - **Time of impact**: `Some(toi)` with `toi <= t*`, the true earliest contact time, and
-//!   `t* - toi <= `[`TOI_TOLERANCE`]` = 1e-12` (the root is isolated to an interval of width
-//!   `<= 2^-40 ~ 9.1e-13` and its lower end rounded down to f64). `toi = 0` exactly when the
-//!   pair already touches at t = 0; `toi = t*` exactly when `t*` is 0 or `t_max` or the
-//!   root lands exactly on a bisection point.
+//!   `t* - toi <= 1e-12` ([`TOI_TOLERANCE`]): the root is isolated to an interval of width
+//!   `<= 2^-40 ~ 9.1e-13` and its lower end rounded down to f64. `toi = 0` exactly when the
+//!   pair already touches at t = 0; `toi = t_max` exactly when the first contact is at
+//!   `t_max` (a root at 0 or `t_max` is found by exact evaluation, never approximated).
 //! - Invalid options (`t_max` outside `[0, 1]` or NaN, `min_distance` negative or not
 //!   finite) and non-finite coordinates are typed errors of [`CcdOptions::new`],
 //!   [`check_points`] and the `try_*` entries ([`try_vertex_face`], [`try_edge_edge`]). The
