@@ -4,9 +4,6 @@
 //! Ids:
 //! - `frame/<scene>/<impl>`: a whole step, `impl` in `dhcd-dh`, `dhcd-sphere`, `dhcd-aabb`,
 //!   `parry3d`, plus `dhcd-dh-t1` / `dhcd-dh-t2` on `pawns8` (the `Scene` API, one `Scene::step` a frame: object pairs in parallel, `Par::Rayon(1)` / `Rayon(2)`),
-//!   and `dhcd-dh-front` / `dhcd-aabb-front` (each pair's workspace with front tracking:
-//!   every query starts from the last one's traversal front; the setup prints the BV tests,
-//!   refits and triangle pairs of one cycle from the root and from the front);
 //! - `hier/<scene>/<impl>`: refit + traversal down to leaf pairs only (no triangle tests;
 //!   for dhcd `broad_phase`, which also refreshes the leaves' cached triangle boxes);
 //! - `narrow/<scene>/dhcd-dh`: the exact narrow phase alone on the leaf pairs of a frame
@@ -27,7 +24,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
-use dhcd::traverse::{broad_phase, narrow_phase};
+use dhcd::{broad_phase, narrow_phase};
 use dhcd::{collide_with, Counters, Hierarchy, Mesh, Method, ObjectId, Options, Par, Workspace};
 use parry3d::bounding_volume::Aabb as PAabb;
 use parry3d::math::{Pose, Vector};
@@ -146,27 +143,23 @@ fn two_mut<T>(v: &mut [T], i: usize, j: usize) -> (&mut T, &mut T) {
 
 struct DhcdWorld<K: BvKind> {
     hs: Vec<Hierarchy<K>>,
-    ws: Vec<Workspace>,
+    ws: Workspace,
+    /// Each pair's overlapping leaf pairs of the last [`DhcdWorld::hier`].
+    leaves: Vec<Vec<[u32; 2]>>,
 }
 
 impl<K: BvKind> DhcdWorld<K> {
-    /// `front`: each pair's workspace tracks its traversal front.
-    fn new(scene: &Scene, front: bool) -> Self {
+    fn new(scene: &Scene) -> Self {
         let hs = scene
             .meshes
             .iter()
             .map(|m| Hierarchy::<K>::new(m, Options::default()).expect("hierarchy"))
             .collect();
-        let ws = scene
-            .pairs
-            .iter()
-            .map(|_| {
-                let mut ws = Workspace::default();
-                ws.set_front_tracking(front);
-                ws
-            })
-            .collect();
-        Self { hs, ws }
+        Self {
+            hs,
+            ws: Workspace::default(),
+            leaves: vec![Vec::new(); scene.pairs.len()],
+        }
     }
 
     fn apply(&mut self, scene: &Scene, f: usize) {
@@ -185,8 +178,7 @@ impl<K: BvKind> DhcdWorld<K> {
     ) {
         self.apply(scene, f);
         for (k, &(i, j)) in scene.pairs.iter().enumerate() {
-            let (a, b) = two_mut(&mut self.hs, i, j);
-            let c = collide_with(a, b, &mut self.ws[k], par);
+            let c = collide_with(&self.hs[i], &self.hs[j], &mut self.ws, par);
             sink(k, &c);
         }
     }
@@ -196,8 +188,9 @@ impl<K: BvKind> DhcdWorld<K> {
         self.apply(scene, f);
         let mut n = 0;
         for (k, &(i, j)) in scene.pairs.iter().enumerate() {
-            let (a, b) = two_mut(&mut self.hs, i, j);
-            n += broad_phase(a, b, &mut self.ws[k], Par::Seq).prim_tests;
+            let b = broad_phase(&self.hs[i], &self.hs[j], &mut self.ws, Par::Seq);
+            n += b.counters.prim_tests;
+            self.leaves[k] = b.leaf_pairs;
         }
         n
     }
@@ -286,9 +279,9 @@ fn check(scene: &Scene) {
     } else {
         &[0, 5, 11]
     };
-    let mut dh = DhcdWorld::<Dh>::new(scene, false);
-    let mut sp = DhcdWorld::<Sphere>::new(scene, false);
-    let mut bx = DhcdWorld::<Aabb>::new(scene, false);
+    let mut dh = DhcdWorld::<Dh>::new(scene);
+    let mut sp = DhcdWorld::<Sphere>::new(scene);
+    let mut bx = DhcdWorld::<Aabb>::new(scene);
     let mut parry = ParryWorld::new(scene);
     let mut totals = [Counters::default(); 3];
     let mut parry_total = 0u64;
@@ -307,7 +300,7 @@ fn check(scene: &Scene) {
             totals[2] += c.counters;
         });
         // Threads give the same contacts and counters.
-        let mut dh2 = DhcdWorld::<Dh>::new(scene, false);
+        let mut dh2 = DhcdWorld::<Dh>::new(scene);
         dh2.step(scene, f, Par::Rayon(2), |k, c| {
             assert_eq!(c.pairs, got[0][k])
         });
@@ -357,8 +350,8 @@ fn check(scene: &Scene) {
     );
 }
 
-fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par, front: bool) {
-    let mut w = DhcdWorld::<K>::new(scene, front);
+fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
+    let mut w = DhcdWorld::<K>::new(scene);
     let mut f = 0;
     c.bench_function(&format!("frame/{}/{id}", scene.name), |b| {
         b.iter(|| {
@@ -368,44 +361,6 @@ fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par, f
             black_box(n)
         })
     });
-}
-
-/// Prints the work of one cycle (after one to settle) from the root and from the front, and
-/// asserts both find the same contacts.
-fn front_counters<K: BvKind>(scene: &Scene) {
-    let sum = |front: bool| {
-        let mut w = DhcdWorld::<K>::new(scene, front);
-        let mut contacts = Vec::new();
-        let mut total = Counters::default();
-        for cycle in 0..2 {
-            for f in 0..FRAMES {
-                w.step(scene, f, Par::Seq, |_, c| {
-                    if cycle == 1 {
-                        total += c.counters;
-                        contacts.push(c.pairs.clone());
-                    }
-                });
-            }
-        }
-        (total, contacts)
-    };
-    let ((root, want), (front, got)) = (sum(false), sum(true));
-    assert!(
-        got == want,
-        "[{}] contacts from the front differ",
-        scene.name
-    );
-    eprintln!(
-        "[{}] {:?}, one cycle from the root / from the front: BV tests {} / {}, BV updates {} / {}, triangle pairs {} / {}",
-        scene.name,
-        K::METHOD,
-        root.bv_tests,
-        front.bv_tests,
-        root.bv_updates,
-        front.bv_updates,
-        root.prim_tests,
-        front.prim_tests
-    );
 }
 
 fn bench_scene(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
@@ -437,13 +392,9 @@ fn frame(c: &mut Criterion) {
         if checks {
             check(scene);
         }
-        bench_kind::<Dh>(c, scene, "dhcd-dh", Par::Seq, false);
-        bench_kind::<Sphere>(c, scene, "dhcd-sphere", Par::Seq, false);
-        bench_kind::<Aabb>(c, scene, "dhcd-aabb", Par::Seq, false);
-        front_counters::<Dh>(scene);
-        front_counters::<Aabb>(scene);
-        bench_kind::<Dh>(c, scene, "dhcd-dh-front", Par::Seq, true);
-        bench_kind::<Aabb>(c, scene, "dhcd-aabb-front", Par::Seq, true);
+        bench_kind::<Dh>(c, scene, "dhcd-dh", Par::Seq);
+        bench_kind::<Sphere>(c, scene, "dhcd-sphere", Par::Seq);
+        bench_kind::<Aabb>(c, scene, "dhcd-aabb", Par::Seq);
         let mut p = ParryWorld::new(scene);
         let mut f = 0;
         c.bench_function(&format!("frame/{}/parry3d", scene.name), |b| {
@@ -461,7 +412,7 @@ fn frame(c: &mut Criterion) {
             bench_scene(c, scene, "dhcd-dh-t2", Par::Rayon(2));
         }
 
-        let mut w = DhcdWorld::<Dh>::new(scene, false);
+        let mut w = DhcdWorld::<Dh>::new(scene);
         c.bench_function(&format!("hier/{}/dhcd-dh", scene.name), |b| {
             b.iter(|| {
                 f = (f + 1) % FRAMES;
@@ -482,7 +433,7 @@ fn frame(c: &mut Criterion) {
                     w.hier(scene, f);
                     let start = Instant::now();
                     for (k, &(i, j)) in scene.pairs.iter().enumerate() {
-                        let r = narrow_phase(&w.hs[i], &w.hs[j], w.ws[k].leaf_pairs(), Par::Seq)
+                        let r = narrow_phase(&w.hs[i], &w.hs[j], &w.leaves[k], Par::Seq)
                             .expect("leaf pairs of this frame");
                         black_box(r);
                     }

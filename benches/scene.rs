@@ -42,13 +42,8 @@ fn bench(c: &mut Criterion) {
     let (ball, poses) = poses();
     let mut g = c.benchmark_group("scene_step_8_balls_5120_tris");
     g.sample_size(20);
-    for (name, par, front) in [
-        ("scene_seq", Par::Seq, false),
-        ("scene_rayon2", Par::Rayon(2), false),
-        ("scene_seq_front", Par::Seq, true),
-    ] {
+    for (name, par) in [("scene_seq", Par::Seq), ("scene_rayon2", Par::Rayon(2))] {
         let mut scene = Scene::new(Method::Dh, Options::default());
-        scene.set_front_tracking(front);
         for _ in 0..OBJECTS {
             scene.add(&ball).unwrap();
         }
@@ -91,7 +86,7 @@ fn bench(c: &mut Criterion) {
             let mut n = 0;
             for &(i, j) in &pairs {
                 let (lo, hi) = hs.split_at_mut(j);
-                n += collide_with(&mut lo[i], &mut hi[0], &mut ws, Par::Rayon(2))
+                n += collide_with(&lo[i], &hi[0], &mut ws, Par::Rayon(2))
                     .pairs
                     .len();
             }

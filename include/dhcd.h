@@ -173,28 +173,6 @@ void dhcd_hierarchy_free(struct DhcdHierarchy *h);
 int dhcd_hierarchy_method(const struct DhcdHierarchy *h, int *out);
 
 /**
- * Frame-to-frame coherence, off by default: with `on` nonzero, each query through this
- * handle's scratch (`dhcd_self_collide(h, ...)`, `dhcd_collide(h, b, ...)`) keeps where its
- * traversal stopped, and the next query of the same kind on the same objects starts there
- * instead of at the roots. The contacts are exactly the same; the work differs (less on
- * many deforming meshes, not faster on the meshes measured so far: docs/PERFORMANCE.md).
- * One front per handle: any other query through it (self after pair, another object, the
- * two handles swapped) restarts from the roots. `on == 0` drops the kept front.
- *
- * # Safety
- * `h` null or a live handle.
- */
-int dhcd_hierarchy_set_front_tracking(struct DhcdHierarchy *h, int on);
-
-/**
- * Whether front tracking is on (1) or off (0) for this handle, into `*out`.
- *
- * # Safety
- * `h` null or a live handle; `out` null or valid for a write.
- */
-int dhcd_hierarchy_front_tracking(const struct DhcdHierarchy *h, int *out);
-
-/**
  * New positions of the mesh (`3 * vertex_count` floats, the mesh's vertex order and
  * count). On error the hierarchy is unchanged.
  *
@@ -331,27 +309,6 @@ int dhcd_scene_update_many(struct DhcdScene *s,
  * `s` null or a live handle.
  */
 int dhcd_scene_set_self_collision(struct DhcdScene *s, uint64_t id, int on);
-
-/**
- * Frame-to-frame coherence for the whole scene, off by default: with `on` nonzero, each
- * object pair's query (and each self query) keeps where its traversal stopped, and the next
- * `dhcd_scene_contacts` starts that pair there. The contacts are exactly the same; the work
- * differs (fewer node tests on many meshes, not faster on the meshes measured so far:
- * docs/PERFORMANCE.md). A pair that stops overlapping, or an object removed, drops its
- * front; `on == 0` drops them all.
- *
- * # Safety
- * `s` null or a live handle.
- */
-int dhcd_scene_set_front_tracking(struct DhcdScene *s, int on);
-
-/**
- * Whether front tracking is on (1) or off (0) for the scene, into `*out`.
- *
- * # Safety
- * `s` null or a live handle; `out` null or valid for a write.
- */
-int dhcd_scene_front_tracking(const struct DhcdScene *s, int *out);
 
 /**
  * Every contact of the scene's current poses into `*out` (release with

@@ -4,17 +4,17 @@
 use std::sync::Arc;
 
 use crate::bv::Method;
-use crate::counters::Counters;
 use crate::error::Result;
 use crate::hierarchy::{Hierarchy, InvariantError, Options};
 use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, Precision};
 use crate::par::Par;
-use crate::traverse::{
-    broad_phase, collide_with, narrow_phase, self_broad_phase, self_collide_with, Contacts,
-    Workspace,
+use crate::query::{
+    broad_phase, collide_with, narrow_phase, proximity_with, self_broad_phase, self_collide_with,
+    self_proximity_with, BroadPhase, Contacts, Proximity,
 };
 use crate::tree::RegionTree;
+use crate::walk::Workspace;
 
 kinds!(crate::kinds::kind_enum {
     /// A hierarchy of a kind chosen at run time: one variant per row of the table of kinds
@@ -54,8 +54,19 @@ impl AnyHierarchy {
         Ok(with_kind!(method, K => Hierarchy::<K>::with_tree(tree, mesh, options)?.into()))
     }
 
-    pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {
+    /// See [`Hierarchy::update_positions`]: the number of volumes refitted now.
+    pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<u64> {
         each!(self, h => h.update_positions(positions))
+    }
+
+    /// See [`Hierarchy::update_positions_f64`].
+    pub fn update_positions_f64(&mut self, positions: &[[f64; 3]]) -> Result<u64> {
+        each!(self, h => h.update_positions_f64(positions))
+    }
+
+    /// The precision of the positions the hierarchy was built from and takes.
+    pub fn precision(&self) -> Precision {
+        each!(self, h => h.precision())
     }
 
     pub fn validate(&self) -> std::result::Result<usize, InvariantError> {
@@ -79,18 +90,31 @@ impl AnyHierarchy {
     }
 
     /// Contacts between two hierarchies of the same kind; an error if the kinds differ.
-    pub fn collide(
-        &mut self,
-        other: &mut AnyHierarchy,
-        ws: &mut Workspace,
-        par: Par,
-    ) -> Result<Contacts> {
+    pub fn collide(&self, other: &AnyHierarchy, ws: &mut Workspace, par: Par) -> Result<Contacts> {
         pairwise!(self, other, a, b => collide_with(a, b, ws, par))
     }
 
     /// Self-contacts of this object (see [`self_collide`](crate::self_collide())).
-    pub fn self_collide(&mut self, ws: &mut Workspace, par: Par) -> Contacts {
+    pub fn self_collide(&self, ws: &mut Workspace, par: Par) -> Contacts {
         each!(self, h => self_collide_with(h, ws, par))
+    }
+
+    /// Feature pairs within `d` between two hierarchies of the same kind (see
+    /// [`proximity`](crate::proximity())); an error if the kinds differ or `d` is invalid.
+    pub fn proximity(
+        &self,
+        other: &AnyHierarchy,
+        d: f64,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<Proximity> {
+        pairwise!(self, other, a, b => proximity_with(a, b, d, ws, par)?)
+    }
+
+    /// Feature pairs within `d` of this object (see
+    /// [`self_proximity`](crate::self_proximity())).
+    pub fn self_proximity(&self, d: f64, ws: &mut Workspace, par: Par) -> Result<Proximity> {
+        each!(self, h => self_proximity_with(h, d, ws, par))
     }
 
     /// Intersection segments of contacts between `self` and `other` (see
@@ -110,17 +134,17 @@ impl AnyHierarchy {
     }
 
     /// Refits the stale nodes among `ids` (see [`Hierarchy::refit_nodes`]).
-    pub fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<()> {
+    pub fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<u64> {
         each!(self, h => h.refit_nodes(ids, par))
     }
 
     /// Refits every stale node exactly now (see [`Hierarchy::refit_all`]).
-    pub fn refit_all(&mut self) {
+    pub fn refit_all(&mut self) -> u64 {
         each!(self, h => h.refit_all())
     }
 
     /// Refits every stale node bottom-up now (see [`Hierarchy::refit_bottom_up`]).
-    pub fn refit_bottom_up(&mut self) {
+    pub fn refit_bottom_up(&mut self) -> u64 {
         each!(self, h => h.refit_bottom_up())
     }
 
@@ -129,24 +153,19 @@ impl AnyHierarchy {
         each!(self, h => h.fitted_nodes())
     }
 
-    /// The BV updates done since the last call (see [`Hierarchy::take_updates`]).
-    pub fn take_updates(&mut self) -> u64 {
-        each!(self, h => h.take_updates())
-    }
-
     /// [`broad_phase`] between two hierarchies of the same kind; an error if the kinds differ.
     pub fn broad_phase(
-        &mut self,
-        other: &mut AnyHierarchy,
+        &self,
+        other: &AnyHierarchy,
         ws: &mut Workspace,
         par: Par,
-    ) -> Result<Counters> {
+    ) -> Result<BroadPhase> {
         pairwise!(self, other, a, b => broad_phase(a, b, ws, par))
     }
 
     /// [`self_broad_phase`] of this object: refit and traversal down to the overlapping
-    /// leaf pairs (left in `ws`), no triangle tested.
-    pub fn self_broad_phase(&mut self, ws: &mut Workspace, par: Par) -> Counters {
+    /// leaf pairs, no triangle tested.
+    pub fn self_broad_phase(&self, ws: &mut Workspace, par: Par) -> BroadPhase {
         each!(self, h => self_broad_phase(h, ws, par))
     }
 

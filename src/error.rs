@@ -33,7 +33,17 @@ pub enum Error {
         corners: [u32; 3],
     },
     #[error("vertex {vertex} has a non-finite coordinate {position:?}")]
-    NonFinite { vertex: usize, position: [f32; 3] },
+    NonFinite { vertex: usize, position: [f64; 3] },
+    /// An `f64` coordinate too large to round to a finite `f32` (bounding volumes are `f32`).
+    #[error("vertex {vertex} has a coordinate beyond the f32 range {position:?} (|x| must be below about 3.4e38)")]
+    OutOfRange { vertex: usize, position: [f64; 3] },
+    /// Positions of one precision given to a mesh or hierarchy of the other: an `f32`
+    /// update of an `f64` hierarchy would silently round it.
+    #[error("positions are {got}, but the mesh or hierarchy is {expected}")]
+    PrecisionMismatch {
+        expected: crate::mesh::Precision,
+        got: crate::mesh::Precision,
+    },
     #[error("position update has {got} vertices, but the mesh has {expected}")]
     WrongVertexCount { expected: usize, got: usize },
     #[error("levels must be between 1 and {max}, got {got}", max = crate::tree::MAX_LEVELS)]
@@ -55,6 +65,11 @@ pub enum Error {
     UnknownRefit(String),
     #[error("unknown central vertex {0:?} (expected rest-centroid or min-radius)")]
     UnknownCentral(String),
+    #[error("unknown precision {0:?} (expected f32 or f64)")]
+    UnknownPrecision(String),
+    /// A query distance that is negative, NaN or infinite.
+    #[error("distance {0} is not a finite number >= 0")]
+    InvalidDistance(f64),
     /// A node id (e.g. given to `refit_nodes`) beyond the hierarchy's nodes.
     #[error("node {node} out of range (the hierarchy has {node_count} nodes)")]
     NodeOutOfRange { node: u32, node_count: usize },

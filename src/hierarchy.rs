@@ -1,12 +1,11 @@
 //! A bounding-volume hierarchy of one deformable mesh: the shared region tree, the live
 //! vertex positions (internal order), the node buffers of one kind, and the lazy-refit state.
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use crate::bv::{BvKind, Method};
 use crate::error::{Error, Result};
-use crate::mesh::{check_positions, Mesh};
+use crate::mesh::{check_positions, check_positions_f64, Mesh, Precision};
 use crate::points::Points;
 use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
 use dhcd_kernels::lazy::LazyTiles;
@@ -161,60 +160,15 @@ pub struct InvariantError {
 #[derive(Clone, Debug)]
 pub struct Hierarchy<K: BvKind> {
     tree: Arc<RegionTree>,
+    /// The current positions as `f32` (internal order): exact for an `f32` hierarchy, the
+    /// nearest `f32`s of `exact` for an `f64` one. Bounds are fitted from them.
     points: Points,
+    /// The exact positions of an `f64` hierarchy (internal order), which the exact tests read.
+    exact: Option<Vec<[f64; 3]>>,
     nodes: K::Nodes,
     refit: Refit,
-    /// BV updates done outside queries (eager refits) since the last query took them.
-    updates: u64,
     /// Triangle corners and boxes in the current pose, refreshed lazily per leaf.
     tris: TriCache,
-    /// Which scene job first needed each sibling group this step (see [`JobClaims`]).
-    claims: JobClaims,
-}
-
-/// Per sibling group: the first *job* (in the scene's job order) that needed it since the
-/// last drain, and whether a query fitted it (lazy refit). A [`crate::scene::Scene`] runs
-/// all its object-pair queries at once on shared hierarchies, so which query happens to fit
-/// a group depends on timing; crediting each fit to the first job in job order that needed
-/// the group instead gives every job the `bv_updates` it would have in a sequential run in
-/// that order, whatever the thread count. Atomics with relaxed order: the drain runs after
-/// the parallel region has joined.
-#[derive(Debug)]
-struct JobClaims {
-    first: Box<[AtomicUsize]>,
-    fitted: Box<[AtomicBool]>,
-}
-
-/// No job has claimed the group.
-const UNCLAIMED: usize = usize::MAX;
-
-impl JobClaims {
-    fn new(groups: usize) -> Self {
-        Self {
-            first: (0..groups).map(|_| AtomicUsize::new(UNCLAIMED)).collect(),
-            fitted: (0..groups).map(|_| AtomicBool::new(false)).collect(),
-        }
-    }
-
-    /// Job `job` needed group `g` (and fitted it, if `fitted`).
-    #[inline]
-    fn touch(&self, g: usize, job: usize, fitted: bool) {
-        if fitted {
-            self.fitted[g].store(true, Ordering::Relaxed);
-        }
-        let first = &self.first[g];
-        // A load first: most touches come from a job that already holds the claim.
-        if first.load(Ordering::Relaxed) > job {
-            first.fetch_min(job, Ordering::Relaxed);
-        }
-    }
-}
-
-impl Clone for JobClaims {
-    /// A clone starts unclaimed: claims belong to the step of one hierarchy.
-    fn clone(&self) -> Self {
-        Self::new(self.first.len())
-    }
 }
 
 /// Every triangle's corners and closed box in the current pose, refreshed lazily one leaf at
@@ -315,6 +269,15 @@ fn fill_leaf_tile(group: &mut [f32], stride: usize, n: usize, vertices: &[u32], 
             lo[i] = a[i].min(b[i]).min(c[i]);
             hi[i] = a[i].max(b[i]).max(c[i]);
         }
+        if p.is_rounded() {
+            // Rounded corners: the next f32 outward holds the exact ones.
+            for x in lo.iter_mut() {
+                *x = x.next_down();
+            }
+            for x in hi.iter_mut() {
+                *x = x.next_up();
+            }
+        }
     }
     // The union of the boxes: the minima's least, the maxima's greatest (the SIMD bounds
     // reduction; a single `min` chain per axis waits on each one's latency).
@@ -350,36 +313,83 @@ impl<K: BvKind> Hierarchy<K> {
                 mesh_triangles: mesh.triangle_count(),
             });
         }
-        let points = Points::gather(mesh.positions(), tree.vert_order());
+        let (points, exact) = match mesh.positions_f64() {
+            None => (Points::gather(mesh.positions(), tree.vert_order()), None),
+            Some(p) => (
+                Points::gather_rounded(p, tree.vert_order()),
+                Some(tree.vert_order().iter().map(|&o| p[o as usize]).collect()),
+            ),
+        };
         let nodes = K::build(&tree, &points, &options);
         Ok(Self {
             tris: TriCache::new(&tree),
-            claims: JobClaims::new(tree.group_count()),
             tree,
             points,
+            exact,
             nodes,
             refit: options.refit,
-            updates: 0,
         })
     }
 
     /// Hands the hierarchy the mesh's new vertex positions (caller's vertex order, same
     /// count, finite). Every bounding volume becomes stale; with [`Refit::Lazy`] each is
-    /// refitted when first tested, otherwise all are refitted now. On error nothing changes.
-    pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {
+    /// refitted when first tested, otherwise all are refitted now. Returns the number of
+    /// volumes refitted now (`N_U` of the eager modes; 0 with [`Refit::Lazy`], whose refits
+    /// the queries count). On error nothing changes.
+    ///
+    /// An `f64` hierarchy refuses `f32` positions ([`Error::PrecisionMismatch`]): see
+    /// [`Hierarchy::update_positions_f64`].
+    pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<u64> {
+        self.check_precision(Precision::F32)?;
         check_positions(positions, self.tree.vertex_total())?;
-        self.apply_positions(positions);
-        Ok(())
+        Ok(self.apply_positions(positions))
+    }
+
+    /// [`Hierarchy::update_positions`] for an `f64` hierarchy (built from a
+    /// [`Mesh::new_f64`]): the positions are kept exactly (every coordinate finite and
+    /// within the `f32` range, as [`Mesh::new_f64`] asks); an `f32` hierarchy refuses them
+    /// ([`Error::PrecisionMismatch`]).
+    pub fn update_positions_f64(&mut self, positions: &[[f64; 3]]) -> Result<u64> {
+        self.check_precision(Precision::F64)?;
+        check_positions_f64(positions, self.tree.vertex_total())?;
+        Ok(self.apply_positions_f64(positions))
+    }
+
+    fn check_precision(&self, got: Precision) -> Result<()> {
+        let expected = self.precision();
+        if got == expected {
+            Ok(())
+        } else {
+            Err(Error::PrecisionMismatch { expected, got })
+        }
     }
 
     /// [`Hierarchy::update_positions`] of positions the caller has checked
-    /// ([`check_positions`] against [`RegionTree::vertex_total`]).
-    pub(crate) fn apply_positions(&mut self, positions: &[[f32; 3]]) {
+    /// ([`check_positions`] against [`RegionTree::vertex_total`], an `f32` hierarchy).
+    pub(crate) fn apply_positions(&mut self, positions: &[[f32; 3]]) -> u64 {
         debug_assert!(check_positions(positions, self.tree.vertex_total()).is_ok());
+        debug_assert!(self.exact.is_none());
         self.points.gather_from(positions, self.tree.vert_order());
+        self.refit_after_update()
+    }
+
+    /// [`Hierarchy::update_positions_f64`] of positions the caller has checked.
+    pub(crate) fn apply_positions_f64(&mut self, positions: &[[f64; 3]]) -> u64 {
+        debug_assert!(check_positions_f64(positions, self.tree.vertex_total()).is_ok());
+        let order = self.tree.vert_order();
+        self.points.gather_rounded_from(positions, order);
+        if let Some(exact) = &mut self.exact {
+            for (e, &o) in exact.iter_mut().zip(order) {
+                *e = positions[o as usize];
+            }
+        }
+        self.refit_after_update()
+    }
+
+    fn refit_after_update(&mut self) -> u64 {
         self.invalidate();
         match self.refit {
-            Refit::Lazy => {}
+            Refit::Lazy => 0,
             Refit::Eager => self.refit_all(),
             Refit::EagerBottomUp => self.refit_bottom_up(),
         }
@@ -393,9 +403,9 @@ impl<K: BvKind> Hierarchy<K> {
     }
 
     /// Refits the stale sibling groups of the nodes `ids` (each group once), as the lazy
-    /// traversal does, counting the nodes fitted as updates. A node id out of range is an
+    /// traversal does; returns the number of nodes fitted. A node id out of range is an
     /// [`Error::NodeOutOfRange`] and nothing is refitted.
-    pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) -> Result<()> {
+    pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) -> Result<u64> {
         if let Some(&n) = ids.iter().find(|&&n| n as usize >= self.node_count()) {
             return Err(Error::NodeOutOfRange {
                 node: n,
@@ -416,14 +426,12 @@ impl<K: BvKind> Hierarchy<K> {
                 0
             }
         };
-        let fitted: u64 = if par.is_parallel() {
+        Ok(if par.is_parallel() {
             use rayon::prelude::*;
             par.install(|| groups.par_iter().map(fit).sum())
         } else {
             groups.iter().map(fit).sum()
-        };
-        self.updates += fitted;
-        Ok(())
+        })
     }
 
     /// The nodes fitted to the current positions (after a lazy query: the sibling groups it
@@ -434,14 +442,15 @@ impl<K: BvKind> Hierarchy<K> {
             .collect()
     }
 
-    /// Refits every stale node exactly.
-    pub fn refit_all(&mut self) {
-        self.updates += K::refit_all(&mut self.nodes, &self.tree, &self.points, false);
+    /// Refits every stale node exactly; returns the number of nodes fitted.
+    pub fn refit_all(&mut self) -> u64 {
+        K::refit_all(&mut self.nodes, &self.tree, &self.points, false)
     }
 
     /// Refits every stale node bottom-up: leaves exactly, internal nodes from their children.
-    pub fn refit_bottom_up(&mut self) {
-        self.updates += K::refit_all(&mut self.nodes, &self.tree, &self.points, true);
+    /// Returns the number of nodes fitted.
+    pub fn refit_bottom_up(&mut self) -> u64 {
+        K::refit_all(&mut self.nodes, &self.tree, &self.points, true)
     }
 
     /// Sibling group `g`'s volumes, fitted first if stale; whether this call fitted them.
@@ -450,38 +459,10 @@ impl<K: BvKind> Hierarchy<K> {
         K::group(&self.nodes, &self.tree, &self.points, g)
     }
 
-    /// Sibling group `g`'s block for scene job `job`, fitted first if stale; records the
-    /// claim ([`JobClaims`]) instead of returning whether this call fitted it.
-    #[inline]
-    pub(crate) fn group_for_job(&self, g: usize, job: usize) -> K::Block<'_> {
-        let (block, fitted) = self.group(g);
-        self.claims.touch(g, job, fitted);
-        block
-    }
-
-    /// Credits each group a query fitted since the last drain to the first job that needed
-    /// it (`credit(job, nodes fitted)`), and clears every claim.
-    pub(crate) fn drain_claims(&mut self, mut credit: impl FnMut(usize, u64)) {
-        let JobClaims { first, fitted } = &mut self.claims;
-        for (g, (first, fitted)) in first.iter_mut().zip(fitted.iter_mut()).enumerate() {
-            let job = std::mem::replace(first.get_mut(), UNCLAIMED);
-            if std::mem::take(fitted.get_mut()) {
-                debug_assert_ne!(job, UNCLAIMED, "a fitting job claims the group");
-                credit(job, self.tree.group_nodes(g).len() as u64);
-            }
-        }
-    }
-
     /// Leaf `leaf`'s triangles in the current pose, gathered first if stale.
     #[inline]
     pub(crate) fn leaf_tris(&self, leaf: usize) -> LeafTris<'_> {
         self.tris.leaf(&self.tree, &self.points, leaf)
-    }
-
-    /// The BV updates done outside queries (eager refits, [`Hierarchy::refit_nodes`]) since
-    /// the last call; queries add them to their `bv_updates`.
-    pub fn take_updates(&mut self) -> u64 {
-        std::mem::take(&mut self.updates)
     }
 
     /// Checks that every fitted node's volume encloses every vertex of its region in the
@@ -497,7 +478,7 @@ impl<K: BvKind> Hierarchy<K> {
             if let Some(v) = self
                 .tree
                 .region_vertices(n)
-                .find(|&v| !K::encloses(&rec, &self.points, v as usize))
+                .find(|&v| !K::encloses(&rec, &self.points, self.position_f64(v as usize)))
             {
                 return Err(InvariantError {
                     method: K::METHOD,
@@ -529,9 +510,39 @@ impl<K: BvKind> Hierarchy<K> {
         &self.nodes
     }
 
-    /// Current positions in internal vertex order (see [`RegionTree::vert_order`]).
+    /// Current positions in internal vertex order (see [`RegionTree::vert_order`]), as
+    /// `f32` (the nearest `f32`s of an `f64` hierarchy's positions).
     pub fn points(&self) -> &Points {
         &self.points
+    }
+
+    /// The exact current position of internal vertex `v`.
+    #[inline]
+    pub fn position_f64(&self, v: usize) -> [f64; 3] {
+        match &self.exact {
+            Some(e) => e[v],
+            None => self.points.get(v).map(f64::from),
+        }
+    }
+
+    /// The exact positions of an `f64` hierarchy, internal order (`None` for `f32`).
+    #[inline]
+    pub(crate) fn exact_points(&self) -> Option<&[[f64; 3]]> {
+        self.exact.as_deref()
+    }
+
+    /// Whether the `f32` points are roundings of `f64` positions (an `f64` hierarchy).
+    #[inline]
+    pub(crate) fn is_rounded(&self) -> bool {
+        self.points.is_rounded()
+    }
+
+    /// The precision of the positions the hierarchy was built from and takes.
+    pub fn precision(&self) -> Precision {
+        match self.exact {
+            Some(_) => Precision::F64,
+            None => Precision::F32,
+        }
     }
 
     pub fn refit_mode(&self) -> Refit {

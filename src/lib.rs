@@ -31,6 +31,7 @@ pub mod bv;
 pub mod ccd;
 pub mod counters;
 pub mod detail;
+pub mod distance;
 pub mod error;
 pub mod hierarchy;
 pub mod io;
@@ -39,22 +40,25 @@ pub mod mesh;
 pub mod narrow;
 pub mod par;
 pub mod points;
+pub mod query;
 pub mod scene;
 pub mod shapes;
-pub mod traverse;
 pub mod tree;
+mod walk;
 
 pub use any::AnyHierarchy;
 pub use bv::Method;
 pub use counters::Counters;
 pub use error::{Error, Result};
 pub use hierarchy::{CentralVertex, Hierarchy, InvariantError, Options, Refit};
-pub use mesh::Mesh;
+pub use mesh::{Mesh, Precision};
 pub use par::Par;
-pub use scene::{ObjectId, Scene, SceneContacts};
+pub use scene::{ObjectId, PairProximity, Scene, SceneContacts, SceneProximity};
 
-pub use traverse::{
-    broad_phase, collide, collide_with, narrow_phase, self_broad_phase, self_collide,
-    self_collide_with, Contacts, Workspace,
+pub use query::{
+    broad_phase, collide, collide_with, narrow_phase, proximity, proximity_with, self_broad_phase,
+    self_collide, self_collide_with, self_proximity, self_proximity_with, BroadPhase, Contacts,
+    Proximity,
 };
 pub use tree::RegionTree;
+pub use walk::{Workspace, DEFAULT_GRAIN};

@@ -2,21 +2,88 @@
 
 use crate::error::{Error, Result};
 
+/// The floating-point type of a mesh's coordinates: every answer is exact for the
+/// coordinates as given in it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Precision {
+    /// `f32` coordinates (the fastest path).
+    #[default]
+    F32,
+    /// `f64` coordinates, as simulators hold them. Bounding volumes stay `f32` records,
+    /// rounded outward; the triangle, proximity and CCD tests decide for the `f64` values.
+    F64,
+}
+
+impl Precision {
+    /// Every precision, the default first.
+    pub const ALL: [Precision; 2] = [Precision::F32, Precision::F64];
+
+    /// The name on the command line and in JSON reports: `f32`, `f64`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+}
+
+impl std::fmt::Display for Precision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Precision {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Precision::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| Error::UnknownPrecision(s.to_owned()))
+    }
+}
+
 /// A triangle mesh: vertex positions and triangles as vertex-index triples.
 ///
 /// Construction validates everything the kernels rely on: at least one vertex and one
 /// triangle, indices in range, no triangle repeating a vertex index, finite coordinates.
 /// Zero-area triangles (collinear or coincident corners) are legal and are treated exactly
 /// as the segment or point they are.
+///
+/// A mesh has a [`Precision`]: [`Mesh::new`] takes `f32` positions, [`Mesh::new_f64`] `f64`
+/// ones (kept as given; [`Mesh::positions`] is then their rounding to the nearest `f32`,
+/// which the bounding volumes start from, and [`Mesh::positions_f64`] the exact values).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     positions: Vec<[f32; 3]>,
+    /// The exact positions of an `f64` mesh.
+    exact: Option<Vec<[f64; 3]>>,
     triangles: Vec<[u32; 3]>,
 }
 
 impl Mesh {
-    /// Validates and wraps `positions` and `triangles`.
+    /// Validates and wraps `positions` and `triangles` (an [`Precision::F32`] mesh).
     pub fn new(positions: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>) -> Result<Self> {
+        check_finite(&positions)?;
+        Self::checked(positions, None, triangles)
+    }
+
+    /// Validates and wraps `f64` positions and `triangles` (an [`Precision::F64`] mesh):
+    /// besides [`Mesh::new`]'s checks, every coordinate must round to a finite `f32`
+    /// (magnitude below about `3.4e38`, [`Error::OutOfRange`]), since the bounding volumes
+    /// are `f32` records.
+    pub fn new_f64(positions: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Result<Self> {
+        check_finite_f64(&positions)?;
+        let rounded = round_to_f32(&positions);
+        Self::checked(rounded, Some(positions), triangles)
+    }
+
+    fn checked(
+        positions: Vec<[f32; 3]>,
+        exact: Option<Vec<[f64; 3]>>,
+        triangles: Vec<[u32; 3]>,
+    ) -> Result<Self> {
         if positions.is_empty() {
             return Err(Error::NoVertices);
         }
@@ -29,7 +96,6 @@ impl Mesh {
         if triangles.len() >= u32::MAX as usize {
             return Err(Error::TooManyTriangles(triangles.len()));
         }
-        check_finite(&positions)?;
         for (t, tri) in triangles.iter().enumerate() {
             for &index in tri {
                 if index as usize >= positions.len() {
@@ -52,12 +118,37 @@ impl Mesh {
         }
         Ok(Self {
             positions,
+            exact,
             triangles,
         })
     }
 
+    /// The positions as `f32`: exact for an [`Precision::F32`] mesh, the nearest `f32`s of
+    /// an [`Precision::F64`] one (see [`Mesh::positions_f64`]).
     pub fn positions(&self) -> &[[f32; 3]] {
         &self.positions
+    }
+
+    /// The exact positions of an [`Precision::F64`] mesh; `None` for an `f32` one (whose
+    /// positions convert to `f64` exactly).
+    pub fn positions_f64(&self) -> Option<&[[f64; 3]]> {
+        self.exact.as_deref()
+    }
+
+    /// The positions as `f64`, exactly: an `f64` mesh's own, an `f32` mesh's converted.
+    pub fn to_f64_positions(&self) -> Vec<[f64; 3]> {
+        match &self.exact {
+            Some(p) => p.clone(),
+            None => self.positions.iter().map(|p| p.map(f64::from)).collect(),
+        }
+    }
+
+    /// The precision the mesh was built with.
+    pub fn precision(&self) -> Precision {
+        match self.exact {
+            Some(_) => Precision::F64,
+            None => Precision::F32,
+        }
     }
 
     pub fn triangles(&self) -> &[[u32; 3]] {
@@ -72,10 +163,34 @@ impl Mesh {
         self.triangles.len()
     }
 
-    /// Replaces the positions (same vertex count, finite), keeping the triangles.
+    /// Replaces the positions of an `f32` mesh (same vertex count, finite), keeping the
+    /// triangles. An `f64` mesh refuses them ([`Error::PrecisionMismatch`]: rounding its
+    /// positions silently would change its answers); see [`Mesh::set_positions_f64`].
     pub fn set_positions(&mut self, positions: &[[f32; 3]]) -> Result<()> {
+        if self.exact.is_some() {
+            return Err(Error::PrecisionMismatch {
+                expected: Precision::F64,
+                got: Precision::F32,
+            });
+        }
         check_positions(positions, self.positions.len())?;
         self.positions.copy_from_slice(positions);
+        Ok(())
+    }
+
+    /// Replaces the positions of an `f64` mesh (same vertex count, finite, within `f32`
+    /// range), keeping the triangles. An `f32` mesh refuses them
+    /// ([`Error::PrecisionMismatch`]).
+    pub fn set_positions_f64(&mut self, positions: &[[f64; 3]]) -> Result<()> {
+        let Some(exact) = &mut self.exact else {
+            return Err(Error::PrecisionMismatch {
+                expected: Precision::F32,
+                got: Precision::F64,
+            });
+        };
+        check_positions_f64(positions, exact.len())?;
+        exact.copy_from_slice(positions);
+        self.positions = round_to_f32(positions);
         Ok(())
     }
 
@@ -119,6 +234,57 @@ fn check_finite(positions: &[[f32; 3]]) -> Result<()> {
         .expect("a non-finite vertex exists");
     Err(Error::NonFinite {
         vertex,
-        position: positions[vertex],
+        position: positions[vertex].map(f64::from),
     })
+}
+
+/// Checks an `f64` position update: `expected` vertices, every coordinate finite and within
+/// the `f32` range ([`Mesh::new_f64`]).
+pub fn check_positions_f64(positions: &[[f64; 3]], expected: usize) -> Result<()> {
+    if positions.len() != expected {
+        return Err(Error::WrongVertexCount {
+            expected,
+            got: positions.len(),
+        });
+    }
+    check_finite_f64(positions)
+}
+
+/// Every coordinate finite, and finite once rounded to `f32`.
+fn check_finite_f64(positions: &[[f64; 3]]) -> Result<()> {
+    // As `check_finite`: one branch per chunk. `|x| <= F32_LIMIT` is false for NaN and
+    // infinities too.
+    if positions
+        .as_flattened()
+        .chunks(1024)
+        .all(|c| c.iter().fold(true, |ok, x| ok & (x.abs() <= F32_LIMIT)))
+    {
+        return Ok(());
+    }
+    let vertex = positions
+        .iter()
+        .position(|p| !p.iter().all(|x| x.abs() <= F32_LIMIT))
+        .expect("a bad vertex exists");
+    let position = positions[vertex];
+    Err(if position.iter().all(|x| x.is_finite()) {
+        Error::OutOfRange { vertex, position }
+    } else {
+        Error::NonFinite { vertex, position }
+    })
+}
+
+/// The largest `f64` magnitude that rounds to a finite `f32`: `f32::MAX` plus just under half
+/// an ulp of it (ties round to even, i.e. to infinity, so the bound itself is excluded by
+/// taking the `f64` just below it).
+const F32_LIMIT: f64 = {
+    let max = f32::MAX as f64;
+    // f32::MAX = (2 - 2^-23) 2^127; its ulp is 2^104, half of it 2^103.
+    let half_ulp = 10141204801825835211973625643008.0; // 2^103
+                                                       // `max + half_ulp` is exact in f64 (it needs 25 bits); the next f64 below it.
+    f64::from_bits((max + half_ulp).to_bits() - 1)
+};
+
+/// Each coordinate rounded to the nearest `f32`.
+pub(crate) fn round_to_f32(positions: &[[f64; 3]]) -> Vec<[f32; 3]> {
+    positions.iter().map(|p| p.map(|x| x as f32)).collect()
 }

@@ -11,14 +11,12 @@
 //!    shared hierarchies, which may itself split its frontier across the pool. The lazy
 //!    refit fits each sibling group once, for whichever query needs it first.
 //!
-//! With [`Scene::set_front_tracking`] each job keeps its traversal front between steps, in a
-//! workspace of its own (keyed by the two object ids), and starts the next step's query of
-//! the same pair there; a pair that leaves the broad phase drops its front.
-//!
 //! Output is deterministic: contacts are sorted and per-pair counters listed in job order.
-//! A group's refit is credited to the first job *in job order* that needed it (not to the
-//! query that happened to fit it), and an object's eager refits to its first job, so every
-//! pair's `bv_updates` is what a sequential run of the jobs in that order counts, for every
+//! Refits are a fact of an object, not of a pair: each sibling group is fitted once per pose,
+//! by whichever query needs it first, so which job fits it depends on timing, but how many
+//! nodes of each object were fitted does not. Each object's refits (its lazy fits in this
+//! query, and the eager refits of its updates since the last query) are credited to its first
+//! job in job order, so every pair's `bv_updates`, and their sum, are the same for every
 //! `Par`.
 
 use rayon::prelude::*;
@@ -29,9 +27,12 @@ use crate::detail::{segment, OriginalCorners, Segment};
 use crate::error::{Error, Result};
 use crate::hierarchy::{Hierarchy, Options};
 use crate::kinds::{kinds, match_kind, with_kind};
-use crate::mesh::{check_positions, Mesh};
+use crate::mesh::{check_positions, Mesh, Precision};
 use crate::par::Par;
-use crate::traverse::{scene_query, Contacts, Workspace};
+use crate::query::contacts::contacts;
+use crate::query::proximity::{self, check_distance};
+use crate::query::{Contacts, Overlap, Posed, Proximity, Within};
+use crate::walk::Workspace;
 
 /// Identifies an object of a [`Scene`]. Ids are handed out in increasing order from 0 and
 /// are **never reused**, even after [`Scene::remove`]: a stale id is always an
@@ -70,6 +71,28 @@ pub struct SceneContacts {
     pub broad_phase_tests: u64,
 }
 
+/// The proximity of one object pair that passed the broad phase (`a < b`: vertices and
+/// edges of `a` first, see [`Proximity`]), or of one object with itself (`a == b`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairProximity {
+    pub a: ObjectId,
+    pub b: ObjectId,
+    /// Each object's original vertex, triangle and edge indices.
+    pub proximity: Proximity,
+}
+
+/// Result of [`Scene::proximity`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneProximity {
+    /// Every object pair whose root boxes came within the distance (and every object with
+    /// self-collision on), sorted by `(a, b)`, each with its pairs and counters.
+    pub per_pair: Vec<PairProximity>,
+    /// Sum of the pairs' counters.
+    pub counters: Counters,
+    /// Object pairs whose root boxes were compared in the broad phase.
+    pub broad_phase_tests: u64,
+}
+
 /// One object of the scene.
 #[derive(Clone, Debug)]
 struct Object<K: BvKind> {
@@ -78,6 +101,8 @@ struct Object<K: BvKind> {
     self_collision: bool,
     /// Closed box `[min, max]` of the live positions of the vertices used by triangles.
     bounds: [[f32; 3]; 2],
+    /// Nodes refitted by eager updates since the last query (credited to its first job).
+    refitted: u64,
 }
 
 impl<K: BvKind> Object<K> {
@@ -88,7 +113,12 @@ impl<K: BvKind> Object<K> {
     fn refresh_bounds(&mut self) {
         let n = self.h.tree().referenced_vertices();
         let (lo, hi) = dhcd_kernels::refit::bounds(self.h.points().soa().slice(0..n));
-        self.bounds = [lo, hi];
+        self.bounds = if self.h.points().is_rounded() {
+            // Rounded f64 positions: the next f32 outward holds the exact ones.
+            [lo.map(f32::next_down), hi.map(f32::next_up)]
+        } else {
+            [lo, hi]
+        };
     }
 }
 
@@ -139,13 +169,7 @@ pub struct Scene {
     next_id: u64,
     /// Sorted by id (ids only grow, so `add` appends).
     objects: Objects,
-    /// Front tracking on: the workspace (and front) of each job of the last step.
-    fronts: Option<PairFronts>,
 }
-
-/// One workspace per job of the last step, keyed by its object ids `[a, b]` (`a == b`: a
-/// self job), sorted by key (the job order).
-type PairFronts = Vec<([u64; 2], Workspace)>;
 
 impl Scene {
     /// An empty scene whose objects get hierarchies of kind `method` built with `options`.
@@ -155,7 +179,6 @@ impl Scene {
             options,
             next_id: 0,
             objects,
-            fronts: None,
         }
     }
 
@@ -196,6 +219,7 @@ impl Scene {
                 h: Hierarchy::new(mesh, options)?,
                 self_collision: false,
                 bounds: [[0.0; 3]; 2],
+                refitted: 0,
             };
             o.refresh_bounds();
             v.push(o);
@@ -208,10 +232,6 @@ impl Scene {
     pub fn remove(&mut self, id: ObjectId) -> Result<()> {
         let i = self.index(id)?;
         each!(&mut self.objects, v => { v.remove(i); });
-        if let Some(fronts) = &mut self.fronts {
-            // Its jobs' fronts (and the trees they hold) go now, not at the next step.
-            fronts.retain(|(key, _)| !key.contains(&id.0));
-        }
         Ok(())
     }
 
@@ -220,7 +240,18 @@ impl Scene {
     pub fn update_positions(&mut self, id: ObjectId, positions: &[[f32; 3]]) -> Result<()> {
         let i = self.index(id)?;
         each!(&mut self.objects, v => {
-            v[i].h.update_positions(positions)?;
+            v[i].refitted += v[i].h.update_positions(positions)?;
+            v[i].refresh_bounds();
+        });
+        Ok(())
+    }
+
+    /// The new `f64` positions of an object built from an `f64` mesh (see
+    /// [`Hierarchy::update_positions_f64`]). On error nothing changes.
+    pub fn update_positions_f64(&mut self, id: ObjectId, positions: &[[f64; 3]]) -> Result<()> {
+        let i = self.index(id)?;
+        each!(&mut self.objects, v => {
+            v[i].refitted += v[i].h.update_positions_f64(positions)?;
             v[i].refresh_bounds();
         });
         Ok(())
@@ -242,11 +273,10 @@ impl Scene {
     /// step: `docs/PERFORMANCE.md`). On error nothing changes and there are no contacts.
     pub fn step(&mut self, updates: &[(ObjectId, &[[f32; 3]])], par: Par) -> Result<SceneContacts> {
         let slot = self.update_slots(updates)?;
-        let fronts = self.fronts.as_mut();
         let parallel = par.is_parallel();
         each!(&mut self.objects, v => par.install(|| {
             update_objects(v, &slot, parallel)?;
-            Ok(contacts_of(v, fronts, parallel))
+            Ok(contacts_of(v, parallel))
         }))
     }
 
@@ -293,29 +323,17 @@ impl Scene {
     /// Every contact of the current poses: between all object pairs, and inside objects with
     /// self-collision on. The result does not depend on `par`.
     pub fn contacts(&mut self, par: Par) -> SceneContacts {
-        let fronts = self.fronts.as_mut();
-        each!(&mut self.objects, v => par.install(|| contacts_of(v, fronts, par.is_parallel())))
+        each!(&mut self.objects, v => par.install(|| contacts_of(v, par.is_parallel())))
     }
 
-    /// Frame-to-frame coherence for every job (off when created): with it on, each object
-    /// pair's query (and each self query) keeps where its traversal stopped, and the next
-    /// [`Scene::contacts`] starts that pair's query there
-    /// ([`Workspace::set_front_tracking`]). The contacts are exactly the same; `bv_tests`
-    /// and `bv_updates` count the work done, and are the same for every `par`. A pair that
-    /// leaves the broad phase (or an object that is removed) drops its front, so the fronts
-    /// kept are at most one per job of the last step, each bounded as in
-    /// [`Workspace::set_front_tracking`]. Turning it off drops them all.
-    pub fn set_front_tracking(&mut self, on: bool) {
-        if !on {
-            self.fronts = None;
-        } else if self.fronts.is_none() {
-            self.fronts = Some(PairFronts::new());
-        }
-    }
-
-    /// Whether [`Scene::set_front_tracking`] is on.
-    pub fn front_tracking(&self) -> bool {
-        self.fronts.is_some()
+    /// Every vertex-triangle and edge-edge pair within distance `d` (finite, `>= 0`, else
+    /// [`Error::InvalidDistance`]) between every two objects whose root boxes come within
+    /// `d`, and inside every object with self-collision on ([`crate::self_proximity`]). The
+    /// result does not depend on `par`; refits are credited as in [`Scene::contacts`].
+    pub fn proximity(&mut self, d: f64, par: Par) -> Result<SceneProximity> {
+        check_distance(d)?;
+        let parallel = par.is_parallel();
+        Ok(each!(&mut self.objects, v => par.install(|| proximity_of(v, d, parallel))))
     }
 
     /// Intersection segments of `contacts` (from [`Scene::contacts`] in the current poses),
@@ -356,6 +374,37 @@ impl Scene {
     }
 }
 
+fn proximity_of<K: BvKind>(objects: &mut [Object<K>], d: f64, parallel: bool) -> SceneProximity {
+    let within = Within::distance(d);
+    let (jobs, broad_phase_tests) = jobs_of(objects, within.margin);
+    let results = run_jobs(
+        objects,
+        &jobs,
+        parallel,
+        |ws, a, b, par| {
+            let posed = match b {
+                None => Posed::single(a, within),
+                Some(b) => Posed::pair(a, b, within),
+            };
+            proximity::run(posed, d, ws, par)
+        },
+        |p: &mut Proximity| &mut p.counters,
+    );
+    let mut out = SceneProximity {
+        broad_phase_tests,
+        ..SceneProximity::default()
+    };
+    for (&(a, b), p) in jobs.iter().zip(results) {
+        out.counters += p.counters;
+        out.per_pair.push(PairProximity {
+            a: ObjectId(objects[a].id),
+            b: ObjectId(objects[b].id),
+            proximity: p,
+        });
+    }
+    out
+}
+
 /// Sweep-and-prune on the root boxes along x: the index pairs `(i, j)`, `i < j`, of objects
 /// whose closed boxes overlap, sorted; and the number of box pairs compared.
 fn broad_phase(bounds: &[[[f32; 3]; 2]]) -> (Vec<(usize, usize)>, u64) {
@@ -381,25 +430,6 @@ fn broad_phase(bounds: &[[[f32; 3]; 2]]) -> (Vec<(usize, usize)>, u64) {
     (out, tests)
 }
 
-/// The workspaces of `jobs` (object ids, sorted) from the last step's `fronts` (sorted):
-/// a job's own if it had one, else a new tracking one; the others are dropped.
-fn take_fronts(fronts: &mut PairFronts, jobs: &[[u64; 2]]) -> Vec<Workspace> {
-    let mut old = std::mem::take(fronts).into_iter().peekable();
-    jobs.iter()
-        .map(|key| {
-            while old.next_if(|(k, _)| k < key).is_some() {}
-            match old.next_if(|(k, _)| k == key) {
-                Some((_, ws)) => ws,
-                None => {
-                    let mut ws = Workspace::default();
-                    ws.set_front_tracking(true);
-                    ws
-                }
-            }
-        })
-        .collect()
-}
-
 /// Applies `slot[i]` to object `i` (in parallel in the ambient pool if `parallel`), after
 /// checking every one: on error (the first failing object in scene order, whatever
 /// `parallel`) nothing changes.
@@ -409,6 +439,10 @@ fn update_objects<K: BvKind>(
     parallel: bool,
 ) -> Result<()> {
     let check = |(o, p): (&Object<K>, &Option<&[[f32; 3]]>)| match p {
+        Some(_) if o.h.precision() != Precision::F32 => Err(Error::PrecisionMismatch {
+            expected: o.h.precision(),
+            got: Precision::F32,
+        }),
         Some(p) => check_positions(p, o.h.tree().vertex_total()),
         None => Ok(()),
     };
@@ -425,7 +459,7 @@ fn update_objects<K: BvKind>(
     checks.into_iter().collect::<Result<()>>()?;
     let apply = |(o, p): (&mut Object<K>, &Option<&[[f32; 3]]>)| {
         if let Some(p) = p {
-            o.h.apply_positions(p);
+            o.refitted += o.h.apply_positions(p);
             o.refresh_bounds();
         }
     };
@@ -441,15 +475,23 @@ fn update_objects<K: BvKind>(
     Ok(())
 }
 
-fn contacts_of<K: BvKind>(
-    objects: &mut [Object<K>],
-    fronts: Option<&mut PairFronts>,
-    parallel: bool,
-) -> SceneContacts {
-    let bounds: Vec<_> = objects.iter().map(|o| o.bounds).collect();
-    let (candidates, broad_phase_tests) = broad_phase(&bounds);
-    // Jobs in (a, b) order; a self job is (a, a).
-    let mut jobs: Vec<(usize, usize)> = candidates;
+/// The jobs of a query: the object pairs whose root boxes, grown by `margin`, overlap, and
+/// the objects with self-collision on (`(a, a)`), sorted; and the broad phase's box tests.
+fn jobs_of<K: BvKind>(objects: &[Object<K>], margin: f32) -> (Vec<(usize, usize)>, u64) {
+    let bounds: Vec<_> = objects
+        .iter()
+        .map(|o| {
+            if margin == 0.0 {
+                o.bounds
+            } else {
+                [
+                    o.bounds[0].map(|x| (x - margin).next_down()),
+                    o.bounds[1].map(|x| (x + margin).next_up()),
+                ]
+            }
+        })
+        .collect();
+    let (mut jobs, tests) = broad_phase(&bounds);
     jobs.extend(
         objects
             .iter()
@@ -458,67 +500,74 @@ fn contacts_of<K: BvKind>(
             .map(|(i, _)| (i, i)),
     );
     jobs.sort_unstable();
+    (jobs, tests)
+}
 
-    // Every job at once on shared hierarchies (the lazy refit fits each group once, whoever
-    // needs it first); each query may also split its own frontier on the same pool.
+/// Runs `query` on every job at once on the shared hierarchies (the lazy refit fits each
+/// group once, whoever needs it first; each query may also split its own walk on the same
+/// pool), and credits each object's refits (the nodes fitted on it in every job, plus its
+/// eager refits) to its first job: results in job order, each with its counters.
+fn run_jobs<K: BvKind, R: Send>(
+    objects: &mut [Object<K>],
+    jobs: &[(usize, usize)],
+    parallel: bool,
+    query: impl Fn(&mut Workspace, &Hierarchy<K>, Option<&Hierarchy<K>>, Par) -> (R, [u64; 2]) + Sync,
+    counters: impl Fn(&mut R) -> &mut Counters,
+) -> Vec<R> {
     let inner = if parallel { Par::Rayon(0) } else { Par::Seq };
     let shared: &[Object<K>] = objects;
-    let run = |ws: &mut Workspace, k: usize, (a, b): (usize, usize)| {
-        scene_query(&shared[a].h, &shared[b].h, a == b, k, ws, inner)
+    let run = |ws: &mut Workspace, (a, b): (usize, usize)| {
+        let other = (a != b).then(|| &shared[b].h);
+        query(ws, &shared[a].h, other, inner)
     };
-    let mut results: Vec<Contacts> = match fronts {
-        // Each job on its own workspace, which holds its front.
-        Some(fronts) => {
-            let keys: Vec<[u64; 2]> = jobs
-                .iter()
-                .map(|&(a, b)| [shared[a].id, shared[b].id])
-                .collect();
-            let mut spaces = take_fronts(fronts, &keys);
-            let results = if parallel && jobs.len() > 1 {
-                (jobs.par_iter(), spaces.par_iter_mut())
-                    .into_par_iter()
-                    .enumerate()
-                    .map(|(k, (&job, ws))| run(ws, k, job))
-                    .collect()
-            } else {
-                jobs.iter()
-                    .zip(&mut spaces)
-                    .enumerate()
-                    .map(|(k, (&job, ws))| run(ws, k, job))
-                    .collect()
-            };
-            *fronts = keys.into_iter().zip(spaces).collect();
-            results
-        }
+    let mut results: Vec<(R, [u64; 2])> = if parallel && jobs.len() > 1 {
         // One workspace per worker thread, reused across jobs.
-        None if parallel && jobs.len() > 1 => jobs
-            .par_iter()
-            .enumerate()
-            .map_init(Workspace::default, |ws, (k, &job)| run(ws, k, job))
-            .collect(),
-        None => {
-            let mut ws = Workspace::default();
-            jobs.iter()
-                .enumerate()
-                .map(|(k, &job)| run(&mut ws, k, job))
-                .collect()
-        }
+        jobs.par_iter()
+            .map_init(Workspace::default, |ws, &job| run(ws, job))
+            .collect()
+    } else {
+        let mut ws = Workspace::default();
+        jobs.iter().map(|&job| run(&mut ws, job)).collect()
     };
-    // The refits as a sequential run in job order would count them: each lazily fitted group
-    // to the first job that needed it, each object's eager refits to its first job. Objects
-    // in no job were not touched (their claims are clear, their eager refits wait).
+    // Each object's refits (the sum over jobs of the nodes fitted on it, whichever job
+    // fitted them, plus its eager refits) to its first job. Objects in no job were not
+    // touched: their eager refits wait for their next job.
+    let mut refitted = vec![0u64; objects.len()];
+    for (&(a, b), (_, fitted)) in jobs.iter().zip(&results) {
+        refitted[a] += fitted[0];
+        refitted[b] += fitted[1];
+    }
     let mut first_job = vec![None; objects.len()];
     for (k, &(a, b)) in jobs.iter().enumerate().rev() {
         first_job[a] = Some(k);
         first_job[b] = Some(k);
     }
-    for (o, first) in objects.iter_mut().zip(first_job) {
+    for (r, _) in &mut results {
+        counters(r).bv_updates = 0;
+    }
+    for ((o, first), lazy) in objects.iter_mut().zip(first_job).zip(refitted) {
         if let Some(k) = first {
-            o.h.drain_claims(|k, nodes| results[k].counters.bv_updates += nodes);
-            results[k].counters.bv_updates += o.h.take_updates();
+            counters(&mut results[k].0).bv_updates += lazy + std::mem::take(&mut o.refitted);
         }
     }
+    results.into_iter().map(|(r, _)| r).collect()
+}
 
+fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
+    let (jobs, broad_phase_tests) = jobs_of(objects, 0.0);
+    let results = run_jobs(
+        objects,
+        &jobs,
+        parallel,
+        |ws, a, b, par| {
+            let posed = match b {
+                None => Posed::single(a, Overlap),
+                Some(b) => Posed::pair(a, b, Overlap),
+            };
+            contacts(posed, ws, par)
+        },
+        |c: &mut Contacts| &mut c.counters,
+    );
     let mut out = SceneContacts {
         broad_phase_tests,
         ..SceneContacts::default()

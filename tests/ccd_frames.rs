@@ -3,14 +3,16 @@
 //! (t = 0) and the next frame (t = 1) of `../shared/data/real-frames/`, and the CCD result
 //! equal to the label.
 //!
-//! The library's mesh loader rounds positions to f32, so this suite reads the binary PLY
-//! files itself (f64 little-endian or f32 big-endian vertices, uchar-count int32 faces;
-//! f32 values widen to f64 exactly), which is all the four frames need.
+//! Positions come from the library's loader at `Precision::F64`; a minimal binary-PLY
+//! reader of this suite (f64 little-endian or f32 big-endian vertices, uchar-count int32
+//! faces; f32 values widen to f64 exactly) cross-checks them bit for bit.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use dhcd::ccd::{self, CcdOptions};
+use dhcd::io::{load_as, Limits};
+use dhcd::mesh::Precision;
 
 fn data() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data")
@@ -120,8 +122,23 @@ fn frame_truth_labels_match() {
         ("n-body-simulation-18", "n-body-simulation-19"),
         ("rod-twist-3036", "rod-twist-3037"),
     ] {
-        let (p0, tris) = read_ply(&data().join(format!("real-frames/{name}.ply")));
-        let (p1, tris1) = read_ply(&data().join(format!("real-frames/{next}.ply")));
+        let load = |f: &str| {
+            let path = data().join(format!("real-frames/{f}.ply"));
+            let mesh = load_as(&path, &Limits::default(), Precision::F64).unwrap();
+            let pos = mesh.positions_f64().expect("an f64 mesh").to_vec();
+            let (own_pos, own_tris) = read_ply(&path);
+            assert!(pos
+                .iter()
+                .zip(&own_pos)
+                .all(|(a, b)| a.map(f64::to_bits) == b.map(f64::to_bits)));
+            assert_eq!(
+                (pos.len(), mesh.triangles()),
+                (own_pos.len(), &own_tris[..])
+            );
+            (pos, own_tris)
+        };
+        let (p0, tris) = load(name);
+        let (p1, tris1) = load(next);
         assert_eq!(tris, tris1);
         let text =
             std::fs::read_to_string(data().join(format!("ccd/frame-truth/{name}.tsv"))).unwrap();

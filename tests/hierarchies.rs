@@ -18,12 +18,12 @@ fn with_positions(mesh: &Mesh, positions: Vec<[f32; 3]>) -> Mesh {
 
 /// Collides `a` and `b` (rest poses) with kind `K`, checks invariants, returns the pairs.
 fn pairs_of<K: BvKind>(a: &Mesh, b: &Mesh, options: Options) -> Vec<[u32; 2]> {
-    let mut ha = Hierarchy::<K>::new(a, options).unwrap();
-    let mut hb = Hierarchy::<K>::new(b, options).unwrap();
+    let ha = Hierarchy::<K>::new(a, options).unwrap();
+    let hb = Hierarchy::<K>::new(b, options).unwrap();
     ha.tree().check_topology(a).unwrap();
     ha.validate().unwrap();
     hb.validate().unwrap();
-    let c = collide(&mut ha, &mut hb);
+    let c = collide(&ha, &hb);
     ha.validate().unwrap();
     hb.validate().unwrap();
     assert_eq!(c.counters.contacts as usize, c.pairs.len());
@@ -156,7 +156,7 @@ fn deforming_sequence<K: BvKind>(
                 "eager refit fits all"
             );
         }
-        let c = collide(&mut ha, &mut hb);
+        let c = collide(&ha, &hb);
         ha.validate().unwrap();
         hb.validate().unwrap();
         let expected = brute_force_pairs(&with_positions(&a, pa), &with_positions(&b, pb));
@@ -192,7 +192,7 @@ fn collapse_to_degenerate_during_deformation() {
     let a = grid(3, 3, 1.0, [0.0, 0.0, 0.0]);
     let b = grid(3, 3, 1.0, [0.5, 0.5, 0.0]);
     let mut hb = Hierarchy::<Dh>::new(&b, Options::default()).unwrap();
-    let mut ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
+    let ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
     // Flatten b onto a line (every triangle becomes a segment), lifted so it crosses a.
     let flat: Vec<[f32; 3]> = b
         .positions()
@@ -200,7 +200,7 @@ fn collapse_to_degenerate_during_deformation() {
         .map(|p| [p[0], 1.25, p[1] - 1.5])
         .collect();
     hb.update_positions(&flat).unwrap();
-    let c = collide(&mut ha, &mut hb);
+    let c = collide(&ha, &hb);
     hb.validate().unwrap();
     assert_eq!(c.pairs, brute_force_pairs(&a, &with_positions(&b, flat)));
     assert!(!c.pairs.is_empty());
@@ -273,13 +273,13 @@ fn lazy_refit_updates_only_tested_nodes() {
         .unwrap();
     hb.update_positions(&wave(b.positions(), 1.0, 0.1, [0.0; 3]))
         .unwrap();
-    let c = collide(&mut ha, &mut hb);
+    let c = collide(&ha, &hb);
     // Far apart: only the roots are tested, so only the roots are refitted.
     assert_eq!(c.counters.bv_tests, 1);
     assert_eq!(c.counters.bv_updates, 2);
     assert_eq!(ha.validate().unwrap(), 1);
     // A second query in the same step refits nothing.
-    assert_eq!(collide(&mut ha, &mut hb).counters.bv_updates, 0);
+    assert_eq!(collide(&ha, &hb).counters.bv_updates, 0);
 }
 
 #[test]
@@ -370,9 +370,9 @@ fn bad_update_is_an_error_and_changes_nothing() {
     let b = icosphere(2, 1.0, [1.5, 0.0, 0.0]);
     for method in Method::ALL {
         let mut ha = dhcd::AnyHierarchy::new(method, &a, Options::default()).unwrap();
-        let mut hb = dhcd::AnyHierarchy::new(method, &b, Options::default()).unwrap();
+        let hb = dhcd::AnyHierarchy::new(method, &b, Options::default()).unwrap();
         let mut ws = dhcd::Workspace::default();
-        let before = ha.collide(&mut hb, &mut ws, dhcd::Par::Seq).unwrap().pairs;
+        let before = ha.collide(&hb, &mut ws, dhcd::Par::Seq).unwrap().pairs;
         let n = a.vertex_count();
         assert_eq!(
             ha.update_positions(&a.positions()[..n - 1]),
@@ -394,17 +394,17 @@ fn bad_update_is_an_error_and_changes_nothing() {
             Err(Error::NonFinite { vertex: 3, .. })
         ));
         assert_eq!(
-            ha.collide(&mut hb, &mut ws, dhcd::Par::Seq).unwrap().pairs,
+            ha.collide(&hb, &mut ws, dhcd::Par::Seq).unwrap().pairs,
             before
         );
         ha.validate().unwrap();
-        let mut other = dhcd::AnyHierarchy::new(
+        let other = dhcd::AnyHierarchy::new(
             Method::ALL[(method as usize + 1) % 3],
             &b,
             Options::default(),
         )
         .unwrap();
-        assert!(ha.collide(&mut other, &mut ws, dhcd::Par::Seq).is_err());
+        assert!(ha.collide(&other, &mut ws, dhcd::Par::Seq).is_err());
     }
 }
 
@@ -465,7 +465,7 @@ fn sequence_with<K: BvKind>(par: dhcd::Par, grain: usize) -> Vec<dhcd::Contacts>
                 [1.7 - 0.05 * step as f32, 0.2, 0.0],
             ))
             .unwrap();
-            let c = dhcd::collide_with(&mut ha, &mut hb, &mut ws, par);
+            let c = dhcd::collide_with(&ha, &hb, &mut ws, par);
             ha.validate().unwrap();
             hb.validate().unwrap();
             c
@@ -506,14 +506,14 @@ fn broad_then_narrow_phase_equals_collide() {
         .unwrap();
     hb.update_positions(&wave(b.positions(), 0.5, 0.1, [1.4, 0.3, 0.0]))
         .unwrap();
-    let whole = collide(&mut ha.clone(), &mut hb.clone());
+    let whole = collide(&ha.clone(), &hb.clone());
     let mut ws = dhcd::Workspace::default();
-    let broad = dhcd::broad_phase(&mut ha, &mut hb, &mut ws, dhcd::Par::Seq);
-    let narrow = dhcd::narrow_phase(&ha, &hb, ws.leaf_pairs(), dhcd::Par::Rayon(2)).unwrap();
+    let broad = dhcd::broad_phase(&ha, &hb, &mut ws, dhcd::Par::Seq);
+    let narrow = dhcd::narrow_phase(&ha, &hb, &broad.leaf_pairs, dhcd::Par::Rayon(2)).unwrap();
     assert_eq!(narrow.pairs, whole.pairs);
-    assert_eq!(broad.bv_tests, whole.counters.bv_tests);
-    assert_eq!(broad.bv_updates, whole.counters.bv_updates);
-    assert_eq!(broad.prim_tests, whole.counters.prim_tests);
+    assert_eq!(broad.counters.bv_tests, whole.counters.bv_tests);
+    assert_eq!(broad.counters.bv_updates, whole.counters.bv_updates);
+    assert_eq!(broad.counters.prim_tests, whole.counters.prim_tests);
     assert_eq!(narrow.counters.prim_tests, whole.counters.prim_tests);
     // Replaying the step's refit: invalidate, then refit exactly the nodes the query fitted.
     let fitted = ha.fitted_nodes();
@@ -523,8 +523,10 @@ fn broad_then_narrow_phase_equals_collide() {
     );
     ha.invalidate();
     assert_eq!(ha.validate().unwrap(), 0);
-    ha.refit_nodes(&fitted, dhcd::Par::Rayon(2)).unwrap();
-    assert_eq!(ha.take_updates(), fitted.len() as u64);
+    assert_eq!(
+        ha.refit_nodes(&fitted, dhcd::Par::Rayon(2)).unwrap(),
+        fitted.len() as u64
+    );
     assert_eq!(ha.validate().unwrap(), fitted.len());
     // Node ids from elsewhere are errors, not panics.
     let n = ha.node_count() as u32;

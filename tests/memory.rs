@@ -68,10 +68,10 @@ fn collide_scratch_does_not_grow_with_the_work() {
     let a = noisy_grid(cells, [0.0; 3], 1);
     let b = noisy_grid(cells, [0.31 / cells as f32, 0.17 / cells as f32, 0.0], 2);
     for method in Method::ALL {
-        let mut ha = AnyHierarchy::new(method, &a, deep()).unwrap();
-        let mut hb = AnyHierarchy::new(method, &b, deep()).unwrap();
+        let ha = AnyHierarchy::new(method, &a, deep()).unwrap();
+        let hb = AnyHierarchy::new(method, &b, deep()).unwrap();
         let (c, peak) = peak_bytes(|| {
-            ha.collide(&mut hb, &mut Workspace::default(), Par::Seq)
+            ha.collide(&hb, &mut Workspace::default(), Par::Seq)
                 .unwrap()
         });
         assert_bounded(&format!("collide {method}"), &c, peak);

@@ -75,7 +75,6 @@ fn validate_all(h: &mut AnyHierarchy, what: &str) {
     h.refit_nodes(&all, Par::Seq).unwrap();
     let checked = h.validate().unwrap_or_else(|e| panic!("{what}: {e}"));
     assert_eq!(checked, h.node_count(), "{what}: every node checked");
-    h.take_updates();
 }
 
 /// Both frames of a pair, every kind: build on `first`, query, refit to `second`, query;

@@ -45,13 +45,13 @@ fn check<K: BvKind>(rest: &Mesh, posed: &[[f32; 3]], options: Options) -> Vec<[u
     let expected = brute_force_self_pairs(&with_positions(rest, posed.to_vec()));
     let mut h = Hierarchy::<K>::new(rest, options).unwrap();
     h.update_positions(posed).unwrap();
-    let c = self_collide(&mut h);
+    let c = self_collide(&h);
     h.validate().unwrap();
     assert_eq!(c.pairs, expected, "{:?} {:?}", K::METHOD, options);
     assert_eq!(c.counters.contacts as usize, c.pairs.len());
     assert!(c.pairs.iter().all(|p| p[0] < p[1]));
     // A second query in the same pose refits nothing and finds the same.
-    let again = self_collide(&mut h);
+    let again = self_collide(&h);
     assert_eq!(again.pairs, expected);
     assert_eq!(again.counters.bv_updates, 0);
     expected
@@ -100,8 +100,8 @@ fn crumpled_sphere_equals_brute_force() {
 #[test]
 fn smooth_sphere_has_no_self_contacts() {
     let s = icosphere(3, 1.0, [0.0; 3]);
-    let mut h = Hierarchy::<Dh>::new(&s, Options::default()).unwrap();
-    let c = self_collide(&mut h);
+    let h = Hierarchy::<Dh>::new(&s, Options::default()).unwrap();
+    let c = self_collide(&h);
     assert!(c.pairs.is_empty());
     assert!(c.counters.bv_tests > 0);
     assert!(c.counters.prim_tests > 0, "neighbouring leaves are tested");
@@ -114,8 +114,8 @@ fn single_triangle_and_shared_vertices() {
         vec![[0, 1, 2]],
     )
     .unwrap();
-    let mut h = Hierarchy::<Aabb>::new(&one, Options::default()).unwrap();
-    let c = self_collide(&mut h);
+    let h = Hierarchy::<Aabb>::new(&one, Options::default()).unwrap();
+    let c = self_collide(&h);
     assert!(c.pairs.is_empty());
     assert_eq!(c.counters.prim_tests, 0);
     // Two coplanar overlapping triangles that share vertex 0: excluded; a third crossing
@@ -141,15 +141,15 @@ fn single_triangle_and_shared_vertices() {
         let expected = brute_force_self_pairs(&m);
         assert_eq!(expected, vec![[0, 2], [1, 2]]);
         assert_eq!(
-            self_collide(&mut Hierarchy::<Dh>::new(&m, options).unwrap()).pairs,
+            self_collide(&Hierarchy::<Dh>::new(&m, options).unwrap()).pairs,
             expected
         );
         assert_eq!(
-            self_collide(&mut Hierarchy::<Sphere>::new(&m, options).unwrap()).pairs,
+            self_collide(&Hierarchy::<Sphere>::new(&m, options).unwrap()).pairs,
             expected
         );
         assert_eq!(
-            self_collide(&mut Hierarchy::<Aabb>::new(&m, options).unwrap()).pairs,
+            self_collide(&Hierarchy::<Aabb>::new(&m, options).unwrap()).pairs,
             expected
         );
     }
@@ -164,7 +164,7 @@ fn sequence<K: BvKind>(par: Par, grain: usize) -> Vec<dhcd::Contacts> {
         .map(|step| {
             h.update_positions(&wave(s.positions(), step as f32 * 0.8, 0.5, [0.0; 3]))
                 .unwrap();
-            let c = self_collide_with(&mut h, &mut ws, par);
+            let c = self_collide_with(&h, &mut ws, par);
             h.validate().unwrap();
             c
         })
@@ -223,19 +223,20 @@ fn self_broad_phase_matches_query_for<K: BvKind>() {
         let (_, posed) = folded_grid(12, step as f32, 0.05);
         let mut whole = Hierarchy::<K>::new(&rest, Options::default()).unwrap();
         whole.update_positions(&posed).unwrap();
-        let want = self_collide(&mut whole).counters;
+        let want = self_collide(&whole).counters;
         let mut first: Option<Vec<[u32; 2]>> = None;
         for par in [Par::Seq, Par::Rayon(2), Par::Rayon(3)] {
             let mut h = Hierarchy::<K>::new(&rest, Options::default()).unwrap();
             h.update_positions(&posed).unwrap();
             let mut ws = Workspace::default();
-            let got = dhcd::self_broad_phase(&mut h, &mut ws, par);
+            let broad = dhcd::self_broad_phase(&h, &mut ws, par);
+            let got = broad.counters;
             assert_eq!(got.bv_tests, want.bv_tests, "{:?} {par:?}", K::METHOD);
             assert_eq!(got.bv_updates, want.bv_updates, "{:?} {par:?}", K::METHOD);
             assert_eq!(got.prim_tests, want.prim_tests, "{:?} {par:?}", K::METHOD);
             assert_eq!(got.contacts, 0);
             // Sequential runs list them in walk order, parallel ones sorted.
-            let mut leaves = ws.leaf_pairs().to_vec();
+            let mut leaves = broad.leaf_pairs.clone();
             leaves.sort_unstable();
             let tree = h.tree();
             assert!(leaves

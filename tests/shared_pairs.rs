@@ -106,7 +106,7 @@ fn one_leaf_counts_every_pair_that_shares_no_vertex() {
             ..Options::default()
         };
         let want = n * (n - 1) / 2 - sharing_pairs(&mesh);
-        let c = self_collide(&mut Hierarchy::<Aabb>::new(&mesh, options).unwrap());
+        let c = self_collide(&Hierarchy::<Aabb>::new(&mesh, options).unwrap());
         assert_eq!(c.counters.prim_tests, want, "{name}");
         assert_eq!(c.pairs, brute_force_self_pairs(&mesh), "{name}");
     }
@@ -136,7 +136,7 @@ fn a_mesh_over_the_table_budget_is_answered_without_it() {
     let mesh = Mesh::new(positions, triangles).unwrap();
     let expected = brute_force_self_pairs(&mesh);
     assert!(!expected.is_empty());
-    let mut h = Hierarchy::<Dh>::new(&mesh, Options::default()).unwrap();
+    let h = Hierarchy::<Dh>::new(&mesh, Options::default()).unwrap();
     let tree = h.tree().clone();
     tree.check_topology(&mesh).unwrap();
     let leaves: Vec<usize> = tree.leaves().collect();
@@ -145,7 +145,7 @@ fn a_mesh_over_the_table_budget_is_answered_without_it() {
             assert_eq!(tree.shared_pairs(x, y).unwrap(), direct(&tree, x, y));
         }
     }
-    assert_eq!(self_collide(&mut h).pairs, expected);
-    let mut s = Hierarchy::<Sphere>::with_tree(tree, &mesh, Options::default()).unwrap();
-    assert_eq!(self_collide(&mut s).pairs, expected);
+    assert_eq!(self_collide(&h).pairs, expected);
+    let s = Hierarchy::<Sphere>::with_tree(tree, &mesh, Options::default()).unwrap();
+    assert_eq!(self_collide(&s).pairs, expected);
 }

@@ -45,9 +45,9 @@ fn a_huge_thread_count_runs_a_tiny_query_with_the_sequential_answer() {
     let a = icosphere(1, 1.0, [0.0; 3]);
     let b = icosphere(1, 1.0, [0.5, 0.0, 0.0]);
     let query = |par| {
-        let mut ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
-        let mut hb = Hierarchy::<Dh>::new(&b, Options::default()).unwrap();
-        dhcd::collide_with(&mut ha, &mut hb, &mut Workspace::default(), par)
+        let ha = Hierarchy::<Dh>::new(&a, Options::default()).unwrap();
+        let hb = Hierarchy::<Dh>::new(&b, Options::default()).unwrap();
+        dhcd::collide_with(&ha, &hb, &mut Workspace::default(), par)
     };
     let seq = query(Par::Seq);
     assert!(!seq.pairs.is_empty());

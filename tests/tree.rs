@@ -78,7 +78,7 @@ fn outliers_do_not_push_a_cluster_into_one_leaf() {
     // 6.5 * 32 n at 32; 4.2 n and 4.8 * 12 n at 12). With the cluster in one leaf the
     // triangle pairs were n^2 / 2 = 5e9.
     for method in Method::ALL {
-        let mut h = AnyHierarchy::with_tree(method, tree.clone(), &mesh, options).unwrap();
+        let h = AnyHierarchy::with_tree(method, tree.clone(), &mesh, options).unwrap();
         let c = h.self_collide(&mut Workspace::default(), Par::Seq);
         eprintln!("{method}: {} levels, {:?}", tree.depth_count(), c.counters);
         assert!(
@@ -284,9 +284,9 @@ fn separate_objects_are_never_one_region() {
         }
     }
     let mut h = Hierarchy::<Aabb>::new(&rest, Options::default()).unwrap();
-    let at_rest = dhcd::self_collide(&mut h).counters;
+    let at_rest = dhcd::self_collide(&h).counters;
     h.update_positions(layout(250.0).positions()).unwrap();
-    let apart = dhcd::self_collide(&mut h).counters;
+    let apart = dhcd::self_collide(&h).counters;
     assert!(
         apart.prim_tests <= at_rest.prim_tests,
         "balls moved apart cost more: {apart:?} vs {at_rest:?}"

@@ -33,7 +33,7 @@ use dhcd::hierarchy::Options;
 use dhcd::mesh::Mesh;
 use dhcd::par::Par;
 use dhcd::scene::{ObjectId, Scene};
-use dhcd::traverse::{Contacts, Workspace};
+use dhcd::{Contacts, Workspace};
 
 /// Success.
 pub const DHCD_OK: c_int = 0;
@@ -404,46 +404,6 @@ pub unsafe extern "C" fn dhcd_hierarchy_method(h: *const DhcdHierarchy, out: *mu
     })
 }
 
-/// Frame-to-frame coherence, off by default: with `on` nonzero, each query through this
-/// handle's scratch (`dhcd_self_collide(h, ...)`, `dhcd_collide(h, b, ...)`) keeps where its
-/// traversal stopped, and the next query of the same kind on the same objects starts there
-/// instead of at the roots. The contacts are exactly the same; the work differs (less on
-/// many deforming meshes, not faster on the meshes measured so far: docs/PERFORMANCE.md).
-/// One front per handle: any other query through it (self after pair, another object, the
-/// two handles swapped) restarts from the roots. `on == 0` drops the kept front.
-///
-/// # Safety
-/// `h` null or a live handle.
-#[no_mangle]
-pub unsafe extern "C" fn dhcd_hierarchy_set_front_tracking(
-    h: *mut DhcdHierarchy,
-    on: c_int,
-) -> c_int {
-    guard(|| {
-        // SAFETY: caller's contract on `h`.
-        let h = unsafe { handle(h, "hierarchy")? };
-        h.ws.set_front_tracking(on != 0);
-        Ok(())
-    })
-}
-
-/// Whether front tracking is on (1) or off (0) for this handle, into `*out`.
-///
-/// # Safety
-/// `h` null or a live handle; `out` null or valid for a write.
-#[no_mangle]
-pub unsafe extern "C" fn dhcd_hierarchy_front_tracking(
-    h: *const DhcdHierarchy,
-    out: *mut c_int,
-) -> c_int {
-    guard(|| {
-        // SAFETY: null or a live handle (caller's contract); only read.
-        let h = unsafe { h.as_ref() }.ok_or_else(|| null("hierarchy"))?;
-        // SAFETY: caller's contract on `out`.
-        unsafe { write(out, c_int::from(h.ws.front_tracking()), "out") }
-    })
-}
-
 /// New positions of the mesh (`3 * vertex_count` floats, the mesh's vertex order and
 /// count). On error the hierarchy is unchanged.
 ///
@@ -463,7 +423,8 @@ pub unsafe extern "C" fn dhcd_hierarchy_update_positions(
                 self::positions(positions, vertex_count)?,
             )
         };
-        Ok(h.h.update_positions(p)?)
+        h.h.update_positions(p)?;
+        Ok(())
     })
 }
 
@@ -491,7 +452,7 @@ pub unsafe extern "C" fn dhcd_collide(
         }
         // SAFETY: live, distinct handles (checked above), so the two `&mut` do not alias.
         let (a, b) = unsafe { (handle(a, "a")?, handle(b, "b")?) };
-        let c = a.h.collide(&mut b.h, &mut a.ws, par(threads)?)?;
+        let c = a.h.collide(&b.h, &mut a.ws, par(threads)?)?;
         // SAFETY: caller's contract on `out` (written above).
         unsafe { write(out, contacts_out(c), "out") }
     })
@@ -781,39 +742,6 @@ pub unsafe extern "C" fn dhcd_scene_set_self_collision(
         // SAFETY: caller's contract.
         let s = unsafe { handle(s, "scene")? };
         Ok(s.scene.set_self_collision(ObjectId(id), on != 0)?)
-    })
-}
-
-/// Frame-to-frame coherence for the whole scene, off by default: with `on` nonzero, each
-/// object pair's query (and each self query) keeps where its traversal stopped, and the next
-/// `dhcd_scene_contacts` starts that pair there. The contacts are exactly the same; the work
-/// differs (fewer node tests on many meshes, not faster on the meshes measured so far:
-/// docs/PERFORMANCE.md). A pair that stops overlapping, or an object removed, drops its
-/// front; `on == 0` drops them all.
-///
-/// # Safety
-/// `s` null or a live handle.
-#[no_mangle]
-pub unsafe extern "C" fn dhcd_scene_set_front_tracking(s: *mut DhcdScene, on: c_int) -> c_int {
-    guard(|| {
-        // SAFETY: caller's contract.
-        let s = unsafe { handle(s, "scene")? };
-        s.scene.set_front_tracking(on != 0);
-        Ok(())
-    })
-}
-
-/// Whether front tracking is on (1) or off (0) for the scene, into `*out`.
-///
-/// # Safety
-/// `s` null or a live handle; `out` null or valid for a write.
-#[no_mangle]
-pub unsafe extern "C" fn dhcd_scene_front_tracking(s: *const DhcdScene, out: *mut c_int) -> c_int {
-    guard(|| {
-        // SAFETY: null or a live handle (caller's contract); only read.
-        let s = unsafe { s.as_ref() }.ok_or_else(|| null("scene"))?;
-        // SAFETY: caller's contract on `out`.
-        unsafe { write(out, c_int::from(s.scene.front_tracking()), "out") }
     })
 }
 

@@ -218,61 +218,6 @@ fn broad_only_counts_what_the_full_step_counts_without_contacts() {
     assert!(text.contains("(broad phase only)"), "{text}");
 }
 
-/// `--front` starts each query from the last one's traversal front: the same contacts as
-/// from the root on every frame and pass, for every method, self and two-object benches, one
-/// and two threads; the node tests counted are the front's, not the root walk's.
-#[test]
-fn front_tracking_finds_the_same_contacts() {
-    let dir = temp_dir("bench-front");
-    let (first_frame, benches) = self_and_collide_benches(&dir);
-    for base in &benches {
-        let mut root_args: Vec<&str> = base.iter().map(String::as_str).collect();
-        root_args.extend([
-            "--method",
-            "all",
-            "--repeat",
-            "3",
-            "--json",
-            "--leaf-size",
-            "4",
-        ]);
-        let root = json_of(&root_args);
-        for threads in ["1", "2"] {
-            let mut front = root_args.clone();
-            front.extend(["--front", "--threads", threads]);
-            let front = json_of(&front);
-            let (mut tests_root, mut tests_front) = (0, 0);
-            for (r, f) in root
-                .as_array()
-                .unwrap()
-                .iter()
-                .zip(front.as_array().unwrap())
-            {
-                assert_eq!(
-                    (r["front"].clone(), f["front"].clone()),
-                    (false.into(), true.into())
-                );
-                for (rf, ff) in r["frames"]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .zip(f["frames"].as_array().unwrap())
-                {
-                    assert_eq!(rf["contacts"], ff["contacts"], "{r} {f}");
-                    tests_root += rf["counters"]["bv_tests"].as_u64().unwrap();
-                    tests_front += ff["counters"]["bv_tests"].as_u64().unwrap();
-                }
-            }
-            // The queries did start from a front (the work differs; fewer or more node
-            // tests depending on the mesh).
-            assert_ne!(tests_front, tests_root);
-        }
-    }
-    let out = dhcd(&["bench", "self", &first_frame, "--front"]);
-    let text = String::from_utf8(out.stdout).unwrap();
-    assert!(text.contains("from the last front"), "{text}");
-}
-
 #[test]
 fn text_output_names_the_build_and_step_times_and_every_frame() {
     let dir = temp_dir("bench-text");

@@ -63,8 +63,23 @@
 //! ever drops pairs, and runs on the rows the other stages leave undecided (flat grid:
 //! 75 -> 20 ms a step on 100 K triangles; armadillo -16%).
 //!
-//! Results are bit-identical to [`leaf_contacts_scalar`] on every backend (same operation
-//! order, no fused multiply-add; the canonical form's vertex choices are selects).
+//! **Rounded corners.** For `f64` geometry the blocks hold the nearest `f32`s of the exact
+//! corners, with boxes rounded outward so that they hold the exact triangles
+//! ([`leaf_candidates_rounded_with`]). Each exact coordinate lies within
+//! `delta = 2^-24 M + 2^-126` of its `f32` (`M` the largest magnitude in the pair's union
+//! box), so every difference of two points moves by at most `2 delta` per axis and, by
+//! multilinearity, a determinant of three differences by at most `12 delta sigma_2(E)`
+//! (`sigma_2(E) = E_x E_y + E_y E_z + E_z E_x`, every difference of either corner set bounded
+//! by the union extents `E`). The plane filter then certifies a sign only beyond its bound
+//! plus `13 delta sigma_2(E)` (the `13` covers the rounding of the slack itself), which is
+//! then the exact sign for the `f64` corners: a separating plane certified this way
+//! separates the exact triangles. The canonical form and the projection are not run (their
+//! verdicts would need the same slack); every candidate is left *undecided*, for the caller's
+//! exact test on the `f64` corners.
+//!
+//! Results are bit-identical to [`leaf_contacts_scalar`] (and [`leaf_candidates_rounded_scalar`])
+//! on every backend (same operation order, no fused multiply-add; the canonical form's vertex
+//! choices are selects).
 
 use crate::lanes::{load_prefix, load_prefix_u32, mask_bits};
 use crate::Tile;
@@ -93,6 +108,38 @@ pub const PLANE_ERR: f32 = 8.0 * (f32::EPSILON / 2.0);
 /// The absolute factor for gradual underflow: `2^-126`, the smallest normal `f32` (a
 /// subnormal factor would make every bound an FP assist; see the module doc).
 pub const PLANE_TINY: f32 = f32::MIN_POSITIVE;
+
+/// The factor of the rounded-corner slack `13 delta sigma_2(E)` (module doc, "Rounded
+/// corners").
+const SLACK_FACTOR: f32 = 13.0;
+
+/// The rounding error of one `f32` coordinate of magnitude at most `m`, rounded up:
+/// `2^-24 m + 2^-126`.
+#[inline(always)]
+fn coordinate_error(m: f32) -> f32 {
+    m * (f32::EPSILON / 2.0) + f32::MIN_POSITIVE
+}
+
+/// The rounded-corner slack of a pair (module doc): `13 delta sigma_2(E)`, `delta` the
+/// coordinate error at the union box's largest magnitude `m`, in the operation order the
+/// SIMD body repeats.
+#[inline(always)]
+fn rounding_slack(ext: &[f32; 3], m: f32) -> f32 {
+    let s2 = (ext[0] * ext[1] + ext[1] * ext[2]) + ext[2] * ext[0];
+    (SLACK_FACTOR * coordinate_error(m)) * s2
+}
+
+/// The largest magnitude of the union of two boxes.
+#[inline(always)]
+fn union_magnitude(a: &([f32; 3], [f32; 3]), b: &([f32; 3], [f32; 3])) -> f32 {
+    let mut m = 0.0f32;
+    for k in 0..3 {
+        m = m
+            .max(a.0[k].min(b.0[k]).abs())
+            .max(a.1[k].max(b.1[k]).abs());
+    }
+    m
+}
 
 /// Triangles in structure-of-arrays form: a [`Tile`] of fifteen fields (coordinate `k` of
 /// corner `c` is field `3c + k`, then the closed box: min x, y, z, max x, y, z) and a tile of
@@ -296,12 +343,13 @@ fn union_extents(a: &([f32; 3], [f32; 3]), b: &([f32; 3], [f32; 3])) -> [f32; 3]
 }
 
 /// The filter's certification bound for every corner of a pair against the plane of
-/// magnitudes `m`, the pair's union extents `ext` (module doc).
+/// magnitudes `m`, the pair's union extents `ext` (module doc), plus `slack` (0, or the
+/// rounded-corner slack).
 #[inline(always)]
-fn pair_bound(m: &[f32; 3], ext: &[f32; 3]) -> f32 {
+fn pair_bound(m: &[f32; 3], ext: &[f32; 3], slack: f32) -> f32 {
     let p = ext[0] * m[0] + ext[1] * m[1] + ext[2] * m[2];
     let l = ext[0] + ext[1] + ext[2];
-    PLANE_ERR * p + PLANE_TINY * (l + 2.0)
+    PLANE_ERR * p + (PLANE_TINY * (l + 2.0) + slack)
 }
 
 /// The filter's sides of the three points `d` against the plane `(a, n)` with the pair's
@@ -325,12 +373,17 @@ fn det(a: &[f32; 3], n: &[f32; 3], d: &[f32; 3]) -> ([f32; 3], f32) {
 /// The filter's signs of a pair: `a`'s corners against `b`'s plane, `b`'s against `a`'s,
 /// `ext` the union extents of their boxes.
 #[inline(always)]
-fn filter_signs(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], ext: &[f32; 3]) -> ([i32; 3], [i32; 3]) {
+fn filter_signs(
+    a: &[[f32; 3]; 3],
+    b: &[[f32; 3]; 3],
+    ext: &[f32; 3],
+    slack: f32,
+) -> ([i32; 3], [i32; 3]) {
     let (an, am) = plane(a);
     let (bn, bm) = plane(b);
     (
-        sides_within(&b[0], &bn, pair_bound(&bm, ext), a),
-        sides_within(&a[0], &an, pair_bound(&am, ext), b),
+        sides_within(&b[0], &bn, pair_bound(&bm, ext, slack), a),
+        sides_within(&a[0], &an, pair_bound(&am, ext, slack), b),
     )
 }
 
@@ -393,7 +446,7 @@ fn projected_apart(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], n_a: &[f32; 3]) -> bool
 /// Whether a separating plane of `a` or `b` is certified (the plane filter on one pair,
 /// boxes from the corners).
 pub fn plane_separated(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
-    let (sa, sb) = filter_signs(a, b, &union_extents(&corner_box(a), &corner_box(b)));
+    let (sa, sb) = filter_signs(a, b, &union_extents(&corner_box(a), &corner_box(b)), 0.0);
     one_side(sa) || one_side(sb)
 }
 
@@ -445,7 +498,7 @@ fn verdict_within(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], ext: &[f32; 3]) -> Verdi
 /// The plane filter and the certified canonical form on one pair.
 fn planes_and_canonical(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], ext: &[f32; 3]) -> Verdict {
     // sa: a's corners against b's plane; sb: b's corners against a's plane.
-    let (sa, sb) = filter_signs(a, b, ext);
+    let (sa, sb) = filter_signs(a, b, ext, 0.0);
     if one_side(sa) || one_side(sb) {
         return Verdict::Apart;
     }
@@ -519,6 +572,29 @@ pub fn leaf_contacts_scalar(
     pairing: Pairing,
     out: &mut [Row],
 ) {
+    rows_scalar::<false>(a, na, b, nb, pairing, out)
+}
+
+/// Scalar reference of [`leaf_candidates_rounded_with`] (one pair at a time).
+pub fn leaf_candidates_rounded_scalar(
+    a: TriSoa,
+    na: usize,
+    b: TriSoa,
+    nb: usize,
+    pairing: Pairing,
+    out: &mut [Row],
+) {
+    rows_scalar::<true>(a, na, b, nb, pairing, out)
+}
+
+fn rows_scalar<const ROUNDED: bool>(
+    a: TriSoa,
+    na: usize,
+    b: TriSoa,
+    nb: usize,
+    pairing: Pairing,
+    out: &mut [Row],
+) {
     check(&a, na, &b, nb, out);
     for i in 0..na {
         let ta = a.corners(i);
@@ -541,7 +617,16 @@ pub fn leaf_contacts_scalar(
                     [t.hi(0)[i], t.hi(1)[i], t.hi(2)[i]],
                 )
             };
-            let ext = union_extents(&stored(&a, i), &stored(&b, j));
+            let (sa, sb) = (stored(&a, i), stored(&b, j));
+            let ext = union_extents(&sa, &sb);
+            if ROUNDED {
+                let slack = rounding_slack(&ext, union_magnitude(&sa, &sb));
+                let (s1, s2) = filter_signs(&ta, &b.corners(j), &ext, slack);
+                if !(one_side(s1) || one_side(s2)) {
+                    row.undecided |= 1 << j;
+                }
+                continue;
+            }
             match verdict_within(&ta, &b.corners(j), &ext) {
                 Verdict::Apart => {}
                 Verdict::Contact => row.contact |= 1 << j,
@@ -679,6 +764,37 @@ pub fn leaf_contacts_with<S: Simd>(
     pairing: Pairing,
     out: &mut [Row],
 ) {
+    leaf_rows::<S, false>(simd, a, na, b, nb, pairing, out)
+}
+
+/// [`leaf_contacts_with`] for blocks whose corners are the nearest `f32`s of `f64` corners
+/// and whose boxes are rounded outward (module doc, "Rounded corners"): `out[i].undecided`
+/// gets bit `j` iff `(i, j)` is allowed, the boxes overlap and no separating plane is
+/// certified for the exact corners (the slack included); `contact` is always empty. Every
+/// pair left out certainly does not intersect for the exact corners.
+#[inline(always)]
+pub fn leaf_candidates_rounded_with<S: Simd>(
+    simd: S,
+    a: TriSoa,
+    na: usize,
+    b: TriSoa,
+    nb: usize,
+    pairing: Pairing,
+    out: &mut [Row],
+) {
+    leaf_rows::<S, true>(simd, a, na, b, nb, pairing, out)
+}
+
+#[inline(always)]
+fn leaf_rows<S: Simd, const ROUNDED: bool>(
+    simd: S,
+    a: TriSoa,
+    na: usize,
+    b: TriSoa,
+    nb: usize,
+    pairing: Pairing,
+    out: &mut [Row],
+) {
     check(&a, na, &b, nb, out);
     for row in out[..na].iter_mut() {
         *row = Row::default();
@@ -700,7 +816,7 @@ pub fn leaf_contacts_with<S: Simd>(
         let (fa, out) = (a.skip(a0).fields(n), &mut out[a0..a0 + n]);
         let mut decidable_rows = [0u64; MAX_ROW];
         let mut candidate_rows = [0u64; MAX_ROW];
-        if filter(
+        if filter::<S, ROUNDED>(
             simd,
             k,
             &fa,
@@ -715,9 +831,10 @@ pub fn leaf_contacts_with<S: Simd>(
         ) {
             decide(simd, k, &fa, &fb, nb, len, out, &decidable_rows);
         }
-        if candidate_rows[..nb.div_ceil(S::F32_LANES)]
-            .iter()
-            .any(|&r| r != 0)
+        if !ROUNDED
+            && candidate_rows[..nb.div_ceil(S::F32_LANES)]
+                .iter()
+                .any(|&r| r != 0)
         {
             project(simd, k, &fa, &fb, nb, len, out, &candidate_rows);
         }
@@ -727,10 +844,11 @@ pub fn leaf_contacts_with<S: Simd>(
 
 /// The filter pass of [`leaf_contacts_with`]: the candidates in `undecided`, and per lane
 /// vector of B (`base / F32_LANES`) the rows with candidates the decision pass may certify
-/// and the rows with any candidate. Returns whether there is any of the first kind.
+/// and the rows with any candidate. Returns whether there is any of the first kind (never,
+/// for `ROUNDED` corners: their candidates are all left undecided).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn filter<S: Simd>(
+fn filter<S: Simd, const ROUNDED: bool>(
     simd: S,
     k: Consts<S>,
     fa: &Fields,
@@ -872,10 +990,13 @@ fn filter<S: Simd>(
                     simd.min_f32s(simd.splat_f32s(fa.lo[d][i]), blo[d]),
                 );
             }
-            let tiny = simd.mul_f32s(
+            let mut tiny = simd.mul_f32s(
                 k.tiny,
                 simd.add_f32s(simd.add_f32s(simd.add_f32s(ext[0], ext[1]), ext[2]), k.two),
             );
+            if ROUNDED {
+                tiny = simd.add_f32s(tiny, slack_simd(simd, k, fa, i, &blo, &bhi, &ext));
+            }
             let bound_a = bound_simd(simd, k, &ext, &splat3(simd, am), tiny);
             let bound_b = bound_simd(simd, k, &ext, &bm, tiny);
             // The block's corners against triangle i's plane, then i's corners against the
@@ -883,6 +1004,11 @@ fn filter<S: Simd>(
             let (sep_a, cert_a) = separated_simd(simd, k, &pc[0], &splat3(simd, an), bound_a, &bc);
             let (sep_b, cert_b) = separated_simd(simd, k, &bc[0], &bn, bound_b, &pc);
             bits &= !u64::from(mask_bits(simd, simd.or_m32s(sep_a, sep_b)));
+            if ROUNDED {
+                out[i].undecided |= bits << base;
+                candidate_rows[base / S::F32_LANES] |= u64::from(bits != 0) << i;
+                continue;
+            }
             let decidable = bits & u64::from(mask_bits(simd, simd.and_m32s(cert_a, cert_b)));
             // `contact` holds the decidable candidates until the decision pass.
             out[i].contact |= decidable << base;
@@ -1209,6 +1335,37 @@ fn orient2_simd<S: Simd>(
         simd.greater_than_f32s(o, bound),
         simd.less_than_f32s(o, simd.sub_f32s(k.zero, bound)),
     )
+}
+
+/// The lane-wise [`rounding_slack`] of row `i` of `fa` against the lanes `blo..bhi`, whose
+/// union extents are `ext`.
+#[inline(always)]
+fn slack_simd<S: Simd>(
+    simd: S,
+    k: Consts<S>,
+    fa: &Fields,
+    i: usize,
+    blo: &[S::f32s; 3],
+    bhi: &[S::f32s; 3],
+    ext: &[S::f32s; 3],
+) -> S::f32s {
+    // |x| as max(x, -x): comparisons and subtractions only, the same on every backend.
+    let abs = |x: S::f32s| simd.max_f32s(x, simd.sub_f32s(k.zero, x));
+    let mut m = k.zero;
+    for d in 0..3 {
+        let lo = simd.min_f32s(simd.splat_f32s(fa.lo[d][i]), blo[d]);
+        let hi = simd.max_f32s(simd.splat_f32s(fa.hi[d][i]), bhi[d]);
+        m = simd.max_f32s(simd.max_f32s(m, abs(lo)), abs(hi));
+    }
+    let delta = simd.add_f32s(
+        simd.mul_f32s(m, simd.splat_f32s(f32::EPSILON / 2.0)),
+        k.tiny,
+    );
+    let s2 = simd.add_f32s(
+        simd.add_f32s(simd.mul_f32s(ext[0], ext[1]), simd.mul_f32s(ext[1], ext[2])),
+        simd.mul_f32s(ext[2], ext[0]),
+    );
+    simd.mul_f32s(simd.mul_f32s(simd.splat_f32s(SLACK_FACTOR), delta), s2)
 }
 
 /// The lane-wise [`pair_bound`], its absolute term `tiny` given.

@@ -547,6 +547,38 @@ fn check_leaf_contacts<S: Simd>(simd: S) {
                             .enumerate()
                             .all(|(i, r)| r.candidates() & low64(i + 1) == 0));
                     }
+                    // The rounded-corner variant: the same bits as its scalar reference, no
+                    // certain contact, and a superset of the plain kernel's candidates (its
+                    // slack only keeps more pairs).
+                    let mut want_r = vec![row(7); na + 1];
+                    let mut got_r = vec![row(9); na + 1];
+                    narrow::leaf_candidates_rounded_scalar(
+                        a.soa(),
+                        na,
+                        b.soa(),
+                        nb,
+                        pairing,
+                        &mut want_r,
+                    );
+                    narrow::leaf_candidates_rounded_with(
+                        simd,
+                        a.soa(),
+                        na,
+                        b.soa(),
+                        nb,
+                        pairing,
+                        &mut got_r,
+                    );
+                    assert_eq!(
+                        &got_r[..na],
+                        &want_r[..na],
+                        "rounded {simd:?} na={na} nb={nb} {pairing:?} scale={scale}"
+                    );
+                    assert_eq!(got_r[na], row(9), "wrote past na rows");
+                    for (r, p) in got_r[..na].iter().zip(&got[..na]) {
+                        assert_eq!(r.contact, 0);
+                        assert_eq!(p.candidates() & !r.undecided, 0, "a candidate dropped");
+                    }
                 }
             }
         }

@@ -94,18 +94,6 @@ class Hierarchy:
     def method(self) -> str:
         """``"dh"``, ``"sphere"`` or ``"aabb"``."""
     @property
-    def front_tracking(self) -> bool:
-        """Frame-to-frame coherence, off by default. On, each query through this
-        hierarchy's scratch (``h.self_collide()``, and ``dhcd.collide(h, other)`` with ``h``
-        first: a pair query uses its first argument's) keeps where its traversal stopped, and
-        the next query of the same kind on the same objects, in the same order, starts there
-        instead of at the roots: the same contacts, fewer node tests on many meshes, not
-        faster on the meshes measured so far. One front per hierarchy: any other query
-        through it (self after pair, another object, the objects swapped) restarts from the
-        roots. Setting it off drops the kept front."""
-    @front_tracking.setter
-    def front_tracking(self, on: bool) -> None: ...
-    @property
     def bytes_per_node(self) -> int:
         """Size of one node record: 8, 16 or 24."""
     @property
@@ -165,15 +153,6 @@ class Scene:
     def remove(self, id: Union[int, str]) -> None: ...
     def set_self_collision(self, id: Union[int, str], on: bool) -> None:
         """With ``on``, ``contacts`` also reports the object's own intersecting faces."""
-    @property
-    def front_tracking(self) -> bool:
-        """Frame-to-frame coherence, off by default. On, each object pair's query (and
-        each self query) keeps where its traversal stopped, and the next ``contacts()``
-        starts that pair there: the same contacts, fewer node tests on many meshes, not
-        faster on the meshes measured so far. A pair that stops overlapping, or an object
-        removed, drops its front; off drops them all."""
-    @front_tracking.setter
-    def front_tracking(self, on: bool) -> None: ...
     def contacts(self, threads: int = 1) -> Contacts:
         """Every contact: rows ``[object_a, face_a, object_b, face_b]``, sorted,
         ``object_a < object_b`` (``==`` for self-contacts, then ``face_a < face_b``)."""

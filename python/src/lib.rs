@@ -286,7 +286,9 @@ impl Hierarchy {
         let v = Vertices::new(vertices)?;
         let positions = v.as_slice()?;
         let h = &mut self.h;
-        py.detach(|| h.update_positions(positions)).map_err(to_py)
+        py.detach(|| h.update_positions(positions))
+            .map(|_| ())
+            .map_err(to_py)
     }
 
     /// Intersecting face pairs `[i, j]`, `i < j`, of this mesh, sharing no vertex.
@@ -305,19 +307,6 @@ impl Hierarchy {
     #[getter]
     fn method(&self) -> &'static str {
         self.h.method().name()
-    }
-
-    /// Frame-to-frame coherence, off by default: on, each query through this hierarchy's
-    /// scratch (`self_collide`, `collide(h, other)` with it first) starts where the last one
-    /// of the same kind on the same objects stopped. Same contacts; off drops the front.
-    #[getter]
-    fn front_tracking(&self) -> bool {
-        self.ws.front_tracking()
-    }
-
-    #[setter]
-    fn set_front_tracking(&mut self, on: bool) {
-        self.ws.set_front_tracking(on);
     }
 
     #[getter]
@@ -368,7 +357,7 @@ fn collide(
     let (mut a, mut b) = (a.try_borrow_mut()?, b.try_borrow_mut()?);
     let (a, b) = (&mut *a, &mut *b);
     let c = py
-        .detach(|| a.h.collide(&mut b.h, &mut a.ws, par))
+        .detach(|| a.h.collide(&b.h, &mut a.ws, par))
         .map_err(to_py)?;
     Contacts::new(py, widen(c.pairs), c.counters)
 }
@@ -623,18 +612,6 @@ impl Scene {
     fn set_self_collision(&mut self, id: &Bound<'_, PyAny>, on: bool) -> PyResult<()> {
         let id = self.object(id)?;
         self.scene.set_self_collision(id, on).map_err(to_py)
-    }
-
-    /// Frame-to-frame coherence, off by default: on, each object pair's query (and each self
-    /// query) starts where the last step's stopped. Same contacts; off drops the fronts.
-    #[getter]
-    fn front_tracking(&self) -> bool {
-        self.scene.front_tracking()
-    }
-
-    #[setter]
-    fn set_front_tracking(&mut self, on: bool) {
-        self.scene.set_front_tracking(on);
     }
 
     /// Every contact: rows `[object_a, face_a, object_b, face_b]`, sorted.

@@ -75,40 +75,6 @@ def test_self_collision_equals_brute_force(method, levels):
         assert np.all(c.pairs[:, 0] < c.pairs[:, 1])
 
 
-@pytest.mark.parametrize("method", METHODS)
-def test_front_tracking_gives_the_same_contacts(method):
-    va, fa = icosphere(2)
-    vb, fb = icosphere(2, 0.9)
-    rest, _, fs = folded_grid(12)
-    a, b, s = (dhcd.Hierarchy(v, f, method=method) for v, f in [(va, fa), (vb, fb), (rest, fs)])
-    roots = [dhcd.Hierarchy(v, f, method=method) for v, f in [(va, fa), (vb, fb), (rest, fs)]]
-    assert not a.front_tracking, "off by default"
-    a.front_tracking = s.front_tracking = True
-    assert a.front_tracking and not b.front_tracking
-    replayed = set()
-    for step in range(6):
-        t = 0.4 * step
-        pa = wave(va, t, 0.1)
-        pb = wave(vb, -t, 0.1, (1.6 - 0.1 * step, 0.2, 0.0))
-        ps = folded_grid(12, t)[1]
-        for h, p in zip([a, b, s], [pa, pb, ps]):
-            h.update(p)
-        for h, p in zip(roots, [pa, pb, ps]):
-            h.update(p)
-        pair, pair_root = dhcd.collide(a, b), dhcd.collide(roots[0], roots[1])
-        np.testing.assert_array_equal(pair.pairs, brute_force_pairs(pa, fa, pb, fb))
-        np.testing.assert_array_equal(pair.pairs, pair_root.pairs)
-        own, own_root = s.self_collide(), roots[2].self_collide()
-        assert len(own_root) > 0, "the grid folds onto itself"
-        np.testing.assert_array_equal(own.pairs, own_root.pairs)
-        for kind, c, root in [("pair", pair, pair_root), ("self", own, own_root)]:
-            if c.counters["bv_tests"] != root.counters["bv_tests"]:
-                replayed.add(kind)
-    assert replayed == {"pair", "self"}, "later queries start from the kept fronts"
-    a.front_tracking = False
-    assert not a.front_tracking
-
-
 def test_contacts_are_original_face_indices():
     # Faces listed in a scrambled order: pairs name the caller's rows.
     va, fa = icosphere(2)

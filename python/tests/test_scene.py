@@ -165,31 +165,3 @@ def test_update_many_bad_entry_changes_nothing():
     assert len(s.contacts().pairs) == 0
 
 
-@pytest.mark.parametrize("method", list(dhcd._dhcd.METHODS))
-def test_scene_front_tracking_gives_the_same_contacts(method):
-    v, f = icosphere(2)
-    rest, _, sheet_faces = folded_grid(12)
-    scenes = [dhcd.Scene(method=method) for _ in range(2)]
-    tracked, plain = scenes
-    assert not tracked.front_tracking, "off by default"
-    tracked.front_tracking = True
-    for s in scenes:
-        s.add(v, f, name="a")
-        s.add(v, f, name="b")
-        s.add(rest, sheet_faces, name="sheet")
-        s.set_self_collision("sheet", True)
-    replays = 0
-    for step in range(6):
-        t = 0.4 * step
-        for s in scenes:
-            s.update("a", wave(v, t, 0.1))
-            s.update("b", wave(v, -t, 0.1, (2.4 - 0.2 * step, 0.2, 0.0)))
-            s.update("sheet", folded_grid(12, t)[1])
-        c, root = tracked.contacts(), plain.contacts()
-        assert len(root) > 0
-        np.testing.assert_array_equal(c.pairs, root.pairs)
-        assert tracked.contacts(threads=2).pairs.tolist() == c.pairs.tolist()
-        replays += c.counters["bv_tests"] != root.counters["bv_tests"]
-    assert replays > 0, "later steps start from the kept fronts"
-    tracked.front_tracking = False
-    assert not tracked.front_tracking

@@ -36,6 +36,14 @@ fn fit_node(tree: &RegionTree, p: &Points, n: usize) -> AabbNode {
         refit::bounds(p.soa().slice(tree.vert_run(n))),
         refit::bounds_indexed(p.soa(), tree.borrowed(n)),
     );
+    if p.is_rounded() {
+        // An exact coordinate lies within half an ulp of its nearest f32, so beyond the next
+        // f32 outward of no rounded one.
+        return AabbNode {
+            min: min.map(f32::next_down),
+            max: max.map(f32::next_up),
+        };
+    }
     AabbNode { min, max }
 }
 
@@ -83,6 +91,22 @@ impl BvKind for Aabb {
         overlap::aabb_block_with(simd, lo, hi, b, n)
     }
 
+    #[inline(always)]
+    fn test_within<S: pulp::Simd>(
+        simd: S,
+        a: overlap::AabbSoa<'_>,
+        i: usize,
+        b: overlap::AabbSoa<'_>,
+        n: usize,
+        margin: f32,
+    ) -> u32 {
+        // Grown and rounded outward: a box within `margin` along every axis still meets it.
+        let (lo, hi) = a.get(i);
+        let lo = lo.map(|x| (x - margin).next_down());
+        let hi = hi.map(|x| (x + margin).next_up());
+        overlap::aabb_block_with(simd, lo, hi, b, n)
+    }
+
     /// Half the box's perimeter (sum of the extents).
     #[inline(always)]
     fn extent(a: overlap::AabbSoa<'_>, i: usize) -> f32 {
@@ -120,8 +144,7 @@ impl BvKind for Aabb {
         })
     }
 
-    fn encloses(r: &AabbNode, p: &Points, v: usize) -> bool {
-        let q = p.get(v);
-        (0..3).all(|k| r.min[k] <= q[k] && q[k] <= r.max[k])
+    fn encloses(r: &AabbNode, _: &Points, q: [f64; 3]) -> bool {
+        (0..3).all(|k| f64::from(r.min[k]) <= q[k] && q[k] <= f64::from(r.max[k]))
     }
 }

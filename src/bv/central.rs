@@ -176,7 +176,7 @@ impl MinRadius {
         for w in &self.witnesses {
             let [xs, ys, zs] = &self.xyz;
             for (((b, &x), &y), &z) in self.bound.iter_mut().zip(xs).zip(ys).zip(zs) {
-                let d = dist2_f64([x, y, z], *w);
+                let d = dist2_f64([x, y, z], w.map(f64::from));
                 *b = if d > *b { d } else { *b };
             }
         }
@@ -197,7 +197,7 @@ impl MinRadius {
             }
             let refined = self.witnesses[initial..]
                 .iter()
-                .any(|&w| worse(dist2_f64(c, w), id, best));
+                .any(|&w| worse(dist2_f64(c, w.map(f64::from)), id, best));
             if refined {
                 continue;
             }
@@ -269,7 +269,7 @@ fn farthest(kd: &[KdNode], pts: &[([f32; 3], u32)], k: usize, q: &mut Query) {
     let node = kd[k];
     if node.left == 0 {
         for &(p, _) in &pts[node.start as usize..node.end as usize] {
-            let d = dist2_f64(q.c, p);
+            let d = dist2_f64(q.c, p.map(f64::from));
             if d > q.max {
                 q.max = d;
                 q.far = p;
@@ -354,7 +354,10 @@ mod tests {
     fn brute(ids: &[u32], rest: &Points) -> u32 {
         let radius = |c: u32| {
             ids.iter().fold(0.0f64, |m, &v| {
-                m.max(dist2_f64(rest.get(c as usize), rest.get(v as usize)))
+                m.max(dist2_f64(
+                    rest.get(c as usize),
+                    rest.get(v as usize).map(f64::from),
+                ))
             })
         };
         ids.iter()

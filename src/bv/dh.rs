@@ -4,7 +4,7 @@
 //! centre moves with the mesh for free; only the radius is ever recomputed.
 
 use super::{central, sealed, BvKind, Method};
-use super::{conservative_radius, conservative_sum, dist2_f64, Bounds};
+use super::{conservative_radius, conservative_sum, dist2_f64, exact_radius, Bounds};
 use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
@@ -42,7 +42,7 @@ impl sealed::Sealed for Dh {}
 fn radius(tree: &RegionTree, p: &Points, n: usize, c: [f32; 3]) -> f32 {
     let run = refit::max_dist_sq(p.soa().slice(tree.vert_run(n)), c);
     let borrowed = refit::max_dist_sq_indexed(p.soa(), tree.borrowed(n), c);
-    conservative_radius(run.max(borrowed))
+    exact_radius(p, c, conservative_radius(run.max(borrowed)))
 }
 
 impl BvKind for Dh {
@@ -93,6 +93,20 @@ impl BvKind for Dh {
     }
 
     #[inline(always)]
+    fn test_within<S: pulp::Simd>(
+        simd: S,
+        a: overlap::SphereSoa<'_>,
+        i: usize,
+        b: overlap::SphereSoa<'_>,
+        n: usize,
+        margin: f32,
+    ) -> u32 {
+        // The sum rounded up like a bottom-up radius: the test stays conservative.
+        let (c, r) = a.get(i);
+        overlap::sphere_block_with(simd, c, conservative_sum(r, margin), b, n)
+    }
+
+    #[inline(always)]
     fn extent(a: overlap::SphereSoa<'_>, i: usize) -> f32 {
         a.r()[i]
     }
@@ -138,8 +152,8 @@ impl BvKind for Dh {
         })
     }
 
-    fn encloses(r: &DhNode, p: &Points, v: usize) -> bool {
+    fn encloses(r: &DhNode, p: &Points, point: [f64; 3]) -> bool {
         let rad = r.radius as f64;
-        dist2_f64(p.get(r.vertex as usize), p.get(v)) <= rad * rad
+        dist2_f64(p.get(r.vertex as usize), point) <= rad * rad
     }
 }

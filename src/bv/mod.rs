@@ -47,6 +47,18 @@ pub(crate) fn conservative_sum(a: f32, b: f32) -> f32 {
     ((a + b) * RADIUS_INFLATION).max(MIN_RADIUS)
 }
 
+/// A radius fitted around `center` from `p`'s `f32` points, grown when they are roundings
+/// of `f64` positions by how far an exact point may lie from its rounding (the region lies
+/// within `radius` of the centre, so its coordinates within `|center|_inf + radius`).
+#[inline]
+pub(crate) fn exact_radius(p: &Points, center: [f32; 3], radius: f32) -> f32 {
+    if !p.is_rounded() {
+        return radius;
+    }
+    let magnitude = center[0].abs().max(center[1].abs()).max(center[2].abs()) + radius;
+    conservative_sum(radius, p.rounding_slack(magnitude))
+}
+
 mod sealed {
     pub trait Sealed {}
 }
@@ -94,6 +106,16 @@ pub trait BvKind:
         b: Self::Block<'_>,
         n: usize,
     ) -> u32;
+    /// [`BvKind::test`] with entry `i`'s volume grown by `margin` (finite, `>= 0`), rounded
+    /// outward: the bits of every entry of `b` whose volume comes within `margin` of it.
+    fn test_within<S: pulp::Simd>(
+        simd: S,
+        a: Self::Block<'_>,
+        i: usize,
+        b: Self::Block<'_>,
+        n: usize,
+        margin: f32,
+    ) -> u32;
     /// A size of entry `i` of a block, to descend the larger volume of an overlapping pair.
     fn extent(a: Self::Block<'_>, i: usize) -> f32;
     /// The exact bounding volume of node `n` for the current positions `p` (reads the
@@ -107,8 +129,9 @@ pub trait BvKind:
     /// as a bound of its children's volumes: for DH `r_p = max_c(|C_p - C_c| + r_c)`).
     /// Returns the number of nodes fitted.
     fn refit_all(nodes: &mut Self::Nodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64;
-    /// Whether record `r` encloses point `v` of `p` (checked in f64; for validation).
-    fn encloses(r: &Self::Record, p: &Points, v: usize) -> bool;
+    /// Whether record `r` (its centres read from `p`) encloses `point` (checked in f64; for
+    /// validation).
+    fn encloses(r: &Self::Record, p: &Points, point: [f64; 3]) -> bool;
 }
 
 /// The lazily fitted buffers of a kind, grouped by sibling group.
@@ -208,10 +231,10 @@ impl<const F: usize> Bounds<F> {
 }
 
 #[inline]
-pub(crate) fn dist2_f64(a: [f32; 3], b: [f32; 3]) -> f64 {
+pub(crate) fn dist2_f64(a: [f32; 3], b: [f64; 3]) -> f64 {
     (0..3)
         .map(|k| {
-            let d = a[k] as f64 - b[k] as f64;
+            let d = a[k] as f64 - b[k];
             d * d
         })
         .sum()

@@ -1,7 +1,7 @@
 //! Sphere bounding volumes (the paper's SBV): centre = mean of the region's vertices,
 //! radius = largest distance from it. Refitting reads the region twice (mean, then radius).
 
-use super::{conservative_radius, conservative_sum, dist2_f64, Bounds};
+use super::{conservative_radius, conservative_sum, dist2_f64, exact_radius, Bounds};
 use super::{sealed, BvKind, Method};
 use crate::hierarchy::Options;
 use crate::points::Points;
@@ -52,7 +52,7 @@ fn fit_node(tree: &RegionTree, p: &Points, n: usize) -> SphereNode {
         refit::max_dist_sq(run, center).max(refit::max_dist_sq_indexed(p.soa(), borrowed, center));
     SphereNode {
         center,
-        radius: conservative_radius(d2),
+        radius: exact_radius(p, center, conservative_radius(d2)),
     }
 }
 
@@ -101,6 +101,20 @@ impl BvKind for Sphere {
     }
 
     #[inline(always)]
+    fn test_within<S: pulp::Simd>(
+        simd: S,
+        a: overlap::SphereSoa<'_>,
+        i: usize,
+        b: overlap::SphereSoa<'_>,
+        n: usize,
+        margin: f32,
+    ) -> u32 {
+        // The sum rounded up like a bottom-up radius: the test stays conservative.
+        let (c, r) = a.get(i);
+        overlap::sphere_block_with(simd, c, conservative_sum(r, margin), b, n)
+    }
+
+    #[inline(always)]
     fn extent(a: overlap::SphereSoa<'_>, i: usize) -> f32 {
         a.r()[i]
     }
@@ -131,9 +145,9 @@ impl BvKind for Sphere {
         })
     }
 
-    fn encloses(r: &SphereNode, p: &Points, v: usize) -> bool {
+    fn encloses(r: &SphereNode, _: &Points, point: [f64; 3]) -> bool {
         let rad = r.radius as f64;
-        dist2_f64(r.center, p.get(v)) <= rad * rad
+        dist2_f64(r.center, point) <= rad * rad
     }
 }
 

@@ -25,7 +25,7 @@ mod stl;
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, Precision};
 
 pub use obj::{parse_obj, parse_obj_bytes, write_obj};
 pub use ply::parse_ply;
@@ -103,13 +103,22 @@ impl Default for Limits {
 }
 
 /// Loads a mesh with the default [`Limits`], choosing the format from the extension
-/// (case-insensitive) or, failing that, from the contents.
+/// (case-insensitive) or, failing that, from the contents. Coordinates are read as `f32`
+/// ([`Precision::F32`]); see [`load_as`] for `f64`.
 pub fn load(path: &Path) -> Result<Mesh> {
     load_with(path, &Limits::default())
 }
 
 /// As [`load`], within `limits`.
 pub fn load_with(path: &Path, limits: &Limits) -> Result<Mesh> {
+    load_as(path, limits, Precision::F32)
+}
+
+/// As [`load_with`], building a mesh of `precision`. With [`Precision::F64`], PLY `double`
+/// properties and OBJ decimals are read at full `f64` precision (a PLY `float` or an STL
+/// coordinate is an `f32` value, which `f64` holds exactly); with [`Precision::F32`] each
+/// is rounded to the nearest `f32`.
+pub fn load_as(path: &Path, limits: &Limits, precision: Precision) -> Result<Mesh> {
     let bytes = read(path, limits)?;
     let format = match Format::from_extension(path).or_else(|| Format::sniff(&bytes)) {
         Some(format) => format,
@@ -123,15 +132,81 @@ pub fn load_with(path: &Path, limits: &Limits) -> Result<Mesh> {
             })
         }
     };
-    parse(&bytes, format, path)
+    parse_as(&bytes, format, path, precision)
 }
 
-/// Parses `bytes` as `format`; `path` is only used in error messages.
+/// Parses `bytes` as `format` (`f32` coordinates); `path` is only used in error messages.
 pub fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<Mesh> {
-    match format {
-        Format::Obj => parse_obj_bytes(bytes, path),
-        Format::Stl => parse_stl(bytes, path),
-        Format::Ply => parse_ply(bytes, path),
+    parse_as(bytes, format, path, Precision::F32)
+}
+
+/// Parses `bytes` as `format` into a mesh of `precision` (see [`load_as`]).
+pub fn parse_as(bytes: &[u8], format: Format, path: &Path, precision: Precision) -> Result<Mesh> {
+    match (format, precision) {
+        (Format::Obj, Precision::F32) => obj::parse_obj_bytes_as::<f32>(bytes, path),
+        (Format::Obj, Precision::F64) => obj::parse_obj_bytes_as::<f64>(bytes, path),
+        (Format::Ply, Precision::F32) => ply::parse_ply_as::<f32>(bytes, path),
+        (Format::Ply, Precision::F64) => ply::parse_ply_as::<f64>(bytes, path),
+        (Format::Stl, Precision::F32) => parse_stl(bytes, path),
+        // STL stores f32 coordinates: f64 holds them exactly.
+        (Format::Stl, Precision::F64) => {
+            let m = parse_stl(bytes, path)?;
+            let positions = m.positions().iter().map(|p| p.map(f64::from)).collect();
+            Mesh::new_f64(positions, m.triangles().to_vec())
+        }
+    }
+}
+
+/// A coordinate type the text and PLY parsers read into: `f32` or `f64`.
+pub(crate) trait Coordinate: Copy + Default + std::fmt::Display {
+    /// The type's name in messages.
+    const NAME: &'static str;
+    /// A decimal token, rounded once to this type.
+    fn parse_decimal(token: &str) -> Option<Self>;
+    /// A value read as `f64` (a PLY `double`, or a `float` widened exactly).
+    fn from_f64(x: f64) -> Self;
+    /// A PLY integer property.
+    fn from_i64(i: i64) -> Self;
+    fn is_finite(self) -> bool;
+    /// The mesh of these positions.
+    fn mesh(positions: Vec<[Self; 3]>, triangles: Vec<[u32; 3]>) -> Result<Mesh>;
+}
+
+impl Coordinate for f32 {
+    const NAME: &'static str = "f32";
+    fn parse_decimal(token: &str) -> Option<Self> {
+        token.parse().ok()
+    }
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+    fn from_i64(i: i64) -> Self {
+        i as f32
+    }
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+    fn mesh(positions: Vec<[Self; 3]>, triangles: Vec<[u32; 3]>) -> Result<Mesh> {
+        Mesh::new(positions, triangles)
+    }
+}
+
+impl Coordinate for f64 {
+    const NAME: &'static str = "f64";
+    fn parse_decimal(token: &str) -> Option<Self> {
+        token.parse().ok()
+    }
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+    fn from_i64(i: i64) -> Self {
+        i as f64
+    }
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+    fn mesh(positions: Vec<[Self; 3]>, triangles: Vec<[u32; 3]>) -> Result<Mesh> {
+        Mesh::new_f64(positions, triangles)
     }
 }
 
@@ -248,9 +323,9 @@ pub(crate) fn parse_error(path: &Path, line: usize, message: impl Into<String>) 
 
 /// Builds the mesh; any validation error the parser did not already report with a line number
 /// is reported against the file.
-pub(crate) fn build(
+pub(crate) fn build<T: Coordinate>(
     path: &Path,
-    positions: Vec<[f32; 3]>,
+    positions: Vec<[T; 3]>,
     triangles: Vec<[u32; 3]>,
 ) -> Result<Mesh> {
     if positions.is_empty() && triangles.is_empty() {
@@ -266,7 +341,7 @@ pub(crate) fn build(
     if triangles.is_empty() {
         return Err(parse_error(path, 0, "file contains no triangles"));
     }
-    Mesh::new(positions, triangles).map_err(|e| match e {
+    T::mesh(positions, triangles).map_err(|e| match e {
         Error::Io { .. } | Error::Parse { .. } => e,
         other => parse_error(path, 0, format!("invalid mesh: {other}")),
     })

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 use std::path::Path;
 
-use super::{build, fan, parse_error};
+use super::{build, fan, parse_error, Coordinate};
 use crate::error::Result;
 use crate::mesh::Mesh;
 
@@ -53,8 +53,13 @@ const IGNORED: &[&str] = &[
 
 /// Parses OBJ bytes, reporting invalid UTF-8 with its line.
 pub fn parse_obj_bytes(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    parse_obj_bytes_as::<f32>(bytes, path)
+}
+
+/// [`parse_obj_bytes`] into coordinates of type `T`.
+pub(crate) fn parse_obj_bytes_as<T: Coordinate>(bytes: &[u8], path: &Path) -> Result<Mesh> {
     match std::str::from_utf8(bytes) {
-        Ok(text) => parse_obj(text, path),
+        Ok(text) => parse_obj_as::<T>(text, path),
         Err(e) => {
             let good = &bytes[..e.valid_up_to()];
             let line = 1 + good.iter().filter(|&&b| b == b'\n').count();
@@ -74,8 +79,13 @@ pub fn parse_obj_bytes(bytes: &[u8], path: &Path) -> Result<Mesh> {
 /// positive (1-based) or negative (relative to the vertices defined so far) and may carry
 /// texture/normal indices (`i/t`, `i//n`, `i/t/n`), which are ignored.
 pub fn parse_obj(text: &str, path: &Path) -> Result<Mesh> {
+    parse_obj_as::<f32>(text, path)
+}
+
+/// [`parse_obj`] into coordinates of type `T` (each decimal rounded once, to `T`).
+pub(crate) fn parse_obj_as<T: Coordinate>(text: &str, path: &Path) -> Result<Mesh> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut positions: Vec<[T; 3]> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut corners: Vec<u32> = Vec::new();
     // Largest (0-based) positive index and the line that used it first: positive indices may
@@ -114,7 +124,7 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<Mesh> {
         };
         match keyword {
             "v" => {
-                let mut p = [0.0f32; 3];
+                let mut p = [T::default(); 3];
                 for (axis, slot) in p.iter_mut().enumerate() {
                     let Some(token) = tokens.next() else {
                         return Err(parse_error(
@@ -208,14 +218,14 @@ fn truncate(token: &str) -> &str {
     }
 }
 
-fn parse_coordinate(token: &str) -> std::result::Result<f32, String> {
-    let value: f32 = token
-        .parse()
-        .map_err(|_| format!("invalid coordinate '{}'", truncate(token)))?;
+fn parse_coordinate<T: Coordinate>(token: &str) -> std::result::Result<T, String> {
+    let value = T::parse_decimal(token)
+        .ok_or_else(|| format!("invalid coordinate '{}'", truncate(token)))?;
     if !value.is_finite() {
         return Err(format!(
-            "non-finite coordinate '{}' (NaN, infinite or out of f32 range)",
-            truncate(token)
+            "non-finite coordinate '{}' (NaN, infinite or out of {} range)",
+            truncate(token),
+            T::NAME
         ));
     }
     Ok(value)

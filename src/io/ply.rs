@@ -3,7 +3,7 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use super::{build, fan, line_end, parse_error};
+use super::{build, fan, line_end, parse_error, Coordinate};
 use crate::error::Result;
 use crate::mesh::Mesh;
 
@@ -87,10 +87,10 @@ enum Num {
 }
 
 impl Num {
-    fn as_f32(self) -> f32 {
+    fn to<T: Coordinate>(self) -> T {
         match self {
-            Num::Int(i) => i as f32,
-            Num::Float(f) => f as f32,
+            Num::Int(i) => T::from_i64(i),
+            Num::Float(f) => T::from_f64(f),
         }
     }
 }
@@ -463,11 +463,17 @@ impl Source for Binary<'_> {
 /// `face` element with a `vertex_indices` (or `vertex_index`) list of integers; faces are
 /// fan-split in order. All other elements and properties are skipped.
 pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    parse_ply_as::<f32>(bytes, path)
+}
+
+/// [`parse_ply`] into coordinates of type `T` (`double` properties read at full precision
+/// for `f64`).
+pub(crate) fn parse_ply_as<T: Coordinate>(bytes: &[u8], path: &Path) -> Result<Mesh> {
     let header = parse_header(bytes, path)?;
     let data = &bytes[header.data_start..];
     match header.encoding {
-        Encoding::Ascii => read_body(&header, &mut Ascii::new(data, header.lines), path),
-        Encoding::LittleEndian | Encoding::BigEndian => read_body(
+        Encoding::Ascii => read_body::<T>(&header, &mut Ascii::new(data, header.lines), path),
+        Encoding::LittleEndian | Encoding::BigEndian => read_body::<T>(
             &header,
             &mut Binary {
                 data,
@@ -593,10 +599,10 @@ fn min_row_bytes(element: &Element, roles: &[Role], encoding: Encoding) -> usize
     bytes.max(1)
 }
 
-fn read_body(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh> {
+fn read_body<T: Coordinate>(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh> {
     let data_len = header.data_end - header.data_start;
     let (v_elem, vertex_roles, f_elem, face_roles) = roles(header, path)?;
-    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut positions: Vec<[T; 3]> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut corners: Vec<u32> = Vec::new();
     // Largest index used, with the face row and line that used it first (faces may precede
@@ -629,13 +635,13 @@ fn read_body(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh
                 )
             };
             src.begin_row().map_err(|m| at(src.line(), m))?;
-            let mut p = [0.0f32; 3];
+            let mut p = [T::default(); 3];
             corners.clear();
             for (i, property) in element.properties.iter().enumerate() {
                 let role = roles.get(i).copied().unwrap_or(Role::Skip);
                 match (&property.kind, role) {
                     (Kind::Scalar(ty), Role::Coordinate(axis)) => {
-                        p[axis] = src.value(*ty).map_err(|m| at(src.line(), m))?.as_f32();
+                        p[axis] = src.value(*ty).map_err(|m| at(src.line(), m))?.to::<T>();
                     }
                     (Kind::Scalar(ty), _) => {
                         src.skip(*ty, 1).map_err(|m| at(src.line(), m))?;
@@ -691,8 +697,11 @@ fn read_body(header: &Header, src: &mut impl Source, path: &Path) -> Result<Mesh
                         src.line(),
                         format!(
                             "non-finite vertex coordinate ({} {} {}): NaN, infinite or beyond the \
-                             f32 range",
-                            p[0], p[1], p[2]
+                             {} range",
+                            p[0],
+                            p[1],
+                            p[2],
+                            T::NAME
                         ),
                     ));
                 }

@@ -5,21 +5,39 @@
 //!
 //! The kernel only drops pairs that cannot intersect and only reports pairs that do, so the
 //! contacts are exactly those of the exact test on every pair (debug builds re-check every
-//! certified contact with the exact test). `N_P` counts every triangle pair of the leaf pair (the cost
+//! certified contact with the exact test).
+//!
+//! `f64` hierarchies (`ROUNDED`): the tiles hold the nearest `f32`s of the exact corners with
+//! boxes rounded outward; the kernel's rounded variant only drops pairs certainly apart for
+//! the exact corners, and every other pair gets the exact test on the `f64` corners. `N_P` counts every triangle pair of the leaf pair (the cost
 //! model's unit), minus the vertex-sharing pairs of a self query, which the region tree
 //! tabulates (`RegionTree::shared_pairs`): the kernel never counts.
 
-use dhcd_kernels::narrow::{leaf_contacts_with, Pairing, Row, MAX_ROW};
+use dhcd_kernels::narrow::{
+    leaf_candidates_rounded_with, leaf_contacts_with, Pairing, Row, TriSoa, MAX_ROW,
+};
 use pulp::Simd;
 
 use super::tritri::{intersects, intersects_given_boxes_overlap};
 use crate::hierarchy::LeafTris;
 
-/// One leaf of a leaf pair: its cached triangles and their original indices.
+/// One leaf of a leaf pair: its cached triangles, their original indices, and the exact
+/// positions of an `f64` hierarchy (internal vertex order).
 #[derive(Clone, Copy)]
 pub(crate) struct LeafSide<'a> {
     pub(crate) tris: LeafTris<'a>,
     pub(crate) order: &'a [u32],
+    pub(crate) exact: Option<&'a [[f64; 3]]>,
+}
+
+/// Triangle `i` of `soa` with its exact corners: from `exact` (internal vertex order) or
+/// the `f32` corners widened.
+#[inline(always)]
+fn corners_f64(soa: &TriSoa, i: usize, exact: Option<&[[f64; 3]]>) -> [[f64; 3]; 3] {
+    match exact {
+        Some(p) => std::array::from_fn(|c| p[soa.vertex(c)[i] as usize]),
+        None => soa.corners(i).map(|c| c.map(f64::from)),
+    }
 }
 
 /// Which pairs of a leaf pair are tested.
@@ -37,7 +55,7 @@ pub(crate) enum Leaves {
 /// two objects); pushes contacts (original indices; `[min, max]` for self queries) and
 /// returns the number of pairs counted in `N_P`.
 #[inline(always)]
-pub(crate) fn leaf_pair<S: Simd>(
+pub(crate) fn leaf_pair<S: Simd, const ROUNDED: bool>(
     simd: S,
     a: &LeafSide,
     b: &LeafSide,
@@ -58,7 +76,7 @@ pub(crate) fn leaf_pair<S: Simd>(
     let counted = counted_pairs(na, nb, leaves, shared);
     if na <= MAX_ROW && nb <= MAX_ROW {
         // Adaptive trees: one block per leaf.
-        blocks(simd, a, 0, na, b, 0, nb, pairing, ordered, rows, out);
+        blocks::<S, ROUNDED>(simd, a, 0, na, b, 0, nb, pairing, ordered, rows, out);
         return counted;
     }
     // Leaves longer than a block (fixed-depth trees): blocks of MAX_ROW triangles.
@@ -71,7 +89,7 @@ pub(crate) fn leaf_pair<S: Simd>(
                 p => p,
             };
             let (ra, rb) = ((na - a0).min(MAX_ROW), (nb - b0).min(MAX_ROW));
-            blocks(simd, a, a0, ra, b, b0, rb, pairing, ordered, rows, out);
+            blocks::<S, ROUNDED>(simd, a, a0, ra, b, b0, rb, pairing, ordered, rows, out);
         }
     }
     counted
@@ -93,7 +111,7 @@ pub(crate) fn counted_pairs(na: usize, nb: usize, leaves: Leaves, shared: u64) -
 /// as `[min, max]` when `ordered`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn blocks<S: Simd>(
+fn blocks<S: Simd, const ROUNDED: bool>(
     simd: S,
     a: &LeafSide,
     a0: usize,
@@ -108,7 +126,11 @@ fn blocks<S: Simd>(
 ) {
     let (sa, sb) = (a.tris.soa.skip(a0), b.tris.soa.skip(b0));
     debug_assert!(na <= MAX_ROW);
-    leaf_contacts_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
+    if ROUNDED {
+        leaf_candidates_rounded_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
+    } else {
+        leaf_contacts_with(simd, sa, na, sb, nb, pairing, &mut rows[..na]);
+    }
     let contact = |i: usize, j: usize| {
         let (oi, oj) = (a.order[a0 + i], b.order[b0 + j]);
         if ordered {
@@ -130,6 +152,17 @@ fn blocks<S: Simd>(
             out.push(contact(i, j));
         }
         let mut bits = row.undecided;
+        if ROUNDED {
+            let ti = corners_f64(&sa, i, a.exact);
+            while bits != 0 {
+                let j = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if intersects(&ti, &corners_f64(&sb, j, b.exact)) {
+                    out.push(contact(i, j));
+                }
+            }
+            continue;
+        }
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;

@@ -23,16 +23,26 @@
 //! other's plane (early exit when all are strictly on one side). Only pairs surviving both
 //! filters pay for the edge tests (measured by `cargo bench --bench narrow`).
 
+mod exact;
 pub(crate) mod leaves;
 mod oracle;
 mod predicates;
 mod tritri;
 
-pub use oracle::{brute_force_pairs, brute_force_self_pairs};
+pub use oracle::{
+    brute_force_pairs, brute_force_proximity, brute_force_self_pairs, brute_force_self_proximity,
+};
 
 /// Whether the closed triangles share at least one point, decided exactly for the f32 inputs.
 #[inline]
 pub fn triangles_intersect(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
+    tritri::intersects(a, b)
+}
+
+/// Whether the closed triangles share at least one point, decided exactly for the f64 inputs
+/// (any finite values).
+#[inline]
+pub fn triangles_intersect_f64(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> bool {
     tritri::intersects(a, b)
 }
 

@@ -1,39 +1,70 @@
 //! Brute-force oracles: every triangle pair through the exact test.
 
-use super::triangles_intersect_reference as triangles_intersect;
-use crate::mesh::Mesh;
+use super::predicates::Coordinate;
+use super::tritri::{tri_tri, Decide};
+use crate::mesh::{Mesh, Precision};
 
-/// Per-triangle closed boxes `[min, max]` (exact; only used to skip pairs cheaply).
-fn boxes(m: &Mesh) -> Vec<[[f32; 3]; 2]> {
-    (0..m.triangle_count())
-        .map(|t| {
-            let c = m.corners(t);
-            let mut b = [c[0], c[0]];
-            for p in &c[1..] {
-                for k in 0..3 {
-                    b[0][k] = b[0][k].min(p[k]);
-                    b[1][k] = b[1][k].max(p[k]);
-                }
-            }
-            b
-        })
-        .collect()
+/// The triangles of a mesh as corner coordinates of type `C`, with their closed boxes.
+struct Tris<C> {
+    corners: Vec<[[C; 3]; 3]>,
+    boxes: Vec<[[C; 3]; 2]>,
 }
 
-#[inline]
-fn overlap(a: &[[f32; 3]; 2], b: &[[f32; 3]; 2]) -> bool {
-    (0..3).all(|k| a[1][k] >= b[0][k] && b[1][k] >= a[0][k])
+impl<C: Coordinate> Tris<C> {
+    fn new(m: &Mesh, positions: &[[C; 3]]) -> Self {
+        let corners: Vec<[[C; 3]; 3]> = m
+            .triangles()
+            .iter()
+            .map(|t| t.map(|v| positions[v as usize]))
+            .collect();
+        let boxes = corners
+            .iter()
+            .map(|c| {
+                let mut b = [c[0], c[0]];
+                for p in &c[1..] {
+                    for k in 0..3 {
+                        if p[k] < b[0][k] {
+                            b[0][k] = p[k];
+                        }
+                        if p[k] > b[1][k] {
+                            b[1][k] = p[k];
+                        }
+                    }
+                }
+                b
+            })
+            .collect();
+        Self { corners, boxes }
+    }
+
+    #[inline]
+    fn meet(&self, i: usize, other: &Self, j: usize) -> bool {
+        let (a, b) = (&self.boxes[i], &other.boxes[j]);
+        (0..3).all(|k| a[1][k] >= b[0][k] && b[1][k] >= a[0][k])
+    }
+
+    #[inline]
+    fn intersect(&self, i: usize, other: &Self, j: usize) -> bool {
+        self.meet(i, other, j) && tri_tri(&self.corners[i], &other.corners[j], &mut Decide)
+    }
 }
 
 /// Exact brute-force oracle: every `(ta, tb)` with intersecting closed triangles, sorted
-/// ascending. `O(|a| |b|)`.
+/// ascending, exact for the meshes' precision (`f64` when either mesh is `f64`). `O(|a| |b|)`.
 pub fn brute_force_pairs(a: &Mesh, b: &Mesh) -> Vec<[u32; 2]> {
-    let (ba, bb) = (boxes(a), boxes(b));
+    if a.precision() == Precision::F64 || b.precision() == Precision::F64 {
+        let (pa, pb) = (a.to_f64_positions(), b.to_f64_positions());
+        pairs(&Tris::new(a, &pa), &Tris::new(b, &pb))
+    } else {
+        pairs(&Tris::new(a, a.positions()), &Tris::new(b, b.positions()))
+    }
+}
+
+fn pairs<C: Coordinate>(a: &Tris<C>, b: &Tris<C>) -> Vec<[u32; 2]> {
     let mut out = Vec::new();
-    for (i, bi) in ba.iter().enumerate() {
-        let ti = a.corners(i);
-        for (j, bj) in bb.iter().enumerate() {
-            if overlap(bi, bj) && triangles_intersect(&ti, &b.corners(j)) {
+    for i in 0..a.corners.len() {
+        for j in 0..b.corners.len() {
+            if a.intersect(i, b, j) {
                 out.push([i as u32, j as u32]);
             }
         }
@@ -42,21 +73,151 @@ pub fn brute_force_pairs(a: &Mesh, b: &Mesh) -> Vec<[u32; 2]> {
 }
 
 /// Self-collision oracle: every `(ti, tj)`, `ti < tj`, intersecting, excluding pairs that
-/// share a vertex index; sorted ascending. `O(n^2)`.
+/// share a vertex index; sorted ascending; exact for the mesh's precision. `O(n^2)`.
 pub fn brute_force_self_pairs(m: &Mesh) -> Vec<[u32; 2]> {
-    let bx = boxes(m);
+    match m.positions_f64() {
+        Some(p) => self_pairs(m, &Tris::new(m, p)),
+        None => self_pairs(m, &Tris::new(m, m.positions())),
+    }
+}
+
+fn self_pairs<C: Coordinate>(m: &Mesh, t: &Tris<C>) -> Vec<[u32; 2]> {
     let tris = m.triangles();
     let mut out = Vec::new();
     for i in 0..tris.len() {
-        let ti = m.corners(i);
         for j in i + 1..tris.len() {
-            if tris[i].iter().any(|v| tris[j].contains(v)) || !overlap(&bx[i], &bx[j]) {
+            if tris[i].iter().any(|v| tris[j].contains(v)) {
                 continue;
             }
-            if triangles_intersect(&ti, &m.corners(j)) {
+            if t.intersect(i, t, j) {
                 out.push([i as u32, j as u32]);
             }
         }
     }
     out
+}
+
+/// Brute-force proximity oracle: every vertex of `a` against every triangle of `b` and the
+/// other way, and every unique edge of `a` against every unique edge of `b`, through the
+/// exact tests of [`crate::distance`] at distance `d`; in the order and form of
+/// [`crate::query::proximity`]'s result (vertices and edges of triangles only; `counters`
+/// zero but `contacts`). `O(|a| |b|)`.
+pub fn brute_force_proximity(a: &Mesh, b: &Mesh, d: f64) -> crate::query::Proximity {
+    use crate::distance::{edge_edge_within, point_triangle_within};
+    use crate::query::{EdgePair, FaceVertex, Proximity, VertexFace};
+    let (pa, pb) = (a.to_f64_positions(), b.to_f64_positions());
+    let mut out = Proximity::default();
+    let tri = |m: &Mesh, p: &[[f64; 3]], t: usize| m.triangles()[t].map(|v| p[v as usize]);
+    for v in used_vertices(a) {
+        for t in 0..b.triangle_count() {
+            if let Some((d2, kind)) = point_triangle_within(pa[v as usize], tri(b, &pb, t), d) {
+                out.vertex_face.push(VertexFace {
+                    vertex: v,
+                    triangle: t as u32,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    for t in 0..a.triangle_count() {
+        for v in used_vertices(b) {
+            if let Some((d2, kind)) = point_triangle_within(pb[v as usize], tri(a, &pa, t), d) {
+                out.face_vertex.push(FaceVertex {
+                    triangle: t as u32,
+                    vertex: v,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    out.face_vertex
+        .sort_unstable_by_key(|x| (x.triangle, x.vertex));
+    for ea in unique_edges(a) {
+        for eb in unique_edges(b) {
+            let (p, q) = (ea.map(|v| pa[v as usize]), eb.map(|v| pb[v as usize]));
+            if let Some((d2, kind)) = edge_edge_within(p[0], p[1], q[0], q[1], d) {
+                out.edge_edge.push(EdgePair {
+                    a: ea,
+                    b: eb,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    out.counters.contacts =
+        (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
+    out
+}
+
+/// Brute-force self-proximity oracle: every vertex against every triangle not containing
+/// it, every pair of unique edges sharing no vertex (`a < b`), as
+/// [`crate::query::self_proximity`] reports them. `O(n^2)`.
+pub fn brute_force_self_proximity(m: &Mesh, d: f64) -> crate::query::Proximity {
+    use crate::distance::{edge_edge_within, point_triangle_within};
+    use crate::query::{EdgePair, Proximity, VertexFace};
+    let p = m.to_f64_positions();
+    let mut out = Proximity::default();
+    for v in used_vertices(m) {
+        for (t, corners) in m.triangles().iter().enumerate() {
+            if corners.contains(&v) {
+                continue;
+            }
+            let tri = corners.map(|c| p[c as usize]);
+            if let Some((d2, kind)) = point_triangle_within(p[v as usize], tri, d) {
+                out.vertex_face.push(VertexFace {
+                    vertex: v,
+                    triangle: t as u32,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    let edges = unique_edges(m);
+    for (i, ea) in edges.iter().enumerate() {
+        for eb in &edges[i + 1..] {
+            if ea.iter().any(|v| eb.contains(v)) {
+                continue;
+            }
+            let (x, y) = (ea.map(|v| p[v as usize]), eb.map(|v| p[v as usize]));
+            if let Some((d2, kind)) = edge_edge_within(x[0], x[1], y[0], y[1], d) {
+                out.edge_edge.push(EdgePair {
+                    a: *ea,
+                    b: *eb,
+                    distance_sq: d2,
+                    kind,
+                });
+            }
+        }
+    }
+    out.counters.contacts = (out.vertex_face.len() + out.edge_edge.len()) as u64;
+    out
+}
+
+/// The vertices some triangle uses, ascending.
+fn used_vertices(m: &Mesh) -> Vec<u32> {
+    let mut used = vec![false; m.vertex_count()];
+    for t in m.triangles() {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    (0..m.vertex_count() as u32)
+        .filter(|&v| used[v as usize])
+        .collect()
+}
+
+/// The unique edges of the triangles, each as its vertices smaller first, ascending.
+fn unique_edges(m: &Mesh) -> Vec<[u32; 2]> {
+    let mut e: Vec<[u32; 2]> = m
+        .triangles()
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])]))
+        .collect();
+    e.sort_unstable();
+    e.dedup();
+    e
 }

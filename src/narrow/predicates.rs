@@ -1,25 +1,100 @@
-//! Exact geometric primitives on `f32` points.
+//! Exact geometric primitives on `f32` or `f64` points ([`Coordinate`]).
 //!
-//! Every sign here is exact: `f32 -> f64` is exact and Shewchuk's adaptive predicates (the
+//! Every sign here is exact. `f32 -> f64` is exact and Shewchuk's adaptive predicates (the
 //! `robust` crate) are exact for any `f64` input whose products neither overflow nor
 //! underflow, which holds for all finite `f32` coordinates (a degree-3 product of `f32`
-//! differences stays far inside the `f64` exponent range). Comparisons of `f32` are exact.
+//! differences stays far inside the `f64` exponent range). Comparisons are exact.
 //! Orientations the floating-point filter leaves open are computed in integers when the
-//! points' exponents allow (`orient3d_fixed`), which is exact by construction.
+//! points' exponents allow (`orient3d_fixed`, `f32`), or by the adaptive predicate; for `f64`
+//! points whose magnitudes could underflow in it, in big integers (`super::exact`).
 
 use robust::{Coord, Coord3D};
 
 /// A point.
-pub(crate) type P3 = [f32; 3];
+pub(crate) type P3<C = f32> = [C; 3];
 /// A triangle (possibly degenerate).
-pub(crate) type Tri = [P3; 3];
+pub(crate) type Tri<C = f32> = [P3<C>; 3];
+
+/// A coordinate type of the exact tests: `f32` (the library's default precision) or `f64`.
+pub(crate) trait Coordinate:
+    Copy + PartialOrd + Into<f64> + std::fmt::Debug + 'static
+{
+    /// The absolute term of the `f64` filters' bounds: 0 for `f32` inputs (no product of
+    /// their differences underflows), `2^-900` for `f64` inputs, far above any underflow
+    /// error of a degree-3 product of coordinates below `2^128` (each rounding of an
+    /// underflowing product is at most `2^-1075`).
+    const TINY: f64;
+    /// Whether a zero permanent proves an exact zero (no product of nonzero differences can
+    /// underflow to zero).
+    const ZERO_IS_EXACT: bool;
+    /// The exact `orient3d(a, b, c, d)` (its sign exact; same convention as `robust`).
+    fn orient3d_exact(a: &P3<Self>, b: &P3<Self>, c: &P3<Self>, d: &P3<Self>) -> f64;
+    /// The sign of [`Coordinate::orient3d_exact`].
+    fn orient3d_sign_exact(a: &P3<Self>, b: &P3<Self>, c: &P3<Self>, d: &P3<Self>) -> i32;
+    /// The exact 2D orientation of three points given as `f64` pairs (exact values of
+    /// `Self`).
+    fn orient2d_exact(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64;
+}
+
+impl Coordinate for f32 {
+    const TINY: f64 = 0.0;
+    const ZERO_IS_EXACT: bool = true;
+
+    #[cold]
+    #[inline(never)]
+    fn orient3d_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
+        match orient3d_fixed(a, b, c, d) {
+            Some(fixed) => fixed.value(),
+            None => robust::orient3d(c3(a), c3(b), c3(c), c3(d)),
+        }
+    }
+
+    /// PERF: without converting the integer determinant to `f64`, a library call that was a
+    /// quarter of the integer path.
+    #[cold]
+    #[inline(never)]
+    fn orient3d_sign_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> i32 {
+        match orient3d_fixed(a, b, c, d) {
+            Some(Fixed { det, .. }) => det.signum() as i32,
+            None => sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d))),
+        }
+    }
+
+    #[inline]
+    fn orient2d_exact(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+        let p = |v: [f64; 2]| Coord { x: v[0], y: v[1] };
+        robust::orient2d(p(a), p(b), p(c))
+    }
+}
+
+impl Coordinate for f64 {
+    const TINY: f64 = f64::from_bits((1023 - 900) << 52); // 2^-900
+    const ZERO_IS_EXACT: bool = false;
+
+    #[cold]
+    #[inline(never)]
+    fn orient3d_exact(a: &P3<f64>, b: &P3<f64>, c: &P3<f64>, d: &P3<f64>) -> f64 {
+        super::exact::orient3d(a, b, c, d)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn orient3d_sign_exact(a: &P3<f64>, b: &P3<f64>, c: &P3<f64>, d: &P3<f64>) -> i32 {
+        sign(super::exact::orient3d(a, b, c, d))
+    }
+
+    #[inline]
+    fn orient2d_exact(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+        super::exact::orient2d(a, b, c)
+    }
+}
 
 #[inline(always)]
-fn c3(p: &P3) -> Coord3D<f64> {
+fn c3<C: Coordinate>(p: &P3<C>) -> Coord3D<f64> {
     Coord3D {
-        x: f64::from(p[0]),
-        y: f64::from(p[1]),
-        z: f64::from(p[2]),
+        x: p[0].into(),
+        y: p[1].into(),
+        z: p[2].into(),
     }
 }
 
@@ -36,8 +111,8 @@ const EPS: f64 = f64::EPSILON / 2.0;
 /// formula and bound) inlined here, falling back to `robust::orient3d` (whose adaptive
 /// stages are exact) only when the filter cannot certify the sign.
 #[inline(always)]
-pub(crate) fn orient3d(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
-    let f = f64::from;
+pub(crate) fn orient3d<C: Coordinate>(a: &P3<C>, b: &P3<C>, c: &P3<C>, d: &P3<C>) -> f64 {
+    let f = |x: C| -> f64 { x.into() };
     let (adx, bdx, cdx) = (f(a[0]) - f(d[0]), f(b[0]) - f(d[0]), f(c[0]) - f(d[0]));
     let (ady, bdy, cdy) = (f(a[1]) - f(d[1]), f(b[1]) - f(d[1]), f(c[1]) - f(d[1]));
     let (adz, bdz, cdz) = (f(a[2]) - f(d[2]), f(b[2]) - f(d[2]), f(c[2]) - f(d[2]));
@@ -48,11 +123,11 @@ pub(crate) fn orient3d(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
     let permanent = (bdxcdy.abs() + cdxbdy.abs()) * adz.abs()
         + (cdxady.abs() + adxcdy.abs()) * bdz.abs()
         + (adxbdy.abs() + bdxady.abs()) * cdz.abs();
-    let errbound = O3D_ERRBOUND_A * permanent;
+    let errbound = O3D_ERRBOUND_A * permanent + C::TINY;
     if det > errbound || -det > errbound {
         return det;
     }
-    orient3d_exact(a, b, c, d)
+    C::orient3d_exact(a, b, c, d)
 }
 
 /// A triangle's plane, prepared for many orientation queries: [`Plane::side`]`(d)` is the
@@ -64,17 +139,17 @@ pub(crate) fn orient3d(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
 /// of the same determinant along `e`), so its first-stage error bound `(7 + 56 eps) eps P`
 /// holds; a sign is certified when `|s| > 8 eps P` (`f32` inputs cannot underflow or
 /// overflow in `f64`), else the adaptive exact predicate decides.
-pub(crate) struct Plane<'a> {
-    t: &'a Tri,
+pub(crate) struct Plane<'a, C: Coordinate = f32> {
+    t: &'a Tri<C>,
     origin: [f64; 3],
     normal: [f64; 3],
     magnitude: [f64; 3],
 }
 
-impl<'a> Plane<'a> {
+impl<'a, C: Coordinate> Plane<'a, C> {
     #[inline(always)]
-    pub(crate) fn new(t: &'a Tri) -> Self {
-        let f = |p: &P3| p.map(f64::from);
+    pub(crate) fn new(t: &'a Tri<C>) -> Self {
+        let f = |p: &P3<C>| p.map(|x| -> f64 { x.into() });
         let (a, b, o) = (f(&t[0]), f(&t[1]), f(&t[2]));
         let u = [a[0] - o[0], a[1] - o[1], a[2] - o[2]];
         let v = [b[0] - o[0], b[1] - o[1], b[2] - o[2]];
@@ -98,26 +173,23 @@ impl<'a> Plane<'a> {
     /// each round once: at most about `3 eps M_k + eps |N_k|`, below `8 eps M_k`).
     #[inline(always)]
     pub(crate) fn spans(&self) -> bool {
-        (0..3).any(|k| self.normal[k].abs() > PLANE_ERRBOUND * self.magnitude[k])
+        (0..3).any(|k| self.normal[k].abs() > PLANE_ERRBOUND * self.magnitude[k] + C::TINY)
     }
 
     /// The exact sign of `orient3d(d, t0, t1, t2)`.
     #[inline(always)]
-    pub(crate) fn side(&self, d: &P3) -> i32 {
+    pub(crate) fn side(&self, d: &P3<C>) -> i32 {
         let (o, n, m) = (&self.origin, &self.normal, &self.magnitude);
-        let e = [
-            f64::from(d[0]) - o[0],
-            f64::from(d[1]) - o[1],
-            f64::from(d[2]) - o[2],
-        ];
+        let f = |x: C| -> f64 { x.into() };
+        let e = [f(d[0]) - o[0], f(d[1]) - o[1], f(d[2]) - o[2]];
         let s = e[0] * n[0] + e[1] * n[1] + e[2] * n[2];
         let p = e[0].abs() * m[0] + e[1].abs() * m[1] + e[2].abs() * m[2];
-        let bound = PLANE_ERRBOUND * p;
+        let bound = PLANE_ERRBOUND * p + C::TINY;
         if s > bound {
             1
         } else if s < -bound {
             -1
-        } else if p == 0.0 {
+        } else if C::ZERO_IS_EXACT && p == 0.0 {
             // Exactly zero (PERF: a corner on an axis-aligned plane, flat cloth or the cap of
             // an axis-aligned cylinder, skips the exact predicate). The terms of `P` are
             // nonnegative, so each is zero: `e_k = 0` or both products of `M_k` are zero. A
@@ -126,7 +198,7 @@ impl<'a> Plane<'a> {
             // and so is `s = sum e_k N_k` with `|N_k| <= M_k`.
             0
         } else {
-            orient3d_sign_exact(d, &self.t[0], &self.t[1], &self.t[2])
+            C::orient3d_sign_exact(d, &self.t[0], &self.t[1], &self.t[2])
         }
     }
 }
@@ -134,29 +206,6 @@ impl<'a> Plane<'a> {
 /// The certification factor of [`Plane::side`]: `8 eps`, above Shewchuk's
 /// `(7 + 56 eps) eps`.
 const PLANE_ERRBOUND: f64 = 8.0 * EPS;
-
-/// The exact `orient3d` of points the floating-point filter could not certify: by integer
-/// arithmetic when the points' coordinates span few binades ([`orient3d_fixed`]), else by
-/// the adaptive predicate.
-#[cold]
-#[inline(never)]
-fn orient3d_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> f64 {
-    match orient3d_fixed(a, b, c, d) {
-        Some(fixed) => fixed.value(),
-        None => robust::orient3d(c3(a), c3(b), c3(c), c3(d)),
-    }
-}
-
-/// The sign of [`orient3d_exact`] (PERF: without converting the integer determinant to
-/// `f64`, a library call that was a quarter of the integer path).
-#[cold]
-#[inline(never)]
-fn orient3d_sign_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> i32 {
-    match orient3d_fixed(a, b, c, d) {
-        Some(Fixed { det, .. }) => det.signum() as i32,
-        None => sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d))),
-    }
-}
 
 /// Largest spread of the (nonzero) coordinates' binary exponents that [`orient3d_fixed`]
 /// takes: the coordinates on the grid of the smallest one's last bit then hold at most
@@ -239,20 +288,17 @@ pub(crate) fn keep(k: usize) -> (usize, usize) {
 /// Sign-exact 2D orientation of `a, b, c` projected along axis `k` (zero iff the
 /// projections are collinear).
 #[inline]
-pub(crate) fn orient2d(k: usize, a: &P3, b: &P3, c: &P3) -> f64 {
+pub(crate) fn orient2d<C: Coordinate>(k: usize, a: &P3<C>, b: &P3<C>, c: &P3<C>) -> f64 {
     let (i, j) = KEEP[k];
-    let p = |v: &P3| Coord {
-        x: f64::from(v[i]),
-        y: f64::from(v[j]),
-    };
-    robust::orient2d(p(a), p(b), p(c))
+    let p = |v: &P3<C>| -> [f64; 2] { [v[i].into(), v[j].into()] };
+    C::orient2d_exact(p(a), p(b), p(c))
 }
 
 /// The projection axis `k` that keeps the triangle `a, b, c` most non-degenerate (largest
 /// `|orient2d|`, i.e. the dominant normal component), or `None` when the corners are
 /// collinear in 3D (all three projections are then collinear, exactly).
 #[inline]
-pub(crate) fn projection_axis(a: &P3, b: &P3, c: &P3) -> Option<usize> {
+pub(crate) fn projection_axis<C: Coordinate>(a: &P3<C>, b: &P3<C>, c: &P3<C>) -> Option<usize> {
     let mut best = None;
     let mut best_abs = 0.0;
     for k in 0..3 {
@@ -274,7 +320,7 @@ pub(crate) fn sign(x: f64) -> i32 {
 /// Lexicographic `a <= b`. On any line, lexicographic order is a linear order compatible
 /// with the line's parametrisation, so it decides betweenness of collinear points exactly.
 #[inline]
-pub(crate) fn lex_le(a: &[f32], b: &[f32]) -> bool {
+pub(crate) fn lex_le<C: PartialOrd>(a: &[C], b: &[C]) -> bool {
     for (x, y) in a.iter().zip(b) {
         if x < y {
             return true;
@@ -288,14 +334,14 @@ pub(crate) fn lex_le(a: &[f32], b: &[f32]) -> bool {
 
 /// `p + t (q - p)` in `f64`, `t` clamped to `[0, 1]`; exact at `t = 0` and `t = 1`.
 #[inline]
-pub(crate) fn lerp(p: &P3, q: &P3, t: f64) -> [f64; 3] {
+pub(crate) fn lerp<C: Coordinate>(p: &P3<C>, q: &P3<C>, t: f64) -> [f64; 3] {
     let t = t.clamp(0.0, 1.0);
     if t == 1.0 {
-        return q.map(f64::from);
+        return q.map(|x| -> f64 { x.into() });
     }
     let mut x = [0.0; 3];
     for i in 0..3 {
-        let (a, b) = (f64::from(p[i]), f64::from(q[i]));
+        let (a, b): (f64, f64) = (p[i].into(), q[i].into());
         x[i] = a + t * (b - a);
     }
     x
@@ -313,6 +359,10 @@ mod tests {
 
     fn robust_sign(a: &P3, b: &P3, c: &P3, d: &P3) -> i32 {
         sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+    }
+
+    fn orient3d_sign_exact(a: &P3, b: &P3, c: &P3, d: &P3) -> i32 {
+        <f32 as Coordinate>::orient3d_sign_exact(a, b, c, d)
     }
 
     proptest! {

@@ -7,7 +7,7 @@
 //! tested as that segment (or point).
 
 use super::predicates::{
-    keep, lerp, lex_le, orient2d, orient3d, projection_axis, sign, Plane, Tri, P3,
+    keep, lerp, lex_le, orient2d, orient3d, projection_axis, sign, Coordinate, Plane, Tri, P3,
 };
 
 /// Receives the candidate points of the intersection region. With `COLLECT = false` the
@@ -68,18 +68,20 @@ impl Sink for Points {
 const AXIS_UNKNOWN: usize = usize::MAX;
 
 #[inline(always)]
-fn to64(p: &P3) -> [f64; 3] {
-    p.map(f64::from)
+fn to64<C: Coordinate>(p: &P3<C>) -> [f64; 3] {
+    p.map(|x| -> f64 { x.into() })
 }
 
 /// Closed axis-aligned boxes of the corners overlap (comparisons only: exact).
 #[inline(always)]
-fn aabb_overlap(a: &Tri, b: &Tri) -> bool {
+fn aabb_overlap<C: Coordinate>(a: &Tri<C>, b: &Tri<C>) -> bool {
+    let min = |x: C, y: C| if y < x { y } else { x };
+    let max = |x: C, y: C| if y > x { y } else { x };
     for k in 0..3 {
-        let amin = a[0][k].min(a[1][k]).min(a[2][k]);
-        let amax = a[0][k].max(a[1][k]).max(a[2][k]);
-        let bmin = b[0][k].min(b[1][k]).min(b[2][k]);
-        let bmax = b[0][k].max(b[1][k]).max(b[2][k]);
+        let amin = min(min(a[0][k], a[1][k]), a[2][k]);
+        let amax = max(max(a[0][k], a[1][k]), a[2][k]);
+        let bmin = min(min(b[0][k], b[1][k]), b[2][k]);
+        let bmax = max(max(b[0][k], b[1][k]), b[2][k]);
         if amax < bmin || bmax < amin {
             return false;
         }
@@ -95,7 +97,7 @@ fn one_side(d: &[f64; 3]) -> bool {
 
 /// The segment a degenerate triangle is: its lexicographically extreme corners (indices).
 #[inline]
-fn extreme_corners(t: &Tri) -> (usize, usize) {
+fn extreme_corners<C: Coordinate>(t: &Tri<C>) -> (usize, usize) {
     let (mut lo, mut hi) = (0, 0);
     for i in 1..3 {
         if !lex_le(&t[lo], &t[i]) {
@@ -120,7 +122,7 @@ fn extreme_corners(t: &Tri) -> (usize, usize) {
 /// the general test ([`tri_tri`]'s body, from the six signs already known), which is also the
 /// oracle the fast path is tested against.
 #[inline]
-pub(crate) fn intersects(a: &Tri, b: &Tri) -> bool {
+pub(crate) fn intersects<C: Coordinate>(a: &Tri<C>, b: &Tri<C>) -> bool {
     aabb_overlap(a, b) && intersects_given_boxes_overlap(a, b)
 }
 
@@ -128,7 +130,7 @@ pub(crate) fn intersects(a: &Tri, b: &Tri) -> bool {
 /// candidates, whose boxes the leaf filter compared exactly): the same answer without
 /// comparing them again.
 #[inline]
-pub(crate) fn intersects_given_boxes_overlap(a: &Tri, b: &Tri) -> bool {
+pub(crate) fn intersects_given_boxes_overlap<C: Coordinate>(a: &Tri<C>, b: &Tri<C>) -> bool {
     debug_assert!(aabb_overlap(a, b));
     // Vertices of `a` against the plane of `b`: (x - b2) . ((b0 - b2) x (b1 - b2)).
     let pb = Plane::new(b);
@@ -193,7 +195,7 @@ pub(crate) fn intersects_given_boxes_overlap(a: &Tri, b: &Tri) -> bool {
 /// hull meets `t`: a 2D test in the plane. `t` is not degenerate, since some corner of `s` is
 /// strictly off its plane.
 #[inline]
-fn touching(s: &Tri, ds: [i32; 3], t: &Tri) -> Option<bool> {
+fn touching<C: Coordinate>(s: &Tri<C>, ds: [i32; 3], t: &Tri<C>) -> Option<bool> {
     let zeros = ds.iter().filter(|&&d| d == 0).count();
     let side = ds.iter().sum::<i32>();
     // One or two zeros and the other signs equal: |sum| = number of nonzero signs.
@@ -231,7 +233,7 @@ fn lone(s: [i32; 3]) -> usize {
 /// The core test. Returns whether the closed triangles intersect; with a collecting sink,
 /// also pushes candidate points of the intersection (at least one iff `true`).
 #[inline]
-pub(crate) fn tri_tri<S: Sink>(a: &Tri, b: &Tri, sink: &mut S) -> bool {
+pub(crate) fn tri_tri<C: Coordinate, S: Sink>(a: &Tri<C>, b: &Tri<C>, sink: &mut S) -> bool {
     if !aabb_overlap(a, b) {
         return false;
     }
@@ -257,7 +259,13 @@ pub(crate) fn tri_tri<S: Sink>(a: &Tri, b: &Tri, sink: &mut S) -> bool {
 
 /// Everything after the cheap filters (kept out of line so the filters inline well).
 #[inline(never)]
-fn tri_tri_full<S: Sink>(a: &Tri, da: &[f64; 3], b: &Tri, db: &[f64; 3], sink: &mut S) -> bool {
+fn tri_tri_full<C: Coordinate, S: Sink>(
+    a: &Tri<C>,
+    da: &[f64; 3],
+    b: &Tri<C>,
+    db: &[f64; 3],
+    sink: &mut S,
+) -> bool {
     // A nonzero orient3d against a's plane proves a non-degenerate.
     let a_axis = if db.iter().all(|&d| d == 0.0) {
         projection_axis(&a[0], &a[1], &a[2])
@@ -297,7 +305,13 @@ fn tri_tri_full<S: Sink>(a: &Tri, da: &[f64; 3], b: &Tri, db: &[f64; 3], sink: &
 /// `s[i]` against the plane of `t`; `axis` is a projection keeping `t` non-degenerate, or
 /// [`AXIS_UNKNOWN`] (computed on first need).
 #[inline]
-fn edges_vs_tri<S: Sink>(s: &Tri, ds: &[f64; 3], t: &Tri, axis: usize, sink: &mut S) -> bool {
+fn edges_vs_tri<C: Coordinate, S: Sink>(
+    s: &Tri<C>,
+    ds: &[f64; 3],
+    t: &Tri<C>,
+    axis: usize,
+    sink: &mut S,
+) -> bool {
     let mut hit = false;
     for (i, j) in [(0, 1), (1, 2), (2, 0)] {
         if seg_vs_tri(&s[i], &s[j], ds[i], ds[j], t, axis, sink) {
@@ -313,12 +327,12 @@ fn edges_vs_tri<S: Sink>(s: &Tri, ds: &[f64; 3], t: &Tri, axis: usize, sink: &mu
 /// Closed segment `pq` against the non-degenerate closed triangle `t`; `sp`, `sq` are the
 /// orientations of `p`, `q` against the plane of `t`.
 #[inline]
-fn seg_vs_tri<S: Sink>(
-    p: &P3,
-    q: &P3,
+fn seg_vs_tri<C: Coordinate, S: Sink>(
+    p: &P3<C>,
+    q: &P3<C>,
     sp: f64,
     sq: f64,
-    t: &Tri,
+    t: &Tri<C>,
     axis: usize,
     sink: &mut S,
 ) -> bool {
@@ -365,7 +379,7 @@ fn seg_vs_tri<S: Sink>(
 /// Point `x` in the closed triangle `t`, all in the plane, projected along `k` where `t`
 /// is non-degenerate.
 #[inline]
-fn point_in_tri_2d(k: usize, x: &P3, t: &Tri) -> bool {
+fn point_in_tri_2d<C: Coordinate>(k: usize, x: &P3<C>, t: &Tri<C>) -> bool {
     let e0 = sign(orient2d(k, &t[0], &t[1], x));
     let e1 = sign(orient2d(k, &t[1], &t[2], x));
     let e2 = sign(orient2d(k, &t[2], &t[0], x));
@@ -373,7 +387,13 @@ fn point_in_tri_2d(k: usize, x: &P3, t: &Tri) -> bool {
 }
 
 /// Segment `pq` lying in the plane of the non-degenerate triangle `t` (projection `k`).
-fn coplanar_seg_tri<S: Sink>(p: &P3, q: &P3, t: &Tri, k: usize, sink: &mut S) -> bool {
+fn coplanar_seg_tri<C: Coordinate, S: Sink>(
+    p: &P3<C>,
+    q: &P3<C>,
+    t: &Tri<C>,
+    k: usize,
+    sink: &mut S,
+) -> bool {
     let mut hit = false;
     for x in [p, q] {
         if point_in_tri_2d(k, x, t) {
@@ -398,7 +418,14 @@ fn coplanar_seg_tri<S: Sink>(p: &P3, q: &P3, t: &Tri, k: usize, sink: &mut S) ->
 
 /// Closed segments `pq` and `rs` (either may be a point) whose affine hull the projection
 /// along `k` maps injectively.
-fn seg_seg_2d<S: Sink>(k: usize, p: &P3, q: &P3, r: &P3, s: &P3, sink: &mut S) -> bool {
+fn seg_seg_2d<C: Coordinate, S: Sink>(
+    k: usize,
+    p: &P3<C>,
+    q: &P3<C>,
+    r: &P3<C>,
+    s: &P3<C>,
+    sink: &mut S,
+) -> bool {
     let o1 = sign(orient2d(k, p, q, r));
     let o2 = sign(orient2d(k, p, q, s));
     if o1 * o2 > 0 {
@@ -433,12 +460,12 @@ fn seg_seg_2d<S: Sink>(k: usize, p: &P3, q: &P3, r: &P3, s: &P3, sink: &mut S) -
 /// Collinear closed segments `pq`, `rs`: overlap decided by lexicographic comparison of
 /// `key` (any coordinates injective on their common line).
 #[inline]
-fn collinear_overlap<S: Sink, K: AsRef<[f32]>>(
-    p: &P3,
-    q: &P3,
-    r: &P3,
-    s: &P3,
-    key: impl Fn(&P3) -> K,
+fn collinear_overlap<C: Coordinate, S: Sink, K: AsRef<[C]>>(
+    p: &P3<C>,
+    q: &P3<C>,
+    r: &P3<C>,
+    s: &P3<C>,
+    key: impl Fn(&P3<C>) -> K,
     sink: &mut S,
 ) -> bool {
     let (kp, kq, kr, ks) = (key(p), key(q), key(r), key(s));
@@ -472,7 +499,13 @@ fn collinear_overlap<S: Sink, K: AsRef<[f32]>>(
 }
 
 /// Closed segments (or points) `pq`, `rs` in 3D.
-fn seg_seg_3d<S: Sink>(p: &P3, q: &P3, r: &P3, s: &P3, sink: &mut S) -> bool {
+fn seg_seg_3d<C: Coordinate, S: Sink>(
+    p: &P3<C>,
+    q: &P3<C>,
+    r: &P3<C>,
+    s: &P3<C>,
+    sink: &mut S,
+) -> bool {
     if orient3d(p, q, r, s) != 0.0 {
         return false;
     }

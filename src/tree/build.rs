@@ -206,6 +206,7 @@ impl RegionTree {
             vert_slot,
             referenced_vertices,
             shared: OnceLock::new(),
+            edges: OnceLock::new(),
         };
         debug_assert_eq!(tree.check_topology(mesh), Ok(()));
         Ok(tree)

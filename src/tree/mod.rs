@@ -13,6 +13,7 @@
 //! - `tri_order`/`vert_order` map internal indices back to the caller's original ones.
 
 mod build;
+mod edges;
 mod shared;
 mod validate;
 
@@ -116,6 +117,8 @@ pub struct RegionTree {
     /// The vertex-sharing triangle pairs of each leaf pair, built by the first self query
     /// (`None` inside: over its build budget).
     shared: OnceLock<Option<shared::SharedPairs>>,
+    /// Each leaf's own edges, built by the first query on features (`edges.rs`).
+    edges: OnceLock<edges::LeafEdges>,
 }
 
 impl RegionTree {
@@ -353,6 +356,16 @@ impl RegionTree {
         self.shared
             .get_or_init(|| shared::SharedPairs::build(self))
             .as_ref()
+    }
+
+    /// Each leaf's own edges (built by the first call; see `edges.rs`).
+    pub(crate) fn leaf_edges(&self) -> &edges::LeafEdges {
+        self.edges.get_or_init(|| edges::LeafEdges::build(self))
+    }
+
+    /// The number of unique edges of the triangles (each vertex pair once).
+    pub fn edge_count(&self) -> usize {
+        self.leaf_edges().len()
     }
 
     /// Bytes of topology (shared by the three kinds; not part of a BV's record; the

@@ -73,11 +73,6 @@ struct Opts {
     /// the narrow phase would test). A full step's time minus this one is the narrow phase's.
     #[arg(long)]
     broad_only: bool,
-    /// Frame-to-frame coherence: start each query from where the last one's traversal
-    /// stopped (its front) instead of the root. Same contacts; the counters count the work
-    /// done, so they can differ from pass to pass (the last pass's are printed).
-    #[arg(long)]
-    front: bool,
     /// Passes over the frames (each pass times one step per frame).
     #[arg(long, default_value_t = 5)]
     repeat: usize,
@@ -94,8 +89,7 @@ struct Run {
     build_ms: f64,
     /// Pass by pass, one step per frame: frame `k`'s steps are `k, k + frames, ...`.
     steps_ms: Vec<f64>,
-    /// Per frame: contacts and counters (of the last pass; every pass gives the same unless
-    /// `--front`).
+    /// Per frame: contacts and counters (of the last pass; every pass gives the same).
     frames: Vec<Counters>,
 }
 
@@ -141,7 +135,6 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         };
         let build_ms = t.elapsed().as_secs_f64() * 1e3;
         let mut ws = Workspace::default();
-        ws.set_front_tracking(opts.front);
         let mut steps_ms = Vec::with_capacity(opts.repeat * steps);
         let mut frames = vec![Counters::default(); steps];
         for _ in 0..opts.repeat {
@@ -154,13 +147,13 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
                         hb.update_positions(b[k % b.len()].positions())
                             .map_err(|e| e.to_string())?;
                         if opts.broad_only {
-                            ha.broad_phase(hb, &mut ws, par)
+                            ha.broad_phase(hb, &mut ws, par).map(|b| b.counters)
                         } else {
                             ha.collide(hb, &mut ws, par).map(|c| c.counters)
                         }
                         .map_err(|e| e.to_string())?
                     }
-                    _ if opts.broad_only => ha.self_broad_phase(&mut ws, par),
+                    _ if opts.broad_only => ha.self_broad_phase(&mut ws, par).counters,
                     _ => ha.self_collide(&mut ws, par).counters,
                 };
                 steps_ms.push(t.elapsed().as_secs_f64() * 1e3);
@@ -237,7 +230,7 @@ fn counters_json(c: &Counters) -> serde_json::Value {
     })
 }
 
-/// `{"method", "threads", "broad_only", "front", "build_ms", "step_ms": {"median", "min"},
+/// `{"method", "threads", "broad_only", "build_ms", "step_ms": {"median", "min"},
 /// "frames": [{"contacts", "counters", "step_ms": {"median", "min"}}...]}`.
 fn to_json(r: &Run, threads: usize, opts: &Opts) -> serde_json::Value {
     let (median, min) = median_min(&r.steps_ms);
@@ -245,7 +238,6 @@ fn to_json(r: &Run, threads: usize, opts: &Opts) -> serde_json::Value {
         "method": r.method.name(),
         "threads": threads,
         "broad_only": opts.broad_only,
-        "front": opts.front,
         "build_ms": r.build_ms,
         "step_ms": { "median": median, "min": min },
         "frames": r.frames.iter().enumerate().map(|(k, c)| {
@@ -272,14 +264,9 @@ fn text(runs: &[Run], opts: &Opts, threads: usize, a: &[Mesh], b: Option<&[Mesh]
     };
     let _ = writeln!(
         s,
-        "{what}{}{}, {} steps per pass, {} passes, {} thread(s)",
+        "{what}{}, {} steps per pass, {} passes, {} thread(s)",
         if opts.broad_only {
             " (broad phase only)"
-        } else {
-            ""
-        },
-        if opts.front {
-            " from the last front"
         } else {
             ""
         },

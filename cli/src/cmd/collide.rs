@@ -23,9 +23,9 @@ pub fn run(args: CollideArgs) -> dhcd::Result<()> {
     let q = &args.query;
     let mesh_a = args.input.load(&args.a)?;
     let mesh_b = args.input.load(&args.b)?;
-    let mut a = AnyHierarchy::new(q.method, &mesh_a, q.options())?;
-    let mut b = AnyHierarchy::new(q.method, &mesh_b, q.options())?;
-    let contacts = a.collide(&mut b, &mut Workspace::default(), Par::Seq)?;
+    let a = AnyHierarchy::new(q.method, &mesh_a, q.options())?;
+    let b = AnyHierarchy::new(q.method, &mesh_b, q.options())?;
+    let contacts = a.collide(&b, &mut Workspace::default(), Par::Seq)?;
     let levels = a.tree().levels().max(b.tree().levels());
     q.report("contacts", levels, &contacts.pairs, contacts.counters)
 }

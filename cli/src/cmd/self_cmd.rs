@@ -20,7 +20,7 @@ pub struct SelfArgs {
 pub fn run(args: SelfArgs) -> dhcd::Result<()> {
     let q = &args.query;
     let mesh = args.input.load(&args.mesh)?;
-    let mut h = AnyHierarchy::new(q.method, &mesh, q.options())?;
+    let h = AnyHierarchy::new(q.method, &mesh, q.options())?;
     let contacts = h.self_collide(&mut Workspace::default(), Par::Seq);
     q.report(
         "self-contacts",

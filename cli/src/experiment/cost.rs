@@ -29,7 +29,7 @@ use std::time::Instant;
 use dhcd::any::AnyHierarchy;
 use dhcd::counters::Counters;
 use dhcd::par::Par;
-use dhcd::traverse::Workspace;
+use dhcd::Workspace;
 
 use super::{two_mut, ExperimentError};
 
@@ -179,8 +179,7 @@ pub(super) fn calibrate_frame(
     // phase over the now fitted hierarchies (it refits nothing).
     for &(i, j) in pairs {
         let (a, b) = two_mut(hs, i, j);
-        a.broad_phase(b, &mut ws, par)?;
-        leaves.push(ws.leaf_pairs().to_vec());
+        leaves.push(a.broad_phase(b, &mut ws, par)?.leaf_pairs);
     }
     let fitted: Vec<Vec<u32>> = hs.iter().map(AnyHierarchy::fitted_nodes).collect();
     let mut times: [Vec<f64>; 4] = Default::default();
@@ -193,19 +192,19 @@ pub(super) fn calibrate_frame(
         let fixed = t.elapsed().as_nanos() as f64;
         // C_U: the step's refit, alone.
         let t = Instant::now();
+        let mut nu = 0;
         for (h, ids) in hs.iter_mut().zip(&fitted) {
             h.invalidate();
-            h.refit_nodes(ids, par)?;
+            nu += h.refit_nodes(ids, par)?;
         }
         let tu = t.elapsed().as_nanos() as f64;
-        let nu: u64 = hs.iter_mut().map(AnyHierarchy::take_updates).sum();
         debug_assert_eq!(nu, counters.bv_updates);
         // C_V: traversal with everything already fitted.
         let t = Instant::now();
         let mut nv = 0;
         for &(i, j) in pairs {
             let (a, b) = two_mut(hs, i, j);
-            let c = a.broad_phase(b, &mut ws, par)?;
+            let c = a.broad_phase(b, &mut ws, par)?.counters;
             debug_assert_eq!(c.bv_updates, 0);
             nv += c.bv_tests;
         }

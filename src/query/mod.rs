@@ -1,0 +1,201 @@
+//! The queries: each one is an implementation of the walk engine's [`Query`] (a node test and
+//! a leaf action), with its public entry points.
+//!
+//! - `contacts.rs`: exact intersecting triangle pairs ([`collide`], [`self_collide`]), and
+//!   the split of that query into [`broad_phase`] (overlapping leaf pairs) and
+//!   [`narrow_phase`] for calibration and benchmarks;
+//! - `proximity.rs`: every vertex-triangle and edge-edge pair within a distance
+//!   ([`proximity`], [`self_proximity`]), with distances and closest sub-features.
+//!
+//! Queries on the current pose share [`Posed`]: two hierarchies' lazily fitted volumes and a
+//! node test ([`Overlap`], or [`Within`] a distance); they differ in the leaf action.
+
+pub(crate) mod contacts;
+pub(crate) mod proximity;
+
+pub use contacts::{
+    broad_phase, collide, collide_with, narrow_phase, self_broad_phase, self_collide,
+    self_collide_with, BroadPhase, Contacts,
+};
+pub use proximity::{
+    proximity, proximity_with, self_proximity, self_proximity_with, EdgePair, FaceVertex,
+    Proximity, VertexFace,
+};
+
+use pulp::Simd;
+
+use crate::bv::BvKind;
+use crate::counters::Counters;
+use crate::hierarchy::Hierarchy;
+use crate::tree::RegionTree;
+use crate::walk::{Query, Side};
+
+/// A node test on the volumes of the current pose.
+pub(crate) trait NodeTest: Copy + Send + Sync {
+    fn test<K: BvKind, S: Simd>(
+        self,
+        simd: S,
+        a: K::Block<'_>,
+        i: usize,
+        b: K::Block<'_>,
+        n: usize,
+    ) -> u32;
+}
+
+/// The volumes overlap (they share a point).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Overlap;
+
+impl NodeTest for Overlap {
+    #[inline(always)]
+    fn test<K: BvKind, S: Simd>(
+        self,
+        simd: S,
+        a: K::Block<'_>,
+        i: usize,
+        b: K::Block<'_>,
+        n: usize,
+    ) -> u32 {
+        K::test(simd, a, i, b, n)
+    }
+}
+
+/// The volumes come within a distance: `margin`, an `f32` at least the query's distance
+/// (rounded up), by which entry `i`'s volume is grown ([`BvKind::test_within`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Within {
+    pub(crate) margin: f32,
+}
+
+impl Within {
+    /// The test for distance `d` (finite, `>= 0`): the least `f32` not below `d`.
+    pub(crate) fn distance(d: f64) -> Self {
+        let m = d as f32;
+        let margin = if f64::from(m) < d { m.next_up() } else { m };
+        Self { margin }
+    }
+}
+
+impl NodeTest for Within {
+    #[inline(always)]
+    fn test<K: BvKind, S: Simd>(
+        self,
+        simd: S,
+        a: K::Block<'_>,
+        i: usize,
+        b: K::Block<'_>,
+        n: usize,
+    ) -> u32 {
+        K::test_within(simd, a, i, b, n, self.margin)
+    }
+}
+
+/// Two hierarchies in their current pose (one, on both sides, for a self query) and a node
+/// test: everything a query on the current pose needs but its leaf action.
+pub(crate) struct Posed<'h, K: BvKind, T: NodeTest> {
+    pub(crate) a: &'h Hierarchy<K>,
+    pub(crate) b: &'h Hierarchy<K>,
+    pub(crate) self_query: bool,
+    pub(crate) node_test: T,
+}
+
+impl<'h, K: BvKind, T: NodeTest> Posed<'h, K, T> {
+    pub(crate) fn pair(a: &'h Hierarchy<K>, b: &'h Hierarchy<K>, node_test: T) -> Self {
+        Self {
+            a,
+            b,
+            self_query: false,
+            node_test,
+        }
+    }
+
+    pub(crate) fn single(h: &'h Hierarchy<K>, node_test: T) -> Self {
+        Self {
+            a: h,
+            b: h,
+            self_query: true,
+            node_test,
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn side(&self, side: Side) -> &'h Hierarchy<K> {
+        match side {
+            Side::A => self.a,
+            Side::B => self.b,
+        }
+    }
+}
+
+/// The action a query on the current pose takes on an overlapping leaf pair.
+pub(crate) trait LeafAction<'h, K: BvKind>: Sync {
+    type Out: Send;
+    fn out(&self) -> Self::Out;
+    fn leaf_pair<S: Simd, T: NodeTest>(
+        &self,
+        posed: &Posed<'h, K, T>,
+        simd: S,
+        x: usize,
+        y: usize,
+        counters: &mut Counters,
+        out: &mut Self::Out,
+    );
+    fn merge(&self, out: &mut Self::Out, other: Self::Out);
+}
+
+/// A query on the current pose: [`Posed`] plus a [`LeafAction`].
+pub(crate) struct PosedQuery<'h, K: BvKind, T: NodeTest, L> {
+    pub(crate) posed: Posed<'h, K, T>,
+    pub(crate) action: L,
+}
+
+impl<'h, K: BvKind, T: NodeTest, L: LeafAction<'h, K>> Query for PosedQuery<'h, K, T, L> {
+    type Block = K::Block<'h>;
+    type Out = L::Out;
+
+    #[inline(always)]
+    fn tree(&self, side: Side) -> &RegionTree {
+        self.posed.side(side).tree()
+    }
+
+    #[inline(always)]
+    fn is_self(&self) -> bool {
+        self.posed.self_query
+    }
+
+    fn out(&self) -> L::Out {
+        self.action.out()
+    }
+
+    #[inline(always)]
+    fn group(&self, side: Side, g: usize) -> (K::Block<'h>, bool) {
+        self.posed.side(side).group(g)
+    }
+
+    #[inline(always)]
+    fn test<S: Simd>(&self, simd: S, a: Self::Block, i: usize, b: Self::Block, n: usize) -> u32 {
+        self.posed.node_test.test::<K, S>(simd, a, i, b, n)
+    }
+
+    #[inline(always)]
+    fn extent(&self, block: Self::Block, i: usize) -> f32 {
+        K::extent(block, i)
+    }
+
+    #[inline(always)]
+    fn leaf_pair<S: Simd>(
+        &self,
+        simd: S,
+        x: usize,
+        y: usize,
+        counters: &mut Counters,
+        out: &mut L::Out,
+    ) {
+        self.action
+            .leaf_pair(&self.posed, simd, x, y, counters, out)
+    }
+
+    fn merge(&self, out: &mut L::Out, other: L::Out) {
+        self.action.merge(out, other)
+    }
+}

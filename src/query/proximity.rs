@@ -1,0 +1,475 @@
+//! Proximity: every vertex-triangle and edge-edge pair whose closed features are within a
+//! distance `d`, decided exactly, with its squared distance and closest sub-features.
+//!
+//! The walk is the contact query's with the node test grown by `d` ([`Within`]): two regions
+//! holding features within `d` of each other have volumes within `d`, so every such pair
+//! lies in a leaf pair the walk reaches. Each leaf pair enumerates its features once:
+//! every vertex belongs to one leaf (its own vertices, the ones first seen in it) and so does
+//! every edge (the leaf of its first triangle), so a vertex-triangle pair is met only in the
+//! leaf pair (vertex's leaf, triangle's leaf) and an edge pair only in the pair of their
+//! leaves, however many triangles share the features. Inside a leaf pair, features are first
+//! culled by the other leaf's union box grown by `d`, then pair by pair by their boxes grown
+//! by `d` (boxes in `f32`, rounded outward for `f64` hierarchies), and the pairs left go to
+//! the exact tests of [`crate::distance`].
+//!
+//! Results are in the caller's original indices, sorted, and the same for every thread count
+//! and every kind. `prim_tests` counts the feature pairs given to the exact test; `contacts`
+//! the pairs reported.
+
+use pulp::Simd;
+
+use super::{LeafAction, NodeTest, Posed, PosedQuery, Within};
+use crate::bv::BvKind;
+use crate::counters::Counters;
+use crate::distance::{self, EdgeEdge, PointTriangle};
+use crate::error::{Error, Result};
+use crate::hierarchy::Hierarchy;
+use crate::par::Par;
+use crate::walk::{self, Workspace};
+
+/// A vertex within the distance of a triangle: in a pair query, a vertex of the first
+/// hierarchy and a triangle of the second (see [`FaceVertex`] for the other way round); in a
+/// self query, a vertex and a triangle not containing it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexFace {
+    /// The vertex (original index).
+    pub vertex: u32,
+    /// The triangle (original index).
+    pub triangle: u32,
+    /// Squared distance between the point and the closed triangle (see [`crate::distance`]
+    /// for its accuracy).
+    pub distance_sq: f64,
+    /// Which sub-feature of the triangle is closest (IPC's point-triangle distance types).
+    pub kind: PointTriangle,
+}
+
+/// A triangle of the first hierarchy within the distance of a vertex of the second (pair
+/// queries only).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceVertex {
+    /// The triangle of the first hierarchy (original index).
+    pub triangle: u32,
+    /// The vertex of the second hierarchy (original index).
+    pub vertex: u32,
+    pub distance_sq: f64,
+    pub kind: PointTriangle,
+}
+
+/// Two edges within the distance: `a` of the first hierarchy and `b` of the second (pair
+/// queries), or two edges of one mesh sharing no vertex with `a < b` (self queries). Each
+/// edge is its two vertices' original indices, smaller first; the distance type names them
+/// in that order (`EA0` is `a[0]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgePair {
+    pub a: [u32; 2],
+    pub b: [u32; 2],
+    pub distance_sq: f64,
+    pub kind: EdgeEdge,
+}
+
+/// Result of a proximity query: every feature pair within the distance, in the caller's
+/// original indices, sorted, and the counted work.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Proximity {
+    /// Sorted by `(vertex, triangle)`.
+    pub vertex_face: Vec<VertexFace>,
+    /// Sorted by `(triangle, vertex)`; empty in a self query.
+    pub face_vertex: Vec<FaceVertex>,
+    /// Sorted by `(a, b)`.
+    pub edge_edge: Vec<EdgePair>,
+    /// `bv_tests` and `bv_updates` as for contacts, `prim_tests` the feature pairs given to
+    /// the exact test, `contacts` the pairs reported.
+    pub counters: Counters,
+}
+
+/// Checks a proximity distance: finite and `>= 0`.
+pub(crate) fn check_distance(d: f64) -> Result<()> {
+    if d.is_finite() && d >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidDistance(d))
+    }
+}
+
+/// Every vertex-triangle and edge-edge pair of `a` and `b` within distance `d` (finite,
+/// `>= 0`; else [`Error::InvalidDistance`]), on the calling thread.
+pub fn proximity<K: BvKind>(a: &Hierarchy<K>, b: &Hierarchy<K>, d: f64) -> Result<Proximity> {
+    proximity_with(a, b, d, &mut Workspace::default(), Par::Seq)
+}
+
+/// [`proximity`] with caller-owned scratch and a choice of parallelism. The result does not
+/// depend on `par`.
+pub fn proximity_with<K: BvKind>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    d: f64,
+    ws: &mut Workspace,
+    par: Par,
+) -> Result<Proximity> {
+    check_distance(d)?;
+    Ok(run(Posed::pair(a, b, Within::distance(d)), d, ws, par).0)
+}
+
+/// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
+/// (sharing no vertex) of one mesh within distance `d`, on the calling thread.
+pub fn self_proximity<K: BvKind>(h: &Hierarchy<K>, d: f64) -> Result<Proximity> {
+    self_proximity_with(h, d, &mut Workspace::default(), Par::Seq)
+}
+
+/// [`self_proximity`] with caller-owned scratch and a choice of parallelism.
+pub fn self_proximity_with<K: BvKind>(
+    h: &Hierarchy<K>,
+    d: f64,
+    ws: &mut Workspace,
+    par: Par,
+) -> Result<Proximity> {
+    check_distance(d)?;
+    Ok(run(Posed::single(h, Within::distance(d)), d, ws, par).0)
+}
+
+/// The proximity query on `posed` (distance already checked); also the nodes fitted on each
+/// side (the scene credits them per object).
+pub(crate) fn run<K: BvKind>(
+    posed: Posed<'_, K, Within>,
+    d: f64,
+    ws: &mut Workspace,
+    par: Par,
+) -> (Proximity, [u64; 2]) {
+    let margin = posed.node_test.margin;
+    let q = PosedQuery {
+        posed,
+        action: Features { d, margin },
+    };
+    let w = walk::walk(&q, ws, par);
+    let mut p = w.out.result;
+    p.vertex_face
+        .sort_unstable_by_key(|x| (u64::from(x.vertex) << 32) | u64::from(x.triangle));
+    p.face_vertex
+        .sort_unstable_by_key(|x| (u64::from(x.triangle) << 32) | u64::from(x.vertex));
+    p.edge_edge.sort_unstable_by_key(|x| (x.a, x.b));
+    p.counters = w.counters;
+    p.counters.contacts = (p.vertex_face.len() + p.face_vertex.len() + p.edge_edge.len()) as u64;
+    (p, w.fitted)
+}
+
+/// The leaf action: the feature pairs of a leaf pair.
+struct Features {
+    d: f64,
+    /// `d` as an `f32` not below it: the boxes' growth.
+    margin: f32,
+}
+
+/// What a proximity walk task produces: its pairs, and scratch for edge boxes.
+struct FeatureOut {
+    result: Proximity,
+    edges: [Boxes; 2],
+}
+
+/// Closed boxes in structure-of-arrays form (scratch).
+#[derive(Default)]
+struct Boxes {
+    lo: [Vec<f32>; 3],
+    hi: [Vec<f32>; 3],
+}
+
+type Bounds = ([f32; 3], [f32; 3]);
+
+impl Boxes {
+    fn clear(&mut self) {
+        for k in 0..3 {
+            self.lo[k].clear();
+            self.hi[k].clear();
+        }
+    }
+
+    fn push(&mut self, (lo, hi): Bounds) {
+        for k in 0..3 {
+            self.lo[k].push(lo[k]);
+            self.hi[k].push(hi[k]);
+        }
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize) -> Bounds {
+        (
+            [self.lo[0][i], self.lo[1][i], self.lo[2][i]],
+            [self.hi[0][i], self.hi[1][i], self.hi[2][i]],
+        )
+    }
+
+    /// The union of the boxes (empty: `+inf..-inf`).
+    fn union(&self) -> Bounds {
+        let mut u = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for k in 0..3 {
+            for (&l, &h) in self.lo[k].iter().zip(&self.hi[k]) {
+                u.0[k] = u.0[k].min(l);
+                u.1[k] = u.1[k].max(h);
+            }
+        }
+        u
+    }
+}
+
+/// Whether two closed boxes meet.
+#[inline(always)]
+fn meet(a: &Bounds, b: &Bounds) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
+
+/// `b` grown by `m` along every axis, rounded outward.
+#[inline(always)]
+fn grown(b: &Bounds, m: f32) -> Bounds {
+    (
+        b.0.map(|x| (x - m).next_down()),
+        b.1.map(|x| (x + m).next_up()),
+    )
+}
+
+/// The closed box of points `p` (`f32` values of the hierarchy's positions), widened by an
+/// ulp when they are roundings of `f64` positions, so it holds the exact points too.
+#[inline(always)]
+fn points_box<const N: usize>(p: [[f32; 3]; N], rounded: bool) -> Bounds {
+    let mut b = (p[0], p[0]);
+    for q in &p[1..] {
+        b.0 = std::array::from_fn(|k| b.0[k].min(q[k]));
+        b.1 = std::array::from_fn(|k| b.1[k].max(q[k]));
+    }
+    if rounded {
+        (b.0.map(f32::next_down), b.1.map(f32::next_up))
+    } else {
+        b
+    }
+}
+
+/// One side of a leaf pair: a hierarchy and one of its leaves.
+#[derive(Clone, Copy)]
+struct Leaf<'h, K: BvKind> {
+    h: &'h Hierarchy<K>,
+    node: usize,
+}
+
+impl<K: BvKind> Leaf<'_, K> {
+    fn own_edges(&self) -> &[[u32; 2]] {
+        let tree = self.h.tree();
+        tree.leaf_edges()
+            .of_rank(tree.leaf_rank(self.node).expect("a leaf"))
+    }
+
+    /// The closed boxes of the leaf's own edges, into `out`.
+    fn edge_boxes(&self, out: &mut Boxes) {
+        out.clear();
+        let (p, rounded) = (self.h.points(), self.h.is_rounded());
+        for &[u, v] in self.own_edges() {
+            out.push(points_box([p.get(u as usize), p.get(v as usize)], rounded));
+        }
+    }
+}
+
+impl<'h, K: BvKind> LeafAction<'h, K> for Features {
+    type Out = FeatureOut;
+
+    fn out(&self) -> FeatureOut {
+        FeatureOut {
+            result: Proximity::default(),
+            edges: Default::default(),
+        }
+    }
+
+    #[inline(always)]
+    fn leaf_pair<S: Simd, T: NodeTest>(
+        &self,
+        posed: &Posed<'h, K, T>,
+        _simd: S,
+        x: usize,
+        y: usize,
+        counters: &mut Counters,
+        out: &mut FeatureOut,
+    ) {
+        let (lx, ly) = (
+            Leaf {
+                h: posed.a,
+                node: x,
+            },
+            Leaf {
+                h: posed.b,
+                node: y,
+            },
+        );
+        let self_query = posed.self_query;
+        let res = &mut out.result;
+        // Vertices of x against triangles of y, and (but for a leaf with itself) the other way.
+        self.vertices_vs_triangles(lx, ly, self_query, counters, |v, t, d2, kind| {
+            res.vertex_face.push(VertexFace {
+                vertex: v,
+                triangle: t,
+                distance_sq: d2,
+                kind,
+            })
+        });
+        if !(self_query && x == y) {
+            self.vertices_vs_triangles(ly, lx, self_query, counters, |v, t, d2, kind| {
+                if self_query {
+                    res.vertex_face.push(VertexFace {
+                        vertex: v,
+                        triangle: t,
+                        distance_sq: d2,
+                        kind,
+                    })
+                } else {
+                    res.face_vertex.push(FaceVertex {
+                        triangle: t,
+                        vertex: v,
+                        distance_sq: d2,
+                        kind,
+                    })
+                }
+            });
+        }
+        self.edges_vs_edges(
+            lx,
+            ly,
+            self_query,
+            &mut out.edges,
+            counters,
+            &mut res.edge_edge,
+        );
+    }
+
+    fn merge(&self, out: &mut FeatureOut, other: FeatureOut) {
+        let (r, o) = (&mut out.result, other.result);
+        r.vertex_face.extend_from_slice(&o.vertex_face);
+        r.face_vertex.extend_from_slice(&o.face_vertex);
+        r.edge_edge.extend_from_slice(&o.edge_edge);
+    }
+}
+
+impl Features {
+    /// The own vertices of leaf `lv` against the triangles of leaf `lt`: `emit(vertex,
+    /// triangle, distance_sq, kind)` for each pair within the distance (original indices).
+    #[inline(always)]
+    fn vertices_vs_triangles<K: BvKind>(
+        &self,
+        lv: Leaf<'_, K>,
+        lt: Leaf<'_, K>,
+        self_query: bool,
+        counters: &mut Counters,
+        mut emit: impl FnMut(u32, u32, f64, PointTriangle),
+    ) {
+        let (tv, tt) = (lv.h.tree(), lt.h.tree());
+        let tris = lt.h.leaf_tris(lt.node);
+        let soa = &tris.soa;
+        let tri_box = |j: usize| -> Bounds {
+            (
+                [soa.lo(0)[j], soa.lo(1)[j], soa.lo(2)[j]],
+                [soa.hi(0)[j], soa.hi(1)[j], soa.hi(2)[j]],
+            )
+        };
+        let mut union = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for j in 0..tris.len {
+            let b = tri_box(j);
+            for k in 0..3 {
+                union.0[k] = union.0[k].min(b.0[k]);
+                union.1[k] = union.1[k].max(b.1[k]);
+            }
+        }
+        let near = grown(&union, self.margin);
+        let (p, rounded) = (lv.h.points(), lv.h.is_rounded());
+        let tri_range = tt.tri_range(lt.node);
+        for v in tv.vert_run(lv.node) {
+            let vbox = points_box([p.get(v)], rounded);
+            if !meet(&vbox, &near) {
+                continue;
+            }
+            let probe = grown(&vbox, self.margin);
+            let mut point = None;
+            for j in 0..tris.len {
+                if !meet(&probe, &tri_box(j)) {
+                    continue;
+                }
+                let t = tri_range.start + j;
+                let corners = tt.triangles()[t];
+                if self_query && corners.contains(&(v as u32)) {
+                    continue;
+                }
+                counters.prim_tests += 1;
+                let pv = *point.get_or_insert_with(|| lv.h.position_f64(v));
+                let tri = corners.map(|c| lt.h.position_f64(c as usize));
+                if let Some((d2, kind)) = distance::point_triangle_within(pv, tri, self.d) {
+                    emit(tv.vert_order()[v], tt.tri_order()[t], d2, kind);
+                }
+            }
+        }
+    }
+
+    /// The own edges of leaf `la` against those of `lb` (a leaf with itself: each unordered
+    /// pair once): each pair within the distance into `out`.
+    #[inline(always)]
+    fn edges_vs_edges<K: BvKind>(
+        &self,
+        la: Leaf<'_, K>,
+        lb: Leaf<'_, K>,
+        self_query: bool,
+        scratch: &mut [Boxes; 2],
+        counters: &mut Counters,
+        out: &mut Vec<EdgePair>,
+    ) {
+        let same = self_query && la.node == lb.node;
+        let [ba, bb] = scratch;
+        la.edge_boxes(ba);
+        let bb: &Boxes = if same {
+            ba
+        } else {
+            lb.edge_boxes(bb);
+            bb
+        };
+        let near = grown(&bb.union(), self.margin);
+        let (ea, eb) = (la.own_edges(), lb.own_edges());
+        let (oa, ob) = (la.h.tree().vert_order(), lb.h.tree().vert_order());
+        for (i, &[u0, u1]) in ea.iter().enumerate() {
+            let abox = ba.get(i);
+            if !meet(&abox, &near) {
+                continue;
+            }
+            let probe = grown(&abox, self.margin);
+            let first = if same { i + 1 } else { 0 };
+            for (j, &[w0, w1]) in eb.iter().enumerate().skip(first) {
+                if !meet(&probe, &bb.get(j)) {
+                    continue;
+                }
+                if self_query && (u0 == w0 || u0 == w1 || u1 == w0 || u1 == w1) {
+                    continue;
+                }
+                counters.prim_tests += 1;
+                // Original indices, each edge smaller first; in a self query the smaller edge
+                // first. The exact test takes the endpoints in that order, so its type names
+                // them as reported.
+                let e = |o: &[u32], s: u32, t: u32| {
+                    let (os, ot) = (o[s as usize], o[t as usize]);
+                    if os < ot {
+                        ([os, ot], [s, t])
+                    } else {
+                        ([ot, os], [t, s])
+                    }
+                };
+                let (mut a, mut b) = ((e(oa, u0, u1), la.h), (e(ob, w0, w1), lb.h));
+                if self_query && b.0 .0 < a.0 .0 {
+                    std::mem::swap(&mut a, &mut b);
+                }
+                let pos = |((_, ids), h): &(([u32; 2], [u32; 2]), &Hierarchy<K>)| {
+                    ids.map(|v| h.position_f64(v as usize))
+                };
+                let (pa, pb) = (pos(&a), pos(&b));
+                if let Some((d2, kind)) =
+                    distance::edge_edge_within(pa[0], pa[1], pb[0], pb[1], self.d)
+                {
+                    out.push(EdgePair {
+                        a: a.0 .0,
+                        b: b.0 .0,
+                        distance_sq: d2,
+                        kind,
+                    });
+                }
+            }
+        }
+    }
+}
