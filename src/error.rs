@@ -103,6 +103,16 @@ pub enum Error {
         cores = crate::par::max_threads()
     )]
     InvalidThreads { got: usize },
+    /// A CCD time limit outside [0, 1] (or NaN).
+    #[error("CCD t_max must be in [0, 1], got {0}")]
+    InvalidTimeLimit(f64),
+    /// A CCD minimum distance that is negative, infinite or NaN.
+    #[error("CCD min_distance must be finite and >= 0, got {0}")]
+    InvalidMinDistance(f64),
+    /// A CCD query point with a NaN or infinite coordinate (`point` 0-3 at t = 0, 4-7 at
+    /// t = 1, in the order of the query).
+    #[error("CCD point {point} has a non-finite coordinate {position:?}")]
+    NonFiniteCcdPoint { point: usize, position: [f64; 3] },
     #[error("{}: {}", escaped_path(.path), escaped(.message))]
     Io { path: PathBuf, message: String },
     #[error(

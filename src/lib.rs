@@ -28,6 +28,7 @@
 
 pub mod any;
 pub mod bv;
+pub mod ccd;
 pub mod counters;
 pub mod detail;
 pub mod distance;

@@ -1,6 +1,10 @@
 //! One integration-test binary; each module is a suite. (The CLI, experiment and simulator
 //! suites live in `cli/tests/`, the C ABI's in `capi/tests/`.)
 
+mod ccd_cases;
+mod ccd_frames;
+mod ccd_reference;
+mod ccd_samples;
 mod central;
 mod distance;
 mod fixtures;

@@ -1,0 +1,445 @@
+//! The float filter: decides a query in f64 arithmetic with rigorous error bounds, or says
+//! it cannot. Stages:
+//!
+//! 0. Swept boxes: the two features' boxes over their positions at t = 0 and t = 1 (they
+//!    move linearly, so each lies in its box all step); disjoint on an axis means no
+//!    contact. Comparisons only: exact.
+//! 1. The coplanarity cubic `f(t)` (zero at every contact) in Bernstein form on [0, 1]:
+//!    its four coefficients are sums of the eight determinants `det(P_i, Q_j, R_k)` of the
+//!    three difference vectors at t = 0 / 1 (the determinant is trilinear and each vector
+//!    is linear in t). All certainly of one sign means `f` has no root: no contact.
+//! 2. Isolation of the roots of `f` in [0, t_max] by subdivision of interval Bernstein
+//!    coefficients, each root narrowed to an interval of width <= 2^-40 by bisection, and
+//!    at each root interval (in increasing order) the in-triangle / crossing signs
+//!    evaluated in interval arithmetic over that interval.
+//!
+//! Anything not certain (a root at an endpoint, a double root, a sign straddling 0, an
+//! edge or vertex contact, huge coordinates) is `Unknown` and goes to the exact path.
+
+use super::interval::Iv;
+use super::ring::{self, Ring, V3};
+
+/// What the filter concluded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Verdict {
+    Miss,
+    /// Contact; the value is a lower bound of the earliest contact time, at most 2^-40 below.
+    Hit(f64),
+    /// Contact at the only root of f in (lo, hi), a simple root where f changes sign; the
+    /// time is to be narrowed exactly.
+    Refine(f64, f64),
+    Unknown,
+}
+
+/// Largest coordinate difference the filter accepts (keeps degree-4 terms far from
+/// overflow).
+const MAX_MAGNITUDE: f64 = 1.606_938_044_258_990_3e60; // 2^200
+/// Root intervals are narrowed to this width.
+const ROOT_WIDTH: f64 = 9.094_947_017_729_282e-13; // 2^-40
+/// Subdivision depth of the root isolation before giving up.
+const MAX_DEPTH: u32 = 12;
+
+#[inline(always)]
+fn min4(a: f64, b: f64, c: f64, d: f64) -> f64 {
+    a.min(b).min(c.min(d))
+}
+#[inline(always)]
+fn max4(a: f64, b: f64, c: f64, d: f64) -> f64 {
+    a.max(b).max(c.max(d))
+}
+
+/// Stage 0 for vertex-face: the vertex's swept interval against the triangle's swept box,
+/// per axis, separated by more than `gap` (certainly).
+#[inline(always)]
+pub(crate) fn vf_boxes_apart(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], gap: f64) -> bool {
+    (0..3).any(|k| {
+        let pmin = x0[0][k].min(x1[0][k]);
+        let pmax = x0[0][k].max(x1[0][k]);
+        let tmin = min4(x0[1][k], x0[2][k], x0[3][k], x1[1][k]).min(x1[2][k].min(x1[3][k]));
+        let tmax = max4(x0[1][k], x0[2][k], x0[3][k], x1[1][k]).max(x1[2][k].max(x1[3][k]));
+        apart(pmin, pmax, tmin, tmax, gap)
+    })
+}
+
+/// Stage 0 for edge-edge.
+#[inline(always)]
+pub(crate) fn ee_boxes_apart(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], gap: f64) -> bool {
+    (0..3).any(|k| {
+        let amin = min4(x0[0][k], x0[1][k], x1[0][k], x1[1][k]);
+        let amax = max4(x0[0][k], x0[1][k], x1[0][k], x1[1][k]);
+        let bmin = min4(x0[2][k], x0[3][k], x1[2][k], x1[3][k]);
+        let bmax = max4(x0[2][k], x0[3][k], x1[2][k], x1[3][k]);
+        apart(amin, amax, bmin, bmax, gap)
+    })
+}
+
+/// Intervals [a0, a1] and [b0, b1] certainly more than `gap` apart. With gap = 0 a plain
+/// comparison; otherwise the rounded difference stepped down one ulp (a lower bound of the
+/// exact difference) must exceed the gap.
+#[inline(always)]
+fn apart(a0: f64, a1: f64, b0: f64, b1: f64, gap: f64) -> bool {
+    if gap == 0.0 {
+        a1 < b0 || b1 < a0
+    } else {
+        (b0 - a1).next_down() > gap || (a0 - b1).next_down() > gap
+    }
+}
+
+/// The three difference vectors of `f` at t = 0 and t = 1, `[[P0, Q0, R0], [P1, Q1, R1]]`,
+/// each rounded to nearest.
+type Diffs = [[[f64; 3]; 3]; 2];
+
+#[inline(always)]
+fn d3(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline(always)]
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Stage 1: the Bernstein coefficients of f on [0, 1] (the middle two times 3) and one
+/// bound `e` on the error of each, or None if the magnitudes are out of the filter's
+/// range.
+///
+/// Error bound. The computed differences carry a relative error <= u = 2^-53; each
+/// determinant then takes a product of three of them and two roundings per product level,
+/// and a coefficient sums three determinants: the standard forward bound is
+/// `gamma_10 * (sum of |terms|) <= 10.1 u * 18 m^3 < 2^-45 m^3`, m the largest difference
+/// (at most `(1 + u) m` exactly). Underflow adds at most `24 (m + 1) 2^-1074` absolute
+/// (an underflowed product, amplified by one factor <= m), far below `(m + 1) 2^-1000`.
+/// The bound is itself computed with a relative slack of 2^-20, which covers its own
+/// rounding.
+#[inline(always)]
+fn bernstein(d: &Diffs) -> Option<([f64; 4], f64)> {
+    let mut m = 0.0f64;
+    for t in d {
+        for v in t {
+            for x in v {
+                m = m.max(x.abs());
+            }
+        }
+    }
+    // `max` ignores NaN, so a NaN difference (inf - inf) is looked for on its own.
+    if m > MAX_MAGNITUDE || d.iter().flatten().flatten().any(|x| x.is_nan()) {
+        return None;
+    }
+    let [[p0, q0, r0], [p1, q1, r1]] = d;
+    let qr00 = cross(q0, r0);
+    let qr01 = cross(q0, r1);
+    let qr10 = cross(q1, r0);
+    let qr11 = cross(q1, r1);
+    let d000 = dot(p0, &qr00);
+    let d100 = dot(p1, &qr00);
+    let d010 = dot(p0, &qr10);
+    let d001 = dot(p0, &qr01);
+    let d110 = dot(p1, &qr10);
+    let d101 = dot(p1, &qr01);
+    let d011 = dot(p0, &qr11);
+    let d111 = dot(p1, &qr11);
+    let b = [d000, d100 + d010 + d001, d110 + d101 + d011, d111];
+    let e = m * m * m * (2f64.powi(-45) * (1.0 + 2f64.powi(-20))) + (m + 1.0) * 2f64.powi(-1000);
+    Some((b, e))
+}
+
+/// Interval Bernstein coefficients over a dyadic piece of [0, 1].
+#[derive(Clone, Copy)]
+struct Piece {
+    s0: f64,
+    s1: f64,
+    c: [Iv; 4],
+}
+
+#[inline(always)]
+fn half(a: Iv, b: Iv) -> Iv {
+    a.add(&b).scale(0.5)
+}
+
+/// de Casteljau at 1/2: the two halves.
+fn split(p: &Piece) -> (Piece, Piece) {
+    let [c0, c1, c2, c3] = p.c;
+    let c01 = half(c0, c1);
+    let c12 = half(c1, c2);
+    let c23 = half(c2, c3);
+    let c012 = half(c01, c12);
+    let c123 = half(c12, c23);
+    let mid = half(c012, c123);
+    let sm = 0.5 * (p.s0 + p.s1); // exact: both are multiples of 2^-MAX_DEPTH in [0, 1]
+    (
+        Piece {
+            s0: p.s0,
+            s1: sm,
+            c: [c0, c01, c012, mid],
+        },
+        Piece {
+            s0: sm,
+            s1: p.s1,
+            c: [mid, c123, c23, c3],
+        },
+    )
+}
+
+/// Enclosure of f(s) from the coefficients on [0, 1].
+fn eval_at(c: &[Iv; 4], s: f64) -> Iv {
+    let l = Iv::point(s);
+    let m = Iv::diff(1.0, s);
+    let lerp = |a: Iv, b: Iv| a.mul(&m).add(&b.mul(&l));
+    let (a0, a1, a2) = (lerp(c[0], c[1]), lerp(c[1], c[2]), lerp(c[2], c[3]));
+    let (b0, b1) = (lerp(a0, a1), lerp(a1, a2));
+    lerp(b0, b1)
+}
+
+/// A root interval (s0, s1) of f and the sign of f at s0.
+#[derive(Clone, Copy)]
+struct RootIv {
+    s0: f64,
+    s1: f64,
+    sign0: i8,
+}
+
+/// Isolates the roots of f in [0, 1] (in increasing order) or fails.
+fn isolate(p: &Piece, depth: u32, out: &mut [RootIv; 3], n: &mut usize) -> bool {
+    let [c0, c1, c2, c3] = p.c;
+    if c0.pos() && c1.pos() && c2.pos() && c3.pos() || c0.neg() && c1.neg() && c2.neg() && c3.neg()
+    {
+        return true;
+    }
+    let (e0, e1, e2) = (c1.sub(&c0), c2.sub(&c1), c3.sub(&c2));
+    let monotone = e0.pos() && e1.pos() && e2.pos() || e0.neg() && e1.neg() && e2.neg();
+    if monotone {
+        let (sa, sb) = (c0.sign(), c3.sign());
+        if sa == 0 || sb == 0 {
+            return false; // possibly a root at an end of the piece
+        }
+        if sa != sb {
+            if *n == 3 {
+                return false;
+            }
+            out[*n] = RootIv {
+                s0: p.s0,
+                s1: p.s1,
+                sign0: sa,
+            };
+            *n += 1;
+        }
+        return true;
+    }
+    if depth == MAX_DEPTH {
+        return false;
+    }
+    let (l, r) = split(p);
+    isolate(&l, depth + 1, out, n) && isolate(&r, depth + 1, out, n)
+}
+
+/// The in-triangle or crossing test over a time interval: Some(true) contact at every
+/// root of f in it, Some(false) none, None unknown.
+type Static = fn(&[[f64; 3]; 4], &[[f64; 3]; 4], Iv) -> Option<bool>;
+
+#[inline(always)]
+fn moving(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t: Iv) -> [V3<Iv>; 4] {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|k| Iv::point(x0[i][k]).add(&t.mul(&Iv::diff(x1[i][k], x0[i][k]))))
+    })
+}
+
+fn vf_static(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t: Iv) -> Option<bool> {
+    let [p, a, b, c] = moving(x0, x1, t);
+    let face = ring::vf_face(&p, &a, &b, &c);
+    if face.d.iter().all(|d| d.pos()) {
+        Some(true) // strictly inside the (coplanar) triangle
+    } else if face.d.iter().any(|d| d.neg()) {
+        Some(false) // a barycentric coordinate < 0: outside the closed triangle
+    } else {
+        None
+    }
+}
+
+fn ee_static(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t: Iv) -> Option<bool> {
+    let [a0, a1, b0, b1] = moving(x0, x1, t);
+    let x = ring::ee_cross(&a0, &a1, &b0, &b1);
+    if x.cc.neg() && x.ee.neg() {
+        Some(true) // a proper crossing of the coplanar segments
+    } else if x.cc.pos() || x.ee.pos() {
+        Some(false) // one segment strictly on one side of the other's line
+    } else {
+        None
+    }
+}
+
+/// Stages 1 and 2 on the difference vectors.
+#[inline(always)]
+fn decide(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], d: &Diffs, t_max: f64, test: Static) -> Verdict {
+    let Some((b, e)) = bernstein(d) else {
+        return Verdict::Unknown;
+    };
+    if b.iter().all(|&x| x > e) || b.iter().all(|&x| x < -e) {
+        return Verdict::Miss;
+    }
+    roots_and_test(x0, x1, b, e, t_max, test)
+}
+
+#[inline(never)]
+fn roots_and_test(
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    b: [f64; 4],
+    e: f64,
+    t_max: f64,
+    test: Static,
+) -> Verdict {
+    let c = [
+        Iv::around(b[0], e),
+        Iv::around(b[1], e).div3(),
+        Iv::around(b[2], e).div3(),
+        Iv::around(b[3], e),
+    ];
+    let mut found = [RootIv {
+        s0: 0.0,
+        s1: 0.0,
+        sign0: 0,
+    }; 3];
+    let mut n = 0;
+    let whole = Piece {
+        s0: 0.0,
+        s1: 1.0,
+        c,
+    };
+    if !isolate(&whole, 0, &mut found, &mut n) {
+        return Verdict::Unknown;
+    }
+    for r in &found[..n] {
+        let (mut s0, mut s1) = (r.s0, r.s1);
+        if s0 >= t_max {
+            break;
+        }
+        if s1 > t_max {
+            match eval_at(&c, t_max).sign() {
+                0 => return Verdict::Unknown,
+                s if s == r.sign0 => break, // the root is beyond t_max
+                _ => s1 = t_max,
+            }
+        }
+        // Narrow the root while f's sign at the midpoint is certain. With small motions
+        // f is flat and its float error (~u m^3) hides the sign before 2^-40: the interval
+        // then stays wider, and a contact's time is narrowed exactly (`Refine`).
+        let mut narrow = true;
+        while s1 - s0 > ROOT_WIDTH {
+            let m = 0.5 * (s0 + s1);
+            match eval_at(&c, m).sign() {
+                0 => {
+                    narrow = false;
+                    break;
+                }
+                s if s == r.sign0 => s0 = m,
+                _ => s1 = m,
+            }
+        }
+        match test(x0, x1, Iv { lo: s0, hi: s1 }) {
+            Some(true) if narrow => return Verdict::Hit(s0),
+            Some(true) => return Verdict::Refine(s0, s1),
+            Some(false) => {}
+            None => return Verdict::Unknown,
+        }
+    }
+    Verdict::Miss
+}
+
+/// The vertex-face filter (stages 0-2).
+#[inline]
+pub(crate) fn vertex_face(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
+    if vf_boxes_apart(x0, x1, 0.0) {
+        return Verdict::Miss;
+    }
+    let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
+    decide(x0, x1, &[at(x0), at(x1)], t_max, vf_static)
+}
+
+/// The edge-edge filter (stages 0-2).
+#[inline]
+pub(crate) fn edge_edge(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
+    if ee_boxes_apart(x0, x1, 0.0) {
+        return Verdict::Miss;
+    }
+    let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
+    decide(x0, x1, &[at(x0), at(x1)], t_max, ee_static)
+}
+
+/// Depth of the time subdivision of [`far_apart`].
+const FAR_DEPTH: u32 = 5;
+
+/// For `min_distance = delta > 0`: true if the features are certainly farther apart than
+/// `delta` at every t in `[0, t_max]` (false: unknown). The step is cut into time pieces
+/// (bisection, up to 2^5 pieces where needed); on each, with the positions enclosed by
+/// intervals, one of these must hold for certain:
+/// - the features' boxes over the piece are more than delta apart on an axis;
+/// - the distance between the vertex and the triangle's plane (the two edges' lines)
+///   exceeds delta: `f^2 > delta^2 |n|^2` with `n` the triangle's normal (`u x v` for the
+///   edges), whose `|f| / |n|` is that distance. (Where `n = 0`, `f = 0` too, so the strict
+///   inequality cannot be certified there.) The distance to a plane or line bounds the
+///   distance to any part of it from below.
+pub(crate) fn far_apart(
+    vf: bool,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    t_max: f64,
+    delta: f64,
+) -> bool {
+    let dd = Iv::point(delta).mul(&Iv::point(delta));
+    let mut stack = [(0.0f64, 0.0f64, 0u32); FAR_DEPTH as usize + 2];
+    stack[0] = (0.0, t_max, 0);
+    let mut n = 1;
+    while n > 0 {
+        n -= 1;
+        let (lo, hi, depth) = stack[n];
+        let pts = moving(x0, x1, Iv { lo, hi });
+        if !piece_apart(vf, &pts, dd, delta) {
+            if depth == FAR_DEPTH {
+                return false;
+            }
+            let mid = 0.5 * (lo + hi); // any split point: the pieces cover [lo, hi]
+            stack[n] = (mid, hi, depth + 1);
+            stack[n + 1] = (lo, mid, depth + 1);
+            n += 2;
+        }
+    }
+    true
+}
+
+fn piece_apart(vf: bool, pts: &[V3<Iv>; 4], dd: Iv, delta: f64) -> bool {
+    let split = if vf { 1 } else { 2 };
+    let (first, second) = pts.split_at(split);
+    let boxed = |ps: &[V3<Iv>], k: usize| {
+        ps.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                (l.min(p[k].lo), h.max(p[k].hi))
+            })
+    };
+    for k in 0..3 {
+        let (l1, h1) = boxed(first, k);
+        let (l2, h2) = boxed(second, k);
+        if (l2 - h1).next_down() > delta || (l1 - h2).next_down() > delta {
+            return true;
+        }
+    }
+    let [p0, p1, p2, p3] = pts;
+    let (f, nrm) = if vf {
+        let face = ring::vf_face(p0, p1, p2, p3);
+        (face.f, face.n)
+    } else {
+        let u = ring::sub3(p1, p0);
+        let v = ring::sub3(p3, p2);
+        let nrm = ring::cross(&u, &v);
+        (ring::dot(&ring::sub3(p2, p0), &nrm), nrm)
+    };
+    f.mul(&f).sub(&dd.mul(&ring::dot(&nrm, &nrm))).pos()
+}
