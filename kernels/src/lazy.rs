@@ -1,4 +1,4 @@
-//! [`LazyTiles`]: one `f32` buffer whose *groups* (disjoint ranges, each a tile of
+//! [`LazyTiles`]: one buffer (of `f32`, or any plain `Copy` element) whose *groups* (disjoint ranges, each a tile of
 //! structure-of-arrays fields) are filled lazily, at most once per *epoch*, by whichever
 //! thread needs them first, and read by any number of threads afterwards.
 //!
@@ -28,9 +28,9 @@ const BUSY: u32 = u32::MAX;
 /// A state no epoch ever has: stale.
 const STALE: u32 = 0;
 
-/// A lazily filled `f32` buffer split into groups (see the module doc).
-pub struct LazyTiles {
-    data: Box<[UnsafeCell<f32>]>,
+/// A lazily filled buffer of `T` (`f32` by default) split into groups (see the module doc).
+pub struct LazyTiles<T = f32> {
+    data: Box<[UnsafeCell<T>]>,
     /// Group `g` owns entries `groups[g]`; disjoint, inside `0..len`.
     groups: Box<[(u32, u32)]>,
     state: Box<[AtomicU32]>,
@@ -43,9 +43,9 @@ pub struct LazyTiles {
 // `&mut self`; shared references to a group's data are handed out only after an acquire load
 // of the current epoch, and that data is not written again until `&mut self` advances the
 // epoch. Groups are disjoint (checked in `new`), so a claim never overlaps another's data.
-unsafe impl Sync for LazyTiles {}
+unsafe impl<T: Copy + Default + Send + Sync> Sync for LazyTiles<T> {}
 
-impl LazyTiles {
+impl<T: Copy + Default> LazyTiles<T> {
     /// A buffer of `len` zeros split into `groups` (disjoint ranges inside `0..len`; entries
     /// in no group are never filled lazily). Every group starts stale.
     ///
@@ -62,7 +62,7 @@ impl LazyTiles {
             "LazyTiles: a group ends past the buffer"
         );
         Self {
-            data: (0..len).map(|_| UnsafeCell::new(0.0)).collect(),
+            data: (0..len).map(|_| UnsafeCell::new(T::default())).collect(),
             groups: groups
                 .iter()
                 .map(|r| (r.start as u32, r.end as u32))
@@ -93,7 +93,7 @@ impl LazyTiles {
 
     /// Group `g`'s entries, or `None` if it is not current.
     #[inline]
-    pub fn get(&self, g: usize) -> Option<&[f32]> {
+    pub fn get(&self, g: usize) -> Option<&[T]> {
         self.is_current(g).then(|| self.read(g))
     }
 
@@ -104,7 +104,7 @@ impl LazyTiles {
     /// `fill` must not wait for another group or run work on a thread pool: a thread waiting
     /// for this group could be the one that has to run that work.
     #[inline]
-    pub fn get_or_fill(&self, g: usize, fill: impl FnOnce(&mut [f32])) -> (&[f32], bool) {
+    pub fn get_or_fill(&self, g: usize, fill: impl FnOnce(&mut [T])) -> (&[T], bool) {
         let state = &self.state[g];
         let mut seen = state.load(Ordering::Acquire);
         if seen == self.epoch {
@@ -119,8 +119,8 @@ impl LazyTiles {
         g: usize,
         state: &AtomicU32,
         seen: &mut u32,
-        fill: impl FnOnce(&mut [f32]),
-    ) -> (&[f32], bool) {
+        fill: impl FnOnce(&mut [T]),
+    ) -> (&[T], bool) {
         let mut spins = 0u32;
         loop {
             if *seen == self.epoch {
@@ -158,7 +158,7 @@ impl LazyTiles {
         // SAFETY: the claim gives this thread exclusive access to the group's entries: no
         // other thread writes them (a writer needs the claim) or reads them (readers need
         // the state to equal the epoch). Groups are disjoint, so the slice aliases nothing.
-        // `UnsafeCell<f32>` has the layout of `f32`.
+        // `UnsafeCell<T>` has the layout of `T`.
         let entries = unsafe {
             std::slice::from_raw_parts_mut(
                 UnsafeCell::raw_get(self.data.as_ptr().add(range.start)),
@@ -173,7 +173,7 @@ impl LazyTiles {
 
     /// The entries of a group known to be current.
     #[inline]
-    fn read(&self, g: usize) -> &[f32] {
+    fn read(&self, g: usize) -> &[T] {
         let range = self.range(g);
         // SAFETY: the caller observed (acquire) the group's state equal to the current
         // epoch, so its writer has published; nothing writes a current group before
@@ -200,10 +200,10 @@ impl LazyTiles {
 
     /// Exclusive access to the whole buffer (eager refits); mark what was filled with
     /// [`LazyTiles::set_current`].
-    pub fn data_mut(&mut self) -> &mut [f32] {
-        let cells: &mut [UnsafeCell<f32>] = &mut self.data;
-        // SAFETY: `&mut self` excludes every other access; `UnsafeCell<f32>` has the layout
-        // of `f32`.
+    pub fn data_mut(&mut self) -> &mut [T] {
+        let cells: &mut [UnsafeCell<T>] = &mut self.data;
+        // SAFETY: `&mut self` excludes every other access; `UnsafeCell<T>` has the layout
+        // of `T`.
         unsafe {
             std::slice::from_raw_parts_mut(UnsafeCell::raw_get(cells.as_mut_ptr()), cells.len())
         }
@@ -215,12 +215,14 @@ impl LazyTiles {
     }
 }
 
-impl Clone for LazyTiles {
+impl<T: Copy + Default> Clone for LazyTiles<T> {
     /// Copies the current groups; the others are stale in the copy (their entries may be
     /// mid-fill in another thread, so they are not read).
     fn clone(&self) -> Self {
         let mut copy = Self {
-            data: (0..self.len()).map(|_| UnsafeCell::new(0.0)).collect(),
+            data: (0..self.len())
+                .map(|_| UnsafeCell::new(T::default()))
+                .collect(),
             groups: self.groups.clone(),
             state: self.groups.iter().map(|_| AtomicU32::new(STALE)).collect(),
             epoch: self.epoch,
@@ -236,7 +238,7 @@ impl Clone for LazyTiles {
     }
 }
 
-impl std::fmt::Debug for LazyTiles {
+impl<T: Copy + Default> std::fmt::Debug for LazyTiles<T> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let current = (0..self.groups.len())
             .filter(|&g| self.is_current(g))
@@ -340,6 +342,6 @@ mod tests {
     #[test]
     #[should_panic(expected = "overlap")]
     fn overlapping_groups_are_refused() {
-        LazyTiles::new(10, vec![0..5, 4..6]);
+        LazyTiles::<f32>::new(10, vec![0..5, 4..6]);
     }
 }

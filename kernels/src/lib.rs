@@ -167,6 +167,32 @@ pub(crate) mod lanes {
         }
     }
 
+    /// [`mask_bits`] for a 64-bit comparison mask (lane `k` -> bit `k`), for the same three
+    /// mask layouts.
+    #[inline(always)]
+    pub fn mask_bits_f64<S: Simd>(_simd: S, m: S::m64s) -> u32 {
+        use core::mem::size_of;
+        if size_of::<S::m64s>() == size_of::<S::u64s>() && S::F64_LANES > 1 {
+            let v: S::u64s = bytemuck::cast(m);
+            let lanes: &[u64] = bytemuck::cast_slice(core::slice::from_ref(&v));
+            let mut bits = 0;
+            for (k, &x) in lanes.iter().enumerate() {
+                bits |= ((x >> 63) as u32) << k;
+            }
+            bits
+        } else if size_of::<S::m64s>() == 1 {
+            let v: u8 = bytemuck::cast(m);
+            u32::from(v)
+        } else if size_of::<S::m64s>() == 2 {
+            let v: u16 = bytemuck::cast(m);
+            u32::from(v)
+        } else {
+            let v: S::u64s = bytemuck::cast(m);
+            let lanes: &[u64] = bytemuck::cast_slice(core::slice::from_ref(&v));
+            u32::from(lanes[0] & 1 != 0)
+        }
+    }
+
     /// `simd` as pulp's x86-v3 token when that is its type.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]

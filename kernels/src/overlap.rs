@@ -14,7 +14,7 @@
 //! are bit-identical to the `*_scalar` references on every backend. NaN policy: a NaN in the
 //! probe or an entry makes the pair not overlap, on every backend.
 
-use crate::lanes::{load_prefix, mask_bits};
+use crate::lanes::{load_prefix, mask_bits, mask_bits_f64};
 use crate::Tile;
 use pulp::{Simd, WithSimd};
 
@@ -410,4 +410,252 @@ pub fn boxes_meet_with<S: Simd>(
         base = end;
     }
     bits
+}
+
+// ---------------------------------------------------------------------------------------
+// moving spheres (swept bounds over a step)
+
+/// A sphere moving over a step: centre `c0 + t (c1 - c0)`, radius `(1 - t) r0 + t r1`,
+/// `t` in `[0, 1]`. It bounds a region over the whole step when both end spheres bound the
+/// region at their end and the region's points and the centre move linearly (the triangle
+/// inequality on `(1 - t)(v0 - c0) + t (v1 - c1)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MovingSphere {
+    pub c0: [f64; 3],
+    pub r0: f64,
+    pub c1: [f64; 3],
+    pub r1: f64,
+}
+
+/// Fields of a [`MovingSphereSoa`]: `c0` x, y, z, `r0`, `c1` x, y, z, `r1`.
+pub const MOVING_SPHERE_FIELDS: usize = 8;
+
+/// Moving spheres in structure-of-arrays form: eight `f64` fields of `stride` entries each,
+/// side by side ([`MOVING_SPHERE_FIELDS`]).
+#[derive(Clone, Copy, Debug)]
+pub struct MovingSphereSoa<'a> {
+    data: &'a [f64],
+    stride: usize,
+}
+
+impl<'a> MovingSphereSoa<'a> {
+    /// Panics unless `data` holds eight fields of `stride` entries.
+    #[inline]
+    pub fn new(data: &'a [f64], stride: usize) -> Self {
+        assert_eq!(
+            data.len(),
+            MOVING_SPHERE_FIELDS * stride,
+            "MovingSphereSoa: c0 xyz, r0, c1 xyz, r1"
+        );
+        Self { data, stride }
+    }
+
+    /// Field `f` of every entry.
+    #[inline(always)]
+    pub fn field(&self, f: usize) -> &'a [f64] {
+        &self.data[f * self.stride..(f + 1) * self.stride]
+    }
+
+    /// Entries per field.
+    #[inline(always)]
+    pub fn len(&self) -> usize {
+        self.stride
+    }
+
+    #[inline(always)]
+    pub fn is_empty(&self) -> bool {
+        self.stride == 0
+    }
+
+    /// Entry `k`.
+    #[inline(always)]
+    pub fn get(&self, k: usize) -> MovingSphere {
+        let f = |i: usize| self.field(i)[k];
+        MovingSphere {
+            c0: [f(0), f(1), f(2)],
+            r0: f(3),
+            c1: [f(4), f(5), f(6)],
+            r1: f(7),
+        }
+    }
+}
+
+/// The relative error bound of the quadratic's coefficients: `2^-44 M^2` (their rounding is
+/// below `2^-46 M^2`, `M` the largest magnitude of the centre differences and radius sums).
+const MOVING_K2: f64 = 1.0 / (1u64 << 44) as f64;
+/// The error bound of `A C - B^2`: `2^-36 M^4` (below `2^-39 M^4`).
+const MOVING_K4: f64 = 1.0 / (1u64 << 36) as f64;
+/// An absolute term for underflow: far above any underflowing rounding (`2^-1075` each,
+/// times magnitudes below `2^130`).
+const MOVING_TINY: f64 = f64::from_bits((1023 - 900) << 52);
+
+/// Whether two moving spheres meet at some `t` in `[0, 1]`, conservatively: always when they
+/// do, and when they come within rounding of doing so. With `D(t) = D0 + t E` the centres'
+/// difference and `R(t) = R0 + t F` the radii's sum, they meet iff `h(t) = |D|^2 - R^2 <= 0`
+/// somewhere: `h(0) = C <= 0`, `h(1) <= 0`, or the minimum of the quadratic
+/// `h = A t^2 + 2 B t + C` is interior (`A > 0`, `-A < B < 0`) and `A C - B^2 <= 0`
+/// (`C - |B| <= 0` is implied, and tested too: it stops near-still pairs that are apart).
+/// Evaluated in `f64` (centres and radii are `f32` values, exact in `f64`), every comparison
+/// widened by its rounding bound (`MOVING_K2`, `MOVING_K4`). A NaN makes the pair not meet.
+/// In the operation order of [`moving_sphere_block_with`].
+#[inline(always)]
+pub fn moving_spheres_meet(a: &MovingSphere, b: &MovingSphere) -> bool {
+    let d0 = [a.c0[0] - b.c0[0], a.c0[1] - b.c0[1], a.c0[2] - b.c0[2]];
+    let d1 = [a.c1[0] - b.c1[0], a.c1[1] - b.c1[1], a.c1[2] - b.c1[2]];
+    let e = [d1[0] - d0[0], d1[1] - d0[1], d1[2] - d0[2]];
+    let (r0, r1) = (a.r0 + b.r0, a.r1 + b.r1);
+    let f = r1 - r0;
+    let dot = |x: [f64; 3], y: [f64; 3]| (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2];
+    let c = dot(d0, d0) - r0 * r0;
+    let h1 = dot(d1, d1) - r1 * r1;
+    let aa = dot(e, e) - f * f;
+    let bb = dot(d0, e) - r0 * f;
+    let abs = |x: f64| if x < 0.0 { 0.0 - x } else { x };
+    let mut m = r0;
+    for x in [d0[0], d0[1], d0[2], d1[0], d1[1], d1[2], r1] {
+        let x = abs(x);
+        m = if x > m { x } else { m };
+    }
+    let m2 = m * m;
+    let s2 = MOVING_K2 * m2 + MOVING_TINY;
+    let s4 = MOVING_K4 * (m2 * m2) + MOVING_TINY;
+    let two_s2 = s2 + s2;
+    let interior = aa > 0.0 - s2
+        && bb < s2
+        && bb > (0.0 - aa) - two_s2
+        && c - abs(bb) <= two_s2
+        && aa * c - bb * bb <= s4;
+    c <= s2 || h1 <= s2 || interior
+}
+
+/// Scalar reference of [`moving_sphere_block_with`].
+pub fn moving_sphere_block_scalar(p: &MovingSphere, b: MovingSphereSoa, n: usize) -> u32 {
+    block_len(b.len(), n);
+    let mut bits = 0;
+    for k in 0..n {
+        bits |= u32::from(moving_spheres_meet(p, &b.get(k))) << k;
+    }
+    bits
+}
+
+/// The moving sphere `p` against the first `n` entries of the block `b` (at most
+/// [`MAX_BLOCK`]): bit `k` set iff they meet during the step ([`moving_spheres_meet`], the
+/// same bits on every backend).
+#[inline(always)]
+pub fn moving_sphere_block_with<S: Simd>(
+    simd: S,
+    p: &MovingSphere,
+    b: MovingSphereSoa,
+    n: usize,
+) -> u32 {
+    let len = block_len(b.len(), n);
+    // No closures in SIMD bodies (see `aabb_block_with`).
+    let pc0 = [
+        simd.splat_f64s(p.c0[0]),
+        simd.splat_f64s(p.c0[1]),
+        simd.splat_f64s(p.c0[2]),
+    ];
+    let pc1 = [
+        simd.splat_f64s(p.c1[0]),
+        simd.splat_f64s(p.c1[1]),
+        simd.splat_f64s(p.c1[2]),
+    ];
+    let (pr0, pr1) = (simd.splat_f64s(p.r0), simd.splat_f64s(p.r1));
+    let zero = simd.splat_f64s(0.0);
+    let k2 = simd.splat_f64s(MOVING_K2);
+    let k4 = simd.splat_f64s(MOVING_K4);
+    let tiny = simd.splat_f64s(MOVING_TINY);
+    let mut bits = 0u32;
+    let mut base = 0;
+    while base < n {
+        let end = (base + S::F64_LANES).min(len);
+        let d0 = [
+            simd.sub_f64s(pc0[0], load_field(simd, &b, 0, base, end)),
+            simd.sub_f64s(pc0[1], load_field(simd, &b, 1, base, end)),
+            simd.sub_f64s(pc0[2], load_field(simd, &b, 2, base, end)),
+        ];
+        let d1 = [
+            simd.sub_f64s(pc1[0], load_field(simd, &b, 4, base, end)),
+            simd.sub_f64s(pc1[1], load_field(simd, &b, 5, base, end)),
+            simd.sub_f64s(pc1[2], load_field(simd, &b, 6, base, end)),
+        ];
+        let e = [
+            simd.sub_f64s(d1[0], d0[0]),
+            simd.sub_f64s(d1[1], d0[1]),
+            simd.sub_f64s(d1[2], d0[2]),
+        ];
+        let r0 = simd.add_f64s(pr0, load_field(simd, &b, 3, base, end));
+        let r1 = simd.add_f64s(pr1, load_field(simd, &b, 7, base, end));
+        let f = simd.sub_f64s(r1, r0);
+        let c = simd.sub_f64s(dot3_f64(simd, &d0, &d0), simd.mul_f64s(r0, r0));
+        let h1 = simd.sub_f64s(dot3_f64(simd, &d1, &d1), simd.mul_f64s(r1, r1));
+        let aa = simd.sub_f64s(dot3_f64(simd, &e, &e), simd.mul_f64s(f, f));
+        let bb = simd.sub_f64s(dot3_f64(simd, &d0, &e), simd.mul_f64s(r0, f));
+        let mut m = r0;
+        for x in [d0[0], d0[1], d0[2], d1[0], d1[1], d1[2], r1] {
+            let x = abs_f64(simd, x, zero);
+            m = simd.select_f64s(simd.greater_than_f64s(x, m), x, m);
+        }
+        let m2 = simd.mul_f64s(m, m);
+        let s2 = simd.add_f64s(simd.mul_f64s(k2, m2), tiny);
+        let s4 = simd.add_f64s(simd.mul_f64s(k4, simd.mul_f64s(m2, m2)), tiny);
+        let two_s2 = simd.add_f64s(s2, s2);
+        let mut interior = simd.greater_than_f64s(aa, simd.sub_f64s(zero, s2));
+        interior = simd.and_m64s(interior, simd.less_than_f64s(bb, s2));
+        interior = simd.and_m64s(
+            interior,
+            simd.greater_than_f64s(bb, simd.sub_f64s(simd.sub_f64s(zero, aa), two_s2)),
+        );
+        interior = simd.and_m64s(
+            interior,
+            simd.less_than_or_equal_f64s(simd.sub_f64s(c, abs_f64(simd, bb, zero)), two_s2),
+        );
+        interior = simd.and_m64s(
+            interior,
+            simd.less_than_or_equal_f64s(
+                simd.sub_f64s(simd.mul_f64s(aa, c), simd.mul_f64s(bb, bb)),
+                s4,
+            ),
+        );
+        let hit = simd.or_m64s(
+            simd.or_m64s(
+                simd.less_than_or_equal_f64s(c, s2),
+                simd.less_than_or_equal_f64s(h1, s2),
+            ),
+            interior,
+        );
+        bits |= (mask_bits_f64(simd, hit) & low_bits(n - base)) << base;
+        base = end;
+    }
+    bits
+}
+
+/// Entries `base..end` of field `f` of `b`.
+#[inline(always)]
+fn load_field<S: Simd>(simd: S, b: &MovingSphereSoa, f: usize, base: usize, end: usize) -> S::f64s {
+    load_prefix_f64(simd, &b.field(f)[base..end])
+}
+
+/// `(x0 y0 + x1 y1) + x2 y2`, lane-wise.
+#[inline(always)]
+fn dot3_f64<S: Simd>(simd: S, x: &[S::f64s; 3], y: &[S::f64s; 3]) -> S::f64s {
+    simd.add_f64s(
+        simd.add_f64s(simd.mul_f64s(x[0], y[0]), simd.mul_f64s(x[1], y[1])),
+        simd.mul_f64s(x[2], y[2]),
+    )
+}
+
+/// `|x|` as a select (`x < 0 ? 0 - x : x`; NaN stays NaN), the scalar reference's form.
+#[inline(always)]
+fn abs_f64<S: Simd>(simd: S, x: S::f64s, zero: S::f64s) -> S::f64s {
+    simd.select_f64s(simd.less_than_f64s(x, zero), simd.sub_f64s(zero, x), x)
+}
+
+/// Loads `v` (at most `S::F64_LANES` values; missing lanes are zero).
+#[inline(always)]
+fn load_prefix_f64<S: Simd>(simd: S, v: &[f64]) -> S::f64s {
+    if v.len() == S::F64_LANES {
+        return S::as_simd_f64s(v).0[0];
+    }
+    simd.partial_load_f64s(v)
 }

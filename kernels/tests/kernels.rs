@@ -1316,3 +1316,120 @@ fn lane_references_agree_with_sequential_on_exact_data() {
         );
     }
 }
+
+fn moving(rng: &mut Rng, scale: f32) -> overlap::MovingSphere {
+    let v = |rng: &mut Rng| f64::from(rng.f32_in(-1.0, 1.0) * scale);
+    overlap::MovingSphere {
+        c0: [v(rng), v(rng), v(rng)],
+        r0: f64::from(rng.f32_in(0.0, 0.3) * scale),
+        c1: [v(rng), v(rng), v(rng)],
+        r1: f64::from(rng.f32_in(0.0, 0.3) * scale),
+    }
+}
+
+fn moving_soa(spheres: &[overlap::MovingSphere], stride: usize) -> Vec<f64> {
+    let mut data = vec![f64::NAN; overlap::MOVING_SPHERE_FIELDS * stride];
+    for (k, s) in spheres.iter().enumerate() {
+        let f = [
+            s.c0[0], s.c0[1], s.c0[2], s.r0, s.c1[0], s.c1[1], s.c1[2], s.r1,
+        ];
+        for (i, x) in f.into_iter().enumerate() {
+            data[i * stride + k] = x;
+        }
+    }
+    data
+}
+
+/// The moving-sphere block test: the scalar reference's bits on every backend (padding of
+/// NaN lanes, every block size up to 32, tiny and huge scales).
+fn check_moving_blocks<S: Simd>(simd: S) {
+    let mut rng = Rng::new(21);
+    for scale in [1.0, 1e-20, 1e20, 3e-3] {
+        for n in block_sizes(S::F32_LANES, overlap::MAX_BLOCK) {
+            for len in [n, (n + 3).min(overlap::MAX_BLOCK)] {
+                let entries: Vec<_> = (0..n).map(|_| moving(&mut rng, scale)).collect();
+                let data = moving_soa(&entries, len);
+                let block = overlap::MovingSphereSoa::new(&data, len);
+                let p = moving(&mut rng, scale);
+                let want = overlap::moving_sphere_block_scalar(&p, block, n);
+                let got = overlap::moving_sphere_block_with(simd, &p, block, n);
+                assert_eq!(got, want, "{simd:?} n={n} len={len} scale={scale}");
+                assert_eq!(u64::from(got) >> n, 0, "bits past n");
+            }
+        }
+    }
+}
+
+#[test]
+fn moving_blocks_match_reference_on_all_backends() {
+    on_all_backends!(check_moving_blocks);
+}
+
+/// Conservative: whenever the spheres meet at a sampled time (by an `f64` margin), the test
+/// says so; and the cases a swept test must tell apart are told apart.
+#[test]
+fn moving_spheres_meet_whenever_they_do() {
+    let meet_at = |a: &overlap::MovingSphere, b: &overlap::MovingSphere, t: f64| {
+        let c = |x: [f64; 3], y: [f64; 3]| {
+            std::array::from_fn::<f64, 3, _>(|k| x[k] + t * (y[k] - x[k]))
+        };
+        let (ca, cb) = (c(a.c0, a.c1), c(b.c0, b.c1));
+        let d = ((0..3).map(|k| (ca[k] - cb[k]).powi(2)).sum::<f64>()).sqrt();
+        let r = (1.0 - t) * (a.r0 + b.r0) + t * (a.r1 + b.r1);
+        d <= r * (1.0 - 1e-9)
+    };
+    let mut rng = Rng::new(5);
+    let mut met = 0;
+    for _ in 0..200_000 {
+        let (a, b) = (moving(&mut rng, 1.0), moving(&mut rng, 1.0));
+        let sampled = (0..=64).any(|i| meet_at(&a, &b, i as f64 / 64.0));
+        if sampled {
+            met += 1;
+            assert!(overlap::moving_spheres_meet(&a, &b), "{a:?} {b:?}");
+        }
+    }
+    assert!(met > 1000);
+    let still = |c: [f64; 3], r: f64| overlap::MovingSphere {
+        c0: c,
+        r0: r,
+        c1: c,
+        r1: r,
+    };
+    // Still and apart: culled (the near-still guard); still and touching: kept.
+    assert!(!overlap::moving_spheres_meet(
+        &still([0.0; 3], 1.0),
+        &still([3.0, 0.0, 0.0], 1.0)
+    ));
+    assert!(overlap::moving_spheres_meet(
+        &still([0.0; 3], 1.0),
+        &still([2.0, 0.0, 0.0], 1.0)
+    ));
+    // Passing through each other mid-step (apart at both ends): kept.
+    let across = overlap::MovingSphere {
+        c0: [-5.0, 0.0, 0.0],
+        r0: 1.0,
+        c1: [5.0, 0.0, 0.0],
+        r1: 1.0,
+    };
+    assert!(overlap::moving_spheres_meet(
+        &across,
+        &still([0.0, 0.5, 0.0], 0.5)
+    ));
+    // Crossing the same point at different times (each first, then the other): culled.
+    let other = overlap::MovingSphere {
+        c0: [0.0, 5.0, 0.0],
+        r0: 0.4,
+        c1: [0.0, -15.0, 0.0],
+        r1: 0.4,
+    };
+    let fast = overlap::MovingSphere {
+        c0: [-10.0, 0.0, 0.0],
+        r0: 0.4,
+        c1: [10.0, 0.0, 0.0],
+        r1: 0.4,
+    };
+    assert!(!overlap::moving_spheres_meet(&fast, &other));
+    // NaN never meets.
+    let nan = still([f64::NAN, 0.0, 0.0], 1.0);
+    assert!(!overlap::moving_spheres_meet(&nan, &still([0.0; 3], 1.0)));
+}
