@@ -5,6 +5,7 @@
 use std::ffi::CStr;
 use std::ptr::{null, null_mut};
 
+use dhcd::distance::{EdgeEdge, PointTriangle};
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
 use dhcd::shapes::{icosphere, translated, wave};
 use dhcd::{Mesh, Method};
@@ -760,6 +761,17 @@ fn header_is_generated() {
     for m in Method::ALL {
         let name = m.name().to_uppercase();
         kinds += &format!("\n#define DHCD_METHOD_{name} {}", m.code());
+    }
+    // The distance types' numbers, from the library's enums (IPC's names and numbers).
+    kinds += "\n\n/**\n * Point-triangle distance types (`vf_type`, `fv_type` of proximity results):\n * \
+              IPC's PointTriangleDistanceType.\n */";
+    for t in PointTriangle::ALL {
+        kinds += &format!("\n#define DHCD_PT_{} {}", t.ipc_name(), t as u8);
+    }
+    kinds += "\n\n/**\n * Edge-edge distance types (`ee_type` of proximity results): IPC's\n * \
+              EdgeEdgeDistanceType.\n */";
+    for t in EdgeEdge::ALL {
+        kinds += &format!("\n#define DHCD_EE_{} {}", t.ipc_name(), t as u8);
     }
     config.after_includes = Some(kinds);
     let mut generated = Vec::new();
