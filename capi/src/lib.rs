@@ -444,7 +444,11 @@ fn proximity_out(p: Proximity) -> DhcdProximity {
         fv_distance_sq: c_array(fv.iter().map(|x| x.distance_sq).collect()),
         fv_type: c_array(fv.iter().map(|x| x.kind as u8).collect()),
         fv_count: fv.len(),
-        edge_edge: c_pairs(ee.iter().map(|x| [x.a[0], x.a[1], x.b[0], x.b[1]]).collect()),
+        edge_edge: c_pairs(
+            ee.iter()
+                .map(|x| [x.a[0], x.a[1], x.b[0], x.b[1]])
+                .collect(),
+        ),
         ee_distance_sq: c_array(ee.iter().map(|x| x.distance_sq).collect()),
         ee_type: c_array(ee.iter().map(|x| x.kind as u8).collect()),
         ee_count: ee.len(),
@@ -477,10 +481,18 @@ fn scene_proximity_out(p: SceneProximity) -> DhcdSceneProximity {
         let (a, b, q) = (pair.a.0, pair.b.0, &pair.proximity);
         let i = u64::from;
         vf.0.extend(q.vertex_face.iter().map(|x| {
-            ([a, i(x.vertex), b, i(x.triangle)], x.distance_sq, x.kind as u8)
+            (
+                [a, i(x.vertex), b, i(x.triangle)],
+                x.distance_sq,
+                x.kind as u8,
+            )
         }));
         fv.0.extend(q.face_vertex.iter().map(|x| {
-            ([a, i(x.triangle), b, i(x.vertex)], x.distance_sq, x.kind as u8)
+            (
+                [a, i(x.triangle), b, i(x.vertex)],
+                x.distance_sq,
+                x.kind as u8,
+            )
         }));
         ee.0.extend(q.edge_edge.iter().map(|x| {
             let row = [a, i(x.a[0]), i(x.a[1]), b, i(x.b[0]), i(x.b[1])];
@@ -898,8 +910,7 @@ pub unsafe extern "C" fn dhcd_proximity(
         if a == b && !a.is_null() {
             return Err(Fail(
                 DHCD_ERR_INVALID_ARGUMENT,
-                "dhcd_proximity needs two different hierarchies (use dhcd_self_proximity)"
-                    .into(),
+                "dhcd_proximity needs two different hierarchies (use dhcd_self_proximity)".into(),
             ));
         }
         // SAFETY: live, distinct handles (checked above), so the two `&mut` do not alias.
@@ -1128,12 +1139,7 @@ pub unsafe extern "C" fn dhcd_scene_update_positions_f64(
 ) -> c_int {
     guard(|| {
         // SAFETY: caller's contract.
-        let (s, p) = unsafe {
-            (
-                handle(s, "scene")?,
-                positions_f64(positions, vertex_count)?,
-            )
-        };
+        let (s, p) = unsafe { (handle(s, "scene")?, positions_f64(positions, vertex_count)?) };
         Ok(s.scene.update_positions_f64(ObjectId(id), p)?)
     })
 }
