@@ -763,6 +763,9 @@ impl Scene {
 /// One object's new positions.
 type Update<'a> = (ObjectId, Positions<'a>);
 
+/// One object's new `f32` positions, as the library's batch calls take them.
+type Update32<'a> = (ObjectId, &'a [[f32; 3]]);
+
 /// The entries of [`Scene::updates`] as positions.
 fn as_updates<'a>(entries: &'a [(ObjectId, Vertices<'_>)]) -> PyResult<Vec<Update<'a>>> {
     entries
@@ -779,7 +782,7 @@ fn update_many(scene: &mut dhcd::Scene, updates: &[Update<'_>], par: Par) -> dhc
     if let Some(f32s) = as_f32(updates) {
         return scene.update_many(&f32s, par);
     }
-    let f32s: Vec<(ObjectId, &[[f32; 3]])> = updates
+    let f32s: Vec<Update32<'_>> = updates
         .iter()
         .filter_map(|&(id, p)| match p {
             Positions::F32(p) => Some((id, p)),
@@ -809,7 +812,7 @@ fn update_many(scene: &mut dhcd::Scene, updates: &[Update<'_>], par: Par) -> dhc
 }
 
 /// The entries as the library's batch calls take them, if all are `f32`.
-fn as_f32<'a>(updates: &[Update<'a>]) -> Option<Vec<(ObjectId, &'a [[f32; 3]])>> {
+fn as_f32<'a>(updates: &[Update<'a>]) -> Option<Vec<Update32<'a>>> {
     updates
         .iter()
         .map(|&(id, p)| match p {
