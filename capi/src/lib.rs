@@ -16,7 +16,10 @@
 //!
 //! - a function with a handle or result output (`*out`) empties it first (NULL handle,
 //!   empty result), so it is empty after any error; scalar outputs (`dhcd_hierarchy_method`,
-//!   `dhcd_scene_add`'s id, `dhcd_contact_segments`' segments) are written only on success.
+//!   `dhcd_hierarchy_precision`, `dhcd_scene_add`'s id, `dhcd_contact_segments`' segments)
+//!   are written only on success;
+//! - `*_f64` calls take `double` positions and make or update `f64` hierarchies and objects
+//!   (exact for the doubles); positions of the other precision are `DHCD_ERR_PRECISION`.
 //!
 //! `threads` arguments: `1` runs on the calling thread, `0` on rayon's global pool (all
 //! cores), `n` on a pool of `n` threads but never more than the machine's cores; above
