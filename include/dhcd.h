@@ -8,9 +8,10 @@
  * Conventions:
  *  - fallible functions return DHCD_OK (0) or a negative DHCD_ERR_* code; then
  *    dhcd_last_error_message() describes the failure (per thread);
- *  - arrays are flat: positions are x,y,z per vertex (3 * vertex_count floats),
- *    triangles are 3 vertex indices each (3 * triangle_count uint32_t);
- *  - triangle indices in results are the caller's original indices;
+ *  - arrays are flat: positions are x,y,z per vertex (3 * vertex_count floats, or
+ *    doubles for the *_f64 calls), triangles are 3 vertex indices each
+ *    (3 * triangle_count uint32_t);
+ *  - vertex and triangle indices in results are the caller's original indices;
  *  - `threads`: 1 = calling thread, 0 = all cores, n = a pool of n threads, never
  *    more than the machine's cores; above 1024 is DHCD_ERR_INVALID_ARGUMENT (results
  *    never depend on it);
@@ -36,6 +37,32 @@
 #define DHCD_METHOD_AABB 2
 
 /**
+ * Point-triangle distance types (`vf_type`, `fv_type` of proximity results):
+ * IPC's PointTriangleDistanceType.
+ */
+#define DHCD_PT_P_T0 0
+#define DHCD_PT_P_T1 1
+#define DHCD_PT_P_T2 2
+#define DHCD_PT_P_E0 3
+#define DHCD_PT_P_E1 4
+#define DHCD_PT_P_E2 5
+#define DHCD_PT_P_T 6
+
+/**
+ * Edge-edge distance types (`ee_type` of proximity results): IPC's
+ * EdgeEdgeDistanceType.
+ */
+#define DHCD_EE_EA0_EB0 0
+#define DHCD_EE_EA0_EB1 1
+#define DHCD_EE_EA1_EB0 2
+#define DHCD_EE_EA1_EB1 3
+#define DHCD_EE_EA_EB0 4
+#define DHCD_EE_EA_EB1 5
+#define DHCD_EE_EA0_EB 6
+#define DHCD_EE_EA1_EB 7
+#define DHCD_EE_EA_EB 8
+
+/**
  * Success.
  */
 #define DHCD_OK 0
@@ -47,13 +74,15 @@
 
 /**
  * A bad argument: unknown method, levels out of range, misaligned or oversized array,
- * the same hierarchy passed twice to `dhcd_collide`, a thread count above 1024.
+ * the same hierarchy passed twice to `dhcd_collide` or `dhcd_proximity`, a thread count
+ * above 1024, a proximity distance that is negative, NaN or infinite.
  */
 #define DHCD_ERR_INVALID_ARGUMENT -2
 
 /**
  * The mesh is invalid: no vertices or triangles, an index out of range, a repeated index
- * in a triangle, a non-finite coordinate.
+ * in a triangle, a non-finite coordinate, a `double` coordinate beyond the `float` range
+ * (about 3.4e38: bounding volumes are `float`).
  */
 #define DHCD_ERR_INVALID_MESH -3
 
@@ -88,6 +117,23 @@
 #define DHCD_ERR_REPEATED_OBJECT -9
 
 /**
+ * Positions of the other precision: `float` positions for an `f64` hierarchy or object
+ * (built by `dhcd_hierarchy_new_f64` / `dhcd_scene_add_f64`), or `double` positions for an
+ * `f32` one.
+ */
+#define DHCD_ERR_PRECISION -10
+
+/**
+ * `dhcd_hierarchy_precision` of a hierarchy built from `float` positions.
+ */
+#define DHCD_PRECISION_F32 32
+
+/**
+ * `dhcd_hierarchy_precision` of a hierarchy built from `double` positions.
+ */
+#define DHCD_PRECISION_F64 64
+
+/**
  * Opaque: one object's hierarchy (and its query scratch).
  */
 typedef struct DhcdHierarchy DhcdHierarchy;
@@ -118,6 +164,39 @@ typedef struct DhcdContacts {
 } DhcdContacts;
 
 /**
+ * Feature pairs within a distance, from `dhcd_proximity` / `dhcd_self_proximity` (release
+ * with `dhcd_proximity_free`). Three lists, each of `*_count` rows, sorted by its index
+ * rows; every row has its squared distance (`*_distance_sq[k]`) and the type of its closest
+ * sub-features (`*_type[k]`: a `DHCD_PT_*` for vertex-face and face-vertex rows, a
+ * `DHCD_EE_*` for edge-edge rows, IPC's distance types). Indices are original vertex and
+ * triangle indices; every array is null when its count is 0.
+ * - `vertex_face`: `[vertex, triangle]` at `vertex_face[2k..2k+2]`: a vertex of `a` and a
+ *   triangle of `b` (self: a vertex and a triangle not containing it);
+ * - `face_vertex`: `[triangle of a, vertex of b]` (pair queries only; empty for self);
+ * - `edge_edge`: `[a0, a1, b0, b1]` at `edge_edge[4k..4k+4]`, an edge of `a` and one of
+ *   `b` (self: two edges sharing no vertex, `(a0, a1) < (b0, b1)`), each as its two
+ *   vertices, smaller first (`DHCD_EE_EA0_*` names `a0`).
+ *
+ * `counters.prim_tests` counts the feature pairs given to the exact test,
+ * `counters.contacts` the rows of the three lists.
+ */
+typedef struct DhcdProximity {
+  uint32_t *vertex_face;
+  double *vf_distance_sq;
+  uint8_t *vf_type;
+  size_t vf_count;
+  uint32_t *face_vertex;
+  double *fv_distance_sq;
+  uint8_t *fv_type;
+  size_t fv_count;
+  uint32_t *edge_edge;
+  double *ee_distance_sq;
+  uint8_t *ee_type;
+  size_t ee_count;
+  struct DhcdCounters counters;
+} DhcdProximity;
+
+/**
  * Contacts of `dhcd_scene_contacts`: `count` quadruples `[object_a, tri_a, object_b,
  * tri_b]` at `pairs[4k..4k+4]`, sorted. `pairs` is null when `count == 0`.
  */
@@ -126,6 +205,33 @@ typedef struct DhcdSceneContacts {
   size_t count;
   struct DhcdCounters counters;
 } DhcdSceneContacts;
+
+/**
+ * Feature pairs within a distance in a scene, from `dhcd_scene_proximity` (release with
+ * `dhcd_scene_proximity_free`): every object pair's results (`object_a < object_b`) and
+ * every self-collision object's own (`object_a == object_b`), flattened with object ids,
+ * each list sorted by its rows; distances and types as in `DhcdProximity`:
+ * - `vertex_face`: `[object_a, vertex, object_b, triangle]` at `vertex_face[4k..4k+4]`;
+ * - `face_vertex`: `[object_a, triangle, object_b, vertex]` (between two objects only);
+ * - `edge_edge`: `[object_a, a0, a1, object_b, b0, b1]` at `edge_edge[6k..6k+6]`.
+ *
+ * `counters` are the totals over the object pairs.
+ */
+typedef struct DhcdSceneProximity {
+  uint64_t *vertex_face;
+  double *vf_distance_sq;
+  uint8_t *vf_type;
+  size_t vf_count;
+  uint64_t *face_vertex;
+  double *fv_distance_sq;
+  uint8_t *fv_type;
+  size_t fv_count;
+  uint64_t *edge_edge;
+  double *ee_distance_sq;
+  uint8_t *ee_type;
+  size_t ee_count;
+  struct DhcdCounters counters;
+} DhcdSceneProximity;
 
 #ifdef __cplusplus
 extern "C" {
@@ -157,6 +263,24 @@ int dhcd_hierarchy_new(int method,
                        struct DhcdHierarchy **out);
 
 /**
+ * `dhcd_hierarchy_new` for `double` positions (`3 * vertex_count` doubles): an `f64`
+ * hierarchy, whose answers (contacts, proximity) are exact for the `double` coordinates as
+ * given. Bounding volumes stay `float` records rounded outward, so every coordinate must
+ * round to a finite `float` (magnitude below about 3.4e38; else `DHCD_ERR_INVALID_MESH`).
+ * It takes only `double` updates (`dhcd_hierarchy_update_positions_f64`).
+ *
+ * # Safety
+ * As `dhcd_hierarchy_new`, with `positions` holding `3 * vertex_count` doubles.
+ */
+int dhcd_hierarchy_new_f64(int method,
+                           uint32_t levels,
+                           const double *positions,
+                           size_t vertex_count,
+                           const uint32_t *triangles,
+                           size_t triangle_count,
+                           struct DhcdHierarchy **out);
+
+/**
  * Releases a hierarchy. Null is allowed (no-op).
  *
  * # Safety
@@ -174,7 +298,9 @@ int dhcd_hierarchy_method(const struct DhcdHierarchy *h, int *out);
 
 /**
  * New positions of the mesh (`3 * vertex_count` floats, the mesh's vertex order and
- * count). On error the hierarchy is unchanged.
+ * count). An `f64` hierarchy refuses them (`DHCD_ERR_PRECISION`: rounding its positions
+ * would change its answers; see `dhcd_hierarchy_update_positions_f64`). On error the
+ * hierarchy is unchanged.
  *
  * # Safety
  * `h` null or a live handle; `positions` holds `3 * vertex_count` floats.
@@ -182,6 +308,27 @@ int dhcd_hierarchy_method(const struct DhcdHierarchy *h, int *out);
 int dhcd_hierarchy_update_positions(struct DhcdHierarchy *h,
                                     const float *positions,
                                     size_t vertex_count);
+
+/**
+ * New `double` positions of an `f64` hierarchy (`3 * vertex_count` doubles; see
+ * `dhcd_hierarchy_new_f64`). An `f32` hierarchy refuses them (`DHCD_ERR_PRECISION`), as an
+ * `f64` one refuses `dhcd_hierarchy_update_positions`. On error the hierarchy is unchanged.
+ *
+ * # Safety
+ * `h` null or a live handle; `positions` holds `3 * vertex_count` doubles.
+ */
+int dhcd_hierarchy_update_positions_f64(struct DhcdHierarchy *h,
+                                        const double *positions,
+                                        size_t vertex_count);
+
+/**
+ * The precision of a hierarchy's positions into `*out`: `DHCD_PRECISION_F32` (32, built by
+ * `dhcd_hierarchy_new`) or `DHCD_PRECISION_F64` (64, built by `dhcd_hierarchy_new_f64`).
+ *
+ * # Safety
+ * `h` null or a live handle; `out` null or valid for a write.
+ */
+int dhcd_hierarchy_precision(const struct DhcdHierarchy *h, int *out);
 
 /**
  * All intersecting triangle pairs `[tri of a, tri of b]` between two hierarchies of the
@@ -231,6 +378,45 @@ int dhcd_contact_segments(const struct DhcdHierarchy *a,
 void dhcd_contacts_free(struct DhcdContacts *c);
 
 /**
+ * Every vertex-triangle and edge-edge pair of `a` and `b` (two hierarchies of the same
+ * kind) whose closed features are within distance `d` (finite, `>= 0`; else
+ * `DHCD_ERR_INVALID_ARGUMENT`), decided exactly, into `*out` (see `DhcdProximity`; release
+ * with `dhcd_proximity_free`). `a` and `b` must be different handles (use
+ * `dhcd_self_proximity` for one object); they may differ in precision (each is exact for
+ * its own coordinates).
+ *
+ * # Safety
+ * `a`, `b` null or live handles; `out` null or valid for a write.
+ */
+int dhcd_proximity(struct DhcdHierarchy *a,
+                   struct DhcdHierarchy *b,
+                   double d,
+                   uint32_t threads,
+                   struct DhcdProximity *out);
+
+/**
+ * Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
+ * (sharing no vertex) of one mesh within distance `d`, into `*out` (see `DhcdProximity`;
+ * `face_vertex` is empty; release with `dhcd_proximity_free`).
+ *
+ * # Safety
+ * `h` null or a live handle; `out` null or valid for a write.
+ */
+int dhcd_self_proximity(struct DhcdHierarchy *h,
+                        double d,
+                        uint32_t threads,
+                        struct DhcdProximity *out);
+
+/**
+ * Releases the arrays of a `DhcdProximity` and resets it to empty. Null, or an already
+ * released or empty result, is a no-op.
+ *
+ * # Safety
+ * `p` null or a `DhcdProximity` filled by this library and not modified since.
+ */
+void dhcd_proximity_free(struct DhcdProximity *p);
+
+/**
  * A new empty scene whose objects get `method` hierarchies of `levels` levels.
  *
  * # Safety
@@ -263,6 +449,23 @@ int dhcd_scene_add(struct DhcdScene *s,
                    uint64_t *out_id);
 
 /**
+ * `dhcd_scene_add` for `double` positions (`3 * vertex_count` doubles): an `f64` object
+ * (as `dhcd_hierarchy_new_f64`), updated only by `dhcd_scene_update_positions_f64`
+ * (`dhcd_scene_update_positions`, `dhcd_scene_update_many` and `dhcd_scene_step` refuse
+ * it: `DHCD_ERR_PRECISION`). A scene may hold objects of both precisions.
+ *
+ * # Safety
+ * As `dhcd_scene_add`, with `positions` holding `3 * vertex_count` doubles.
+ */
+int dhcd_scene_add_f64(struct DhcdScene *s,
+                       const double *positions,
+                       size_t vertex_count,
+                       const uint32_t *triangles,
+                       size_t triangle_count,
+                       int self_collision,
+                       uint64_t *out_id);
+
+/**
  * Removes an object.
  *
  * # Safety
@@ -271,7 +474,8 @@ int dhcd_scene_add(struct DhcdScene *s,
 int dhcd_scene_remove(struct DhcdScene *s, uint64_t id);
 
 /**
- * New positions of an object (`3 * vertex_count` floats). On error nothing changes.
+ * New positions of an object (`3 * vertex_count` floats; an `f64` object refuses them:
+ * `DHCD_ERR_PRECISION`). On error nothing changes.
  *
  * # Safety
  * `s` null or a live handle; `positions` holds `3 * vertex_count` floats.
@@ -282,12 +486,26 @@ int dhcd_scene_update_positions(struct DhcdScene *s,
                                 size_t vertex_count);
 
 /**
+ * New `double` positions of an `f64` object (`3 * vertex_count` doubles; added by
+ * `dhcd_scene_add_f64`; an `f32` object refuses them: `DHCD_ERR_PRECISION`). On error
+ * nothing changes.
+ *
+ * # Safety
+ * `s` null or a live handle; `positions` holds `3 * vertex_count` doubles.
+ */
+int dhcd_scene_update_positions_f64(struct DhcdScene *s,
+                                    uint64_t id,
+                                    const double *positions,
+                                    size_t vertex_count);
+
+/**
  * New positions of several objects in one call: entry `k` gives object `ids[k]` the
  * `3 * vertex_counts[k]` floats at `positions[k]` (as in `dhcd_scene_update_positions`).
  * `ids`, `positions` and `vertex_counts` hold `count` elements each; each id at most once.
  * Every entry is checked before any is applied: on error (a null or misaligned array, an
  * unknown id, an id given twice (`DHCD_ERR_REPEATED_OBJECT`), a wrong vertex count, a
- * non-finite coordinate) no object changes. The result equals one
+ * non-finite coordinate, an `f64` object (`DHCD_ERR_PRECISION`: those take
+ * `dhcd_scene_update_positions_f64`)) no object changes. The result equals one
  * `dhcd_scene_update_positions` per entry, for every `threads`. With `count == 0` it does
  * nothing and the arrays may be NULL.
  *
@@ -345,6 +563,30 @@ int dhcd_scene_step(struct DhcdScene *s,
  * `c` null or a `DhcdSceneContacts` filled by this library and not modified since.
  */
 void dhcd_scene_contacts_free(struct DhcdSceneContacts *c);
+
+/**
+ * Every vertex-triangle and edge-edge pair within distance `d` (finite, `>= 0`; else
+ * `DHCD_ERR_INVALID_ARGUMENT`) between every two objects, and inside every object with
+ * self-collision on, into `*out` (see `DhcdSceneProximity`; release with
+ * `dhcd_scene_proximity_free`). Objects whose root boxes are farther apart than `d` cost
+ * one box test.
+ *
+ * # Safety
+ * `s` null or a live handle; `out` null or valid for a write.
+ */
+int dhcd_scene_proximity(struct DhcdScene *s,
+                         double d,
+                         uint32_t threads,
+                         struct DhcdSceneProximity *out);
+
+/**
+ * Releases the arrays of a `DhcdSceneProximity` and resets it to empty. Null, or an
+ * already released or empty result, is a no-op.
+ *
+ * # Safety
+ * `p` null or a `DhcdSceneProximity` filled by this library and not modified since.
+ */
+void dhcd_scene_proximity_free(struct DhcdSceneProximity *p);
 
 #ifdef __cplusplus
 }  // extern "C"

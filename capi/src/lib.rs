@@ -9,13 +9,17 @@
 //! - null pointers, misaligned arrays, mismatched lengths and hierarchies of different kinds
 //!   are errors, never undefined behaviour on the library's side;
 //! - handles (`DhcdHierarchy`, `DhcdScene`) are created by `*_new` and released by
-//!   `*_free`; results (`DhcdContacts`, `DhcdSceneContacts`) own library-allocated arrays
-//!   released by `dhcd_contacts_free` / `dhcd_scene_contacts_free`;
+//!   `*_free`; results (`DhcdContacts`, `DhcdSceneContacts`, `DhcdProximity`,
+//!   `DhcdSceneProximity`) own library-allocated arrays released by their `*_free`
+//!   (an array is null when its count is 0);
 //! - a handle must not be used from two threads at once (queries refit it lazily).
 //!
 //! - a function with a handle or result output (`*out`) empties it first (NULL handle,
 //!   empty result), so it is empty after any error; scalar outputs (`dhcd_hierarchy_method`,
-//!   `dhcd_scene_add`'s id, `dhcd_contact_segments`' segments) are written only on success.
+//!   `dhcd_hierarchy_precision`, `dhcd_scene_add`'s id, `dhcd_contact_segments`' segments)
+//!   are written only on success;
+//! - `*_f64` calls take `double` positions and make or update `f64` hierarchies and objects
+//!   (exact for the doubles); positions of the other precision are `DHCD_ERR_PRECISION`.
 //!
 //! `threads` arguments: `1` runs on the calling thread, `0` on rayon's global pool (all
 //! cores), `n` on a pool of `n` threads but never more than the machine's cores; above
@@ -30,20 +34,22 @@ use dhcd::bv::Method;
 use dhcd::counters::Counters;
 use dhcd::error::Error;
 use dhcd::hierarchy::Options;
-use dhcd::mesh::Mesh;
+use dhcd::mesh::{Mesh, Precision};
 use dhcd::par::Par;
 use dhcd::scene::{ObjectId, Scene};
-use dhcd::{Contacts, Workspace};
+use dhcd::{Contacts, Proximity, SceneProximity, Workspace};
 
 /// Success.
 pub const DHCD_OK: c_int = 0;
 /// A required pointer argument is null.
 pub const DHCD_ERR_NULL: c_int = -1;
 /// A bad argument: unknown method, levels out of range, misaligned or oversized array,
-/// the same hierarchy passed twice to `dhcd_collide`, a thread count above 1024.
+/// the same hierarchy passed twice to `dhcd_collide` or `dhcd_proximity`, a thread count
+/// above 1024, a proximity distance that is negative, NaN or infinite.
 pub const DHCD_ERR_INVALID_ARGUMENT: c_int = -2;
 /// The mesh is invalid: no vertices or triangles, an index out of range, a repeated index
-/// in a triangle, a non-finite coordinate.
+/// in a triangle, a non-finite coordinate, a `double` coordinate beyond the `float` range
+/// (about 3.4e38: bounding volumes are `float`).
 pub const DHCD_ERR_INVALID_MESH: c_int = -3;
 /// A position update whose vertex count differs from the mesh's.
 pub const DHCD_ERR_LENGTH_MISMATCH: c_int = -4;
@@ -57,10 +63,21 @@ pub const DHCD_ERR_STALE_CONTACT: c_int = -7;
 pub const DHCD_ERR_PANIC: c_int = -8;
 /// The same object id given more than once in one `dhcd_scene_update_many`.
 pub const DHCD_ERR_REPEATED_OBJECT: c_int = -9;
+/// Positions of the other precision: `float` positions for an `f64` hierarchy or object
+/// (built by `dhcd_hierarchy_new_f64` / `dhcd_scene_add_f64`), or `double` positions for an
+/// `f32` one.
+pub const DHCD_ERR_PRECISION: c_int = -10;
+
+/// `dhcd_hierarchy_precision` of a hierarchy built from `float` positions.
+pub const DHCD_PRECISION_F32: c_int = 32;
+/// `dhcd_hierarchy_precision` of a hierarchy built from `double` positions.
+pub const DHCD_PRECISION_F64: c_int = 64;
 
 // The kinds' numbers (`DHCD_METHOD_DH` = 0, ...) are not constants here: they are
 // `Method::code()`, from the library's table of kinds, and the header's `DHCD_METHOD_*`
 // defines are generated from that table with the rest of the header (capi/tests/capi.rs).
+// Likewise the distance types' numbers (`DHCD_PT_*`, `DHCD_EE_*`) are the library's
+// `PointTriangle` / `EdgeEdge` discriminants (IPC's), generated from their `ALL` tables.
 
 /// Counted work of a query (the cost model's `N_V`, `N_P`, `N_U`, and the contacts).
 #[repr(C)]
@@ -103,6 +120,66 @@ pub struct DhcdSceneContacts {
     pub counters: DhcdCounters,
 }
 
+/// Feature pairs within a distance, from `dhcd_proximity` / `dhcd_self_proximity` (release
+/// with `dhcd_proximity_free`). Three lists, each of `*_count` rows, sorted by its index
+/// rows; every row has its squared distance (`*_distance_sq[k]`) and the type of its closest
+/// sub-features (`*_type[k]`: a `DHCD_PT_*` for vertex-face and face-vertex rows, a
+/// `DHCD_EE_*` for edge-edge rows, IPC's distance types). Indices are original vertex and
+/// triangle indices; every array is null when its count is 0.
+/// - `vertex_face`: `[vertex, triangle]` at `vertex_face[2k..2k+2]`: a vertex of `a` and a
+///   triangle of `b` (self: a vertex and a triangle not containing it);
+/// - `face_vertex`: `[triangle of a, vertex of b]` (pair queries only; empty for self);
+/// - `edge_edge`: `[a0, a1, b0, b1]` at `edge_edge[4k..4k+4]`, an edge of `a` and one of
+///   `b` (self: two edges sharing no vertex, `(a0, a1) < (b0, b1)`), each as its two
+///   vertices, smaller first (`DHCD_EE_EA0_*` names `a0`).
+///
+/// `counters.prim_tests` counts the feature pairs given to the exact test,
+/// `counters.contacts` the rows of the three lists.
+#[repr(C)]
+#[derive(Debug)]
+pub struct DhcdProximity {
+    pub vertex_face: *mut u32,
+    pub vf_distance_sq: *mut f64,
+    pub vf_type: *mut u8,
+    pub vf_count: usize,
+    pub face_vertex: *mut u32,
+    pub fv_distance_sq: *mut f64,
+    pub fv_type: *mut u8,
+    pub fv_count: usize,
+    pub edge_edge: *mut u32,
+    pub ee_distance_sq: *mut f64,
+    pub ee_type: *mut u8,
+    pub ee_count: usize,
+    pub counters: DhcdCounters,
+}
+
+/// Feature pairs within a distance in a scene, from `dhcd_scene_proximity` (release with
+/// `dhcd_scene_proximity_free`): every object pair's results (`object_a < object_b`) and
+/// every self-collision object's own (`object_a == object_b`), flattened with object ids,
+/// each list sorted by its rows; distances and types as in `DhcdProximity`:
+/// - `vertex_face`: `[object_a, vertex, object_b, triangle]` at `vertex_face[4k..4k+4]`;
+/// - `face_vertex`: `[object_a, triangle, object_b, vertex]` (between two objects only);
+/// - `edge_edge`: `[object_a, a0, a1, object_b, b0, b1]` at `edge_edge[6k..6k+6]`.
+///
+/// `counters` are the totals over the object pairs.
+#[repr(C)]
+#[derive(Debug)]
+pub struct DhcdSceneProximity {
+    pub vertex_face: *mut u64,
+    pub vf_distance_sq: *mut f64,
+    pub vf_type: *mut u8,
+    pub vf_count: usize,
+    pub face_vertex: *mut u64,
+    pub fv_distance_sq: *mut f64,
+    pub fv_type: *mut u8,
+    pub fv_count: usize,
+    pub edge_edge: *mut u64,
+    pub ee_distance_sq: *mut f64,
+    pub ee_type: *mut u8,
+    pub ee_count: usize,
+    pub counters: DhcdCounters,
+}
+
 /// Opaque: one object's hierarchy (and its query scratch).
 pub struct DhcdHierarchy {
     h: AnyHierarchy,
@@ -130,7 +207,9 @@ impl From<Error> for Fail {
             | Error::TooManyTriangles(_)
             | Error::IndexOutOfRange { .. }
             | Error::RepeatedIndex { .. }
-            | Error::NonFinite { .. } => DHCD_ERR_INVALID_MESH,
+            | Error::NonFinite { .. }
+            | Error::OutOfRange { .. } => DHCD_ERR_INVALID_MESH,
+            Error::PrecisionMismatch { .. } => DHCD_ERR_PRECISION,
             Error::WrongVertexCount { .. } => DHCD_ERR_LENGTH_MISMATCH,
             Error::MethodMismatch { .. } => DHCD_ERR_WRONG_KIND,
             Error::UnknownObject(_) => DHCD_ERR_UNKNOWN_OBJECT,
@@ -148,7 +227,9 @@ impl From<Error> for Fail {
             | Error::InvalidThreads { .. }
             | Error::Io { .. }
             | Error::FileTooLarge { .. }
-            | Error::Parse { .. } => DHCD_ERR_INVALID_ARGUMENT,
+            | Error::Parse { .. }
+            | Error::InvalidDistance(_)
+            | Error::UnknownPrecision(_) => DHCD_ERR_INVALID_ARGUMENT,
             // `Error` is non-exhaustive: a variant added later is a bad argument until it
             // gets a code of its own.
             _ => DHCD_ERR_INVALID_ARGUMENT,
@@ -224,6 +305,15 @@ unsafe fn positions<'a>(ptr: *const f32, count: usize) -> Result<&'a [[f32; 3]],
     unsafe { slice(ptr.cast::<[f32; 3]>(), count, "positions") }
 }
 
+/// `count` `double` positions (`3 * count` doubles).
+///
+/// # Safety
+/// As [`slice`], for `3 * count` doubles.
+unsafe fn positions_f64<'a>(ptr: *const f64, count: usize) -> Result<&'a [[f64; 3]], Fail> {
+    // SAFETY: `[f64; 3]` has the alignment of `f64` and the size of three; same contract.
+    unsafe { slice(ptr.cast::<[f64; 3]>(), count, "positions") }
+}
+
 /// # Safety
 /// As [`slice`], for `3 * count` `u32`.
 unsafe fn triangles<'a>(ptr: *const u32, count: usize) -> Result<&'a [[u32; 3]], Fail> {
@@ -296,14 +386,140 @@ unsafe fn mesh(
     Ok(Mesh::new(p.to_vec(), t.to_vec())?)
 }
 
+/// A validated `f64` mesh from C arrays.
+///
+/// # Safety
+/// As [`positions_f64`] and [`triangles`].
+unsafe fn mesh_f64(
+    pos: *const f64,
+    vertex_count: usize,
+    tris: *const u32,
+    triangle_count: usize,
+) -> Result<Mesh, Fail> {
+    // SAFETY: forwarded contract.
+    let (p, t) = unsafe {
+        (
+            positions_f64(pos, vertex_count)?,
+            triangles(tris, triangle_count)?,
+        )
+    };
+    Ok(Mesh::new_f64(p.to_vec(), t.to_vec())?)
+}
+
+/// `items` as an array the caller owns until the matching `*_free` (which rebuilds the
+/// `Box<[T]>` of `items.len()` elements with [`free_array`]), or null when there are none.
+fn c_array<T>(items: Vec<T>) -> *mut T {
+    if items.is_empty() {
+        return std::ptr::null_mut();
+    }
+    Box::into_raw(items.into_boxed_slice()).cast::<T>()
+}
+
 /// `pairs` flattened into an array the caller owns until the matching `*_free` (which
 /// rebuilds the `Box<[T]>` of `N * count` elements), or null when there are none.
 fn c_pairs<T, const N: usize>(pairs: Vec<[T; N]>) -> *mut T {
-    if pairs.is_empty() {
-        return std::ptr::null_mut();
+    c_array(pairs.into_iter().flatten().collect())
+}
+
+/// Releases an array made by [`c_array`] (or [`c_pairs`]) of `len` elements; null is a
+/// no-op.
+///
+/// # Safety
+/// `ptr` null or from `c_array` of exactly `len` elements, not released yet.
+unsafe fn free_array<T>(ptr: *mut T, len: usize) {
+    if !ptr.is_null() {
+        // SAFETY: `ptr` came from a `Box<[T]>` of `len` elements (caller's contract).
+        drop(unsafe { Box::from_raw(std::ptr::slice_from_raw_parts_mut(ptr, len)) });
     }
-    let flat: Box<[T]> = pairs.into_iter().flatten().collect();
-    Box::into_raw(flat).cast::<T>()
+}
+
+/// The C result of a proximity query.
+fn proximity_out(p: Proximity) -> DhcdProximity {
+    let vf = &p.vertex_face;
+    let fv = &p.face_vertex;
+    let ee = &p.edge_edge;
+    DhcdProximity {
+        vertex_face: c_pairs(vf.iter().map(|x| [x.vertex, x.triangle]).collect()),
+        vf_distance_sq: c_array(vf.iter().map(|x| x.distance_sq).collect()),
+        vf_type: c_array(vf.iter().map(|x| x.kind as u8).collect()),
+        vf_count: vf.len(),
+        face_vertex: c_pairs(fv.iter().map(|x| [x.triangle, x.vertex]).collect()),
+        fv_distance_sq: c_array(fv.iter().map(|x| x.distance_sq).collect()),
+        fv_type: c_array(fv.iter().map(|x| x.kind as u8).collect()),
+        fv_count: fv.len(),
+        edge_edge: c_pairs(
+            ee.iter()
+                .map(|x| [x.a[0], x.a[1], x.b[0], x.b[1]])
+                .collect(),
+        ),
+        ee_distance_sq: c_array(ee.iter().map(|x| x.distance_sq).collect()),
+        ee_type: c_array(ee.iter().map(|x| x.kind as u8).collect()),
+        ee_count: ee.len(),
+        counters: p.counters.into(),
+    }
+}
+
+/// Rows of `N` indices with their squared distances and types, sorted by the rows.
+struct Rows<const N: usize>(Vec<([u64; N], f64, u8)>);
+
+impl<const N: usize> Rows<N> {
+    /// The three arrays (index rows flattened) and the count.
+    fn into_c(mut self) -> (*mut u64, *mut f64, *mut u8, usize) {
+        // Rows are unique (one per feature pair of one object pair): the order is total.
+        self.0.sort_unstable_by_key(|r| r.0);
+        let n = self.0.len();
+        (
+            c_pairs(self.0.iter().map(|r| r.0).collect()),
+            c_array(self.0.iter().map(|r| r.1).collect()),
+            c_array(self.0.iter().map(|r| r.2).collect()),
+            n,
+        )
+    }
+}
+
+/// The C result of a scene's proximity: every pair's rows with their object ids.
+fn scene_proximity_out(p: SceneProximity) -> DhcdSceneProximity {
+    let (mut vf, mut fv, mut ee) = (Rows(Vec::new()), Rows(Vec::new()), Rows(Vec::new()));
+    for pair in &p.per_pair {
+        let (a, b, q) = (pair.a.0, pair.b.0, &pair.proximity);
+        let i = u64::from;
+        vf.0.extend(q.vertex_face.iter().map(|x| {
+            (
+                [a, i(x.vertex), b, i(x.triangle)],
+                x.distance_sq,
+                x.kind as u8,
+            )
+        }));
+        fv.0.extend(q.face_vertex.iter().map(|x| {
+            (
+                [a, i(x.triangle), b, i(x.vertex)],
+                x.distance_sq,
+                x.kind as u8,
+            )
+        }));
+        ee.0.extend(q.edge_edge.iter().map(|x| {
+            let row = [a, i(x.a[0]), i(x.a[1]), b, i(x.b[0]), i(x.b[1])];
+            (row, x.distance_sq, x.kind as u8)
+        }));
+    }
+    let (vertex_face, vf_distance_sq, vf_type, vf_count) = vf.into_c();
+    let (face_vertex, fv_distance_sq, fv_type, fv_count) = fv.into_c();
+    let (edge_edge, ee_distance_sq, ee_type, ee_count) = ee.into_c();
+    DhcdSceneProximity {
+        vertex_face,
+        vf_distance_sq,
+        vf_type,
+        vf_count,
+        face_vertex,
+        fv_distance_sq,
+        fv_type,
+        fv_count,
+        edge_edge,
+        ee_distance_sq,
+        ee_type,
+        ee_count,
+        counters: p.counters.into(),
+    }
 }
 
 fn contacts_out(c: Contacts) -> DhcdContacts {
@@ -328,6 +544,38 @@ const NO_CONTACTS: DhcdContacts = DhcdContacts {
 const NO_SCENE_CONTACTS: DhcdSceneContacts = DhcdSceneContacts {
     pairs: std::ptr::null_mut(),
     count: 0,
+    counters: NO_CONTACTS.counters,
+};
+
+const NO_PROXIMITY: DhcdProximity = DhcdProximity {
+    vertex_face: std::ptr::null_mut(),
+    vf_distance_sq: std::ptr::null_mut(),
+    vf_type: std::ptr::null_mut(),
+    vf_count: 0,
+    face_vertex: std::ptr::null_mut(),
+    fv_distance_sq: std::ptr::null_mut(),
+    fv_type: std::ptr::null_mut(),
+    fv_count: 0,
+    edge_edge: std::ptr::null_mut(),
+    ee_distance_sq: std::ptr::null_mut(),
+    ee_type: std::ptr::null_mut(),
+    ee_count: 0,
+    counters: NO_CONTACTS.counters,
+};
+
+const NO_SCENE_PROXIMITY: DhcdSceneProximity = DhcdSceneProximity {
+    vertex_face: std::ptr::null_mut(),
+    vf_distance_sq: std::ptr::null_mut(),
+    vf_type: std::ptr::null_mut(),
+    vf_count: 0,
+    face_vertex: std::ptr::null_mut(),
+    fv_distance_sq: std::ptr::null_mut(),
+    fv_type: std::ptr::null_mut(),
+    fv_count: 0,
+    edge_edge: std::ptr::null_mut(),
+    ee_distance_sq: std::ptr::null_mut(),
+    ee_type: std::ptr::null_mut(),
+    ee_count: 0,
     counters: NO_CONTACTS.counters,
 };
 
@@ -360,19 +608,64 @@ pub unsafe extern "C" fn dhcd_hierarchy_new(
     out: *mut *mut DhcdHierarchy,
 ) -> c_int {
     guard(|| {
-        // SAFETY: caller's contract on `out`: NULL until there is a handle.
-        unsafe { write(out, std::ptr::null_mut(), "out")? };
-        let m = method_of(method)?;
-        // SAFETY: the caller's contract on the arrays.
-        let mesh = unsafe { mesh(positions, vertex_count, triangles, triangle_count)? };
-        let h = AnyHierarchy::new(m, &mesh, options(levels))?;
-        let boxed = Box::new(DhcdHierarchy {
-            h,
-            ws: Workspace::default(),
-        });
-        // SAFETY: `out` is non-null and valid for a write (caller's contract).
-        unsafe { write(out, Box::into_raw(boxed), "out") }
+        // SAFETY: the caller's contract on `out` and on the arrays.
+        unsafe {
+            new_hierarchy(method, levels, out, || {
+                mesh(positions, vertex_count, triangles, triangle_count)
+            })
+        }
     })
+}
+
+/// `dhcd_hierarchy_new` for `double` positions (`3 * vertex_count` doubles): an `f64`
+/// hierarchy, whose answers (contacts, proximity) are exact for the `double` coordinates as
+/// given. Bounding volumes stay `float` records rounded outward, so every coordinate must
+/// round to a finite `float` (magnitude below about 3.4e38; else `DHCD_ERR_INVALID_MESH`).
+/// It takes only `double` updates (`dhcd_hierarchy_update_positions_f64`).
+///
+/// # Safety
+/// As `dhcd_hierarchy_new`, with `positions` holding `3 * vertex_count` doubles.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_hierarchy_new_f64(
+    method: c_int,
+    levels: u32,
+    positions: *const f64,
+    vertex_count: usize,
+    triangles: *const u32,
+    triangle_count: usize,
+    out: *mut *mut DhcdHierarchy,
+) -> c_int {
+    guard(|| {
+        // SAFETY: the caller's contract on `out` and on the arrays.
+        unsafe {
+            new_hierarchy(method, levels, out, || {
+                mesh_f64(positions, vertex_count, triangles, triangle_count)
+            })
+        }
+    })
+}
+
+/// A new hierarchy of the mesh `mesh()` into `*out` (NULL until there is one).
+///
+/// # Safety
+/// `out` null or valid for a write; `mesh` reads only arrays valid by the caller's contract.
+unsafe fn new_hierarchy(
+    method: c_int,
+    levels: u32,
+    out: *mut *mut DhcdHierarchy,
+    mesh: impl FnOnce() -> Result<Mesh, Fail>,
+) -> Result<(), Fail> {
+    // SAFETY: caller's contract on `out`: NULL until there is a handle.
+    unsafe { write(out, std::ptr::null_mut(), "out")? };
+    let m = method_of(method)?;
+    let mesh = mesh()?;
+    let h = AnyHierarchy::new(m, &mesh, options(levels))?;
+    let boxed = Box::new(DhcdHierarchy {
+        h,
+        ws: Workspace::default(),
+    });
+    // SAFETY: `out` is non-null and valid for a write (caller's contract).
+    unsafe { write(out, Box::into_raw(boxed), "out") }
 }
 
 /// Releases a hierarchy. Null is allowed (no-op).
@@ -405,7 +698,9 @@ pub unsafe extern "C" fn dhcd_hierarchy_method(h: *const DhcdHierarchy, out: *mu
 }
 
 /// New positions of the mesh (`3 * vertex_count` floats, the mesh's vertex order and
-/// count). On error the hierarchy is unchanged.
+/// count). An `f64` hierarchy refuses them (`DHCD_ERR_PRECISION`: rounding its positions
+/// would change its answers; see `dhcd_hierarchy_update_positions_f64`). On error the
+/// hierarchy is unchanged.
 ///
 /// # Safety
 /// `h` null or a live handle; `positions` holds `3 * vertex_count` floats.
@@ -426,6 +721,63 @@ pub unsafe extern "C" fn dhcd_hierarchy_update_positions(
         h.h.update_positions(p)?;
         Ok(())
     })
+}
+
+/// New `double` positions of an `f64` hierarchy (`3 * vertex_count` doubles; see
+/// `dhcd_hierarchy_new_f64`). An `f32` hierarchy refuses them (`DHCD_ERR_PRECISION`), as an
+/// `f64` one refuses `dhcd_hierarchy_update_positions`. On error the hierarchy is unchanged.
+///
+/// # Safety
+/// `h` null or a live handle; `positions` holds `3 * vertex_count` doubles.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_hierarchy_update_positions_f64(
+    h: *mut DhcdHierarchy,
+    positions: *const f64,
+    vertex_count: usize,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract.
+        let (h, p) = unsafe {
+            (
+                handle(h, "hierarchy")?,
+                positions_f64(positions, vertex_count)?,
+            )
+        };
+        h.h.update_positions_f64(p)?;
+        Ok(())
+    })
+}
+
+/// The precision of a hierarchy's positions into `*out`: `DHCD_PRECISION_F32` (32, built by
+/// `dhcd_hierarchy_new`) or `DHCD_PRECISION_F64` (64, built by `dhcd_hierarchy_new_f64`).
+///
+/// # Safety
+/// `h` null or a live handle; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_hierarchy_precision(
+    h: *const DhcdHierarchy,
+    out: *mut c_int,
+) -> c_int {
+    guard(|| {
+        // SAFETY: null or a live handle (caller's contract); only read.
+        let h = unsafe { h.as_ref() }.ok_or_else(|| null("hierarchy"))?;
+        let code = precision_code(h.h.precision())?;
+        // SAFETY: caller's contract on `out`.
+        unsafe { write(out, code, "out") }
+    })
+}
+
+/// The C number of a precision (`DHCD_PRECISION_*`).
+fn precision_code(p: Precision) -> Result<c_int, Fail> {
+    match p {
+        Precision::F32 => Ok(DHCD_PRECISION_F32),
+        Precision::F64 => Ok(DHCD_PRECISION_F64),
+        // `Precision` is non-exhaustive: a precision added later has no C number yet.
+        other => Err(Fail(
+            DHCD_ERR_INVALID_ARGUMENT,
+            format!("precision {other} has no C ABI number"),
+        )),
+    }
 }
 
 /// All intersecting triangle pairs `[tri of a, tri of b]` between two hierarchies of the
@@ -530,12 +882,95 @@ pub unsafe extern "C" fn dhcd_contacts_free(c: *mut DhcdContacts) {
     let _ = guard(|| {
         // SAFETY: caller's contract.
         if let Some(c) = unsafe { c.as_mut() } {
-            if !c.pairs.is_null() {
-                let len = c.count * 2;
-                // SAFETY: `pairs` came from `Box<[u32]>` of `2 * count` elements.
-                drop(unsafe { Box::from_raw(std::ptr::slice_from_raw_parts_mut(c.pairs, len)) });
-            }
+            // SAFETY: `pairs` came from `c_pairs` of `2 * count` elements, or is null.
+            unsafe { free_array(c.pairs, 2 * c.count) };
             *c = NO_CONTACTS;
+        }
+        Ok(())
+    });
+}
+
+/// Every vertex-triangle and edge-edge pair of `a` and `b` (two hierarchies of the same
+/// kind) whose closed features are within distance `d` (finite, `>= 0`; else
+/// `DHCD_ERR_INVALID_ARGUMENT`), decided exactly, into `*out` (see `DhcdProximity`; release
+/// with `dhcd_proximity_free`). `a` and `b` must be different handles (use
+/// `dhcd_self_proximity` for one object); they may differ in precision (each is exact for
+/// its own coordinates).
+///
+/// # Safety
+/// `a`, `b` null or live handles; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_proximity(
+    a: *mut DhcdHierarchy,
+    b: *mut DhcdHierarchy,
+    d: f64,
+    threads: u32,
+    out: *mut DhcdProximity,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on `out`: empty until there is a result.
+        unsafe { write(out, NO_PROXIMITY, "out")? };
+        if a == b && !a.is_null() {
+            return Err(Fail(
+                DHCD_ERR_INVALID_ARGUMENT,
+                "dhcd_proximity needs two different hierarchies (use dhcd_self_proximity)".into(),
+            ));
+        }
+        // SAFETY: live, distinct handles (checked above), so the two `&mut` do not alias.
+        let (a, b) = unsafe { (handle(a, "a")?, handle(b, "b")?) };
+        let p = a.h.proximity(&b.h, d, &mut a.ws, par(threads)?)?;
+        // SAFETY: caller's contract on `out` (written above).
+        unsafe { write(out, proximity_out(p), "out") }
+    })
+}
+
+/// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
+/// (sharing no vertex) of one mesh within distance `d`, into `*out` (see `DhcdProximity`;
+/// `face_vertex` is empty; release with `dhcd_proximity_free`).
+///
+/// # Safety
+/// `h` null or a live handle; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_self_proximity(
+    h: *mut DhcdHierarchy,
+    d: f64,
+    threads: u32,
+    out: *mut DhcdProximity,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on `out`: empty until there is a result.
+        unsafe { write(out, NO_PROXIMITY, "out")? };
+        // SAFETY: caller's contract on `h`.
+        let h = unsafe { handle(h, "hierarchy")? };
+        let p = h.h.self_proximity(d, &mut h.ws, par(threads)?)?;
+        // SAFETY: caller's contract on `out` (written above).
+        unsafe { write(out, proximity_out(p), "out") }
+    })
+}
+
+/// Releases the arrays of a `DhcdProximity` and resets it to empty. Null, or an already
+/// released or empty result, is a no-op.
+///
+/// # Safety
+/// `p` null or a `DhcdProximity` filled by this library and not modified since.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_proximity_free(p: *mut DhcdProximity) {
+    let _ = guard(|| {
+        // SAFETY: caller's contract.
+        if let Some(p) = unsafe { p.as_mut() } {
+            // SAFETY: each array came from `c_array` with the lengths below, or is null.
+            unsafe {
+                free_array(p.vertex_face, 2 * p.vf_count);
+                free_array(p.vf_distance_sq, p.vf_count);
+                free_array(p.vf_type, p.vf_count);
+                free_array(p.face_vertex, 2 * p.fv_count);
+                free_array(p.fv_distance_sq, p.fv_count);
+                free_array(p.fv_type, p.fv_count);
+                free_array(p.edge_edge, 4 * p.ee_count);
+                free_array(p.ee_distance_sq, p.ee_count);
+                free_array(p.ee_type, p.ee_count);
+            }
+            *p = NO_PROXIMITY;
         }
         Ok(())
     });
@@ -596,18 +1031,63 @@ pub unsafe extern "C" fn dhcd_scene_add(
     out_id: *mut u64,
 ) -> c_int {
     guard(|| {
-        // SAFETY: caller's contract.
-        let s = unsafe { handle(s, "scene")? };
-        if out_id.is_null() {
-            return Err(null("out_id"));
+        // SAFETY: caller's contract on the scene, the arrays and `out_id`.
+        unsafe {
+            scene_add(s, self_collision, out_id, || {
+                mesh(positions, vertex_count, triangles, triangle_count)
+            })
         }
-        // SAFETY: caller's contract on the arrays.
-        let mesh = unsafe { mesh(positions, vertex_count, triangles, triangle_count)? };
-        let id = s.scene.add(&mesh)?;
-        s.scene.set_self_collision(id, self_collision != 0)?;
-        // SAFETY: non-null, valid for a write (caller's contract).
-        unsafe { write(out_id, id.0, "out_id") }
     })
+}
+
+/// `dhcd_scene_add` for `double` positions (`3 * vertex_count` doubles): an `f64` object
+/// (as `dhcd_hierarchy_new_f64`), updated only by `dhcd_scene_update_positions_f64`
+/// (`dhcd_scene_update_positions`, `dhcd_scene_update_many` and `dhcd_scene_step` refuse
+/// it: `DHCD_ERR_PRECISION`). A scene may hold objects of both precisions.
+///
+/// # Safety
+/// As `dhcd_scene_add`, with `positions` holding `3 * vertex_count` doubles.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_add_f64(
+    s: *mut DhcdScene,
+    positions: *const f64,
+    vertex_count: usize,
+    triangles: *const u32,
+    triangle_count: usize,
+    self_collision: c_int,
+    out_id: *mut u64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on the scene, the arrays and `out_id`.
+        unsafe {
+            scene_add(s, self_collision, out_id, || {
+                mesh_f64(positions, vertex_count, triangles, triangle_count)
+            })
+        }
+    })
+}
+
+/// Adds the mesh `mesh()` to a scene; its id into `*out_id`.
+///
+/// # Safety
+/// `s` null or a live handle; `out_id` null or valid for a write; `mesh` reads only arrays
+/// valid by the caller's contract.
+unsafe fn scene_add(
+    s: *mut DhcdScene,
+    self_collision: c_int,
+    out_id: *mut u64,
+    mesh: impl FnOnce() -> Result<Mesh, Fail>,
+) -> Result<(), Fail> {
+    // SAFETY: caller's contract.
+    let s = unsafe { handle(s, "scene")? };
+    if out_id.is_null() {
+        return Err(null("out_id"));
+    }
+    let mesh = mesh()?;
+    let id = s.scene.add(&mesh)?;
+    s.scene.set_self_collision(id, self_collision != 0)?;
+    // SAFETY: non-null, valid for a write (caller's contract).
+    unsafe { write(out_id, id.0, "out_id") }
 }
 
 /// Removes an object.
@@ -623,7 +1103,8 @@ pub unsafe extern "C" fn dhcd_scene_remove(s: *mut DhcdScene, id: u64) -> c_int 
     })
 }
 
-/// New positions of an object (`3 * vertex_count` floats). On error nothing changes.
+/// New positions of an object (`3 * vertex_count` floats; an `f64` object refuses them:
+/// `DHCD_ERR_PRECISION`). On error nothing changes.
 ///
 /// # Safety
 /// `s` null or a live handle; `positions` holds `3 * vertex_count` floats.
@@ -643,6 +1124,26 @@ pub unsafe extern "C" fn dhcd_scene_update_positions(
             )
         };
         Ok(s.scene.update_positions(ObjectId(id), p)?)
+    })
+}
+
+/// New `double` positions of an `f64` object (`3 * vertex_count` doubles; added by
+/// `dhcd_scene_add_f64`; an `f32` object refuses them: `DHCD_ERR_PRECISION`). On error
+/// nothing changes.
+///
+/// # Safety
+/// `s` null or a live handle; `positions` holds `3 * vertex_count` doubles.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_update_positions_f64(
+    s: *mut DhcdScene,
+    id: u64,
+    positions: *const f64,
+    vertex_count: usize,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract.
+        let (s, p) = unsafe { (handle(s, "scene")?, positions_f64(positions, vertex_count)?) };
+        Ok(s.scene.update_positions_f64(ObjectId(id), p)?)
     })
 }
 
@@ -699,7 +1200,8 @@ fn scene_contacts_result(c: dhcd::SceneContacts) -> DhcdSceneContacts {
 /// `ids`, `positions` and `vertex_counts` hold `count` elements each; each id at most once.
 /// Every entry is checked before any is applied: on error (a null or misaligned array, an
 /// unknown id, an id given twice (`DHCD_ERR_REPEATED_OBJECT`), a wrong vertex count, a
-/// non-finite coordinate) no object changes. The result equals one
+/// non-finite coordinate, an `f64` object (`DHCD_ERR_PRECISION`: those take
+/// `dhcd_scene_update_positions_f64`)) no object changes. The result equals one
 /// `dhcd_scene_update_positions` per entry, for every `threads`. With `count == 0` it does
 /// nothing and the arrays may be NULL.
 ///
@@ -809,12 +1311,63 @@ pub unsafe extern "C" fn dhcd_scene_contacts_free(c: *mut DhcdSceneContacts) {
     let _ = guard(|| {
         // SAFETY: caller's contract.
         if let Some(c) = unsafe { c.as_mut() } {
-            if !c.pairs.is_null() {
-                let len = c.count * 4;
-                // SAFETY: `pairs` came from `Box<[u64]>` of `4 * count` elements.
-                drop(unsafe { Box::from_raw(std::ptr::slice_from_raw_parts_mut(c.pairs, len)) });
-            }
+            // SAFETY: `pairs` came from `c_pairs` of `4 * count` elements, or is null.
+            unsafe { free_array(c.pairs, 4 * c.count) };
             *c = NO_SCENE_CONTACTS;
+        }
+        Ok(())
+    });
+}
+
+/// Every vertex-triangle and edge-edge pair within distance `d` (finite, `>= 0`; else
+/// `DHCD_ERR_INVALID_ARGUMENT`) between every two objects, and inside every object with
+/// self-collision on, into `*out` (see `DhcdSceneProximity`; release with
+/// `dhcd_scene_proximity_free`). Objects whose root boxes are farther apart than `d` cost
+/// one box test.
+///
+/// # Safety
+/// `s` null or a live handle; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_proximity(
+    s: *mut DhcdScene,
+    d: f64,
+    threads: u32,
+    out: *mut DhcdSceneProximity,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on `out`: empty until there is a result.
+        unsafe { write(out, NO_SCENE_PROXIMITY, "out")? };
+        // SAFETY: caller's contract.
+        let s = unsafe { handle(s, "scene")? };
+        let p = s.scene.proximity(d, par(threads)?)?;
+        // SAFETY: as above.
+        unsafe { write(out, scene_proximity_out(p), "out") }
+    })
+}
+
+/// Releases the arrays of a `DhcdSceneProximity` and resets it to empty. Null, or an
+/// already released or empty result, is a no-op.
+///
+/// # Safety
+/// `p` null or a `DhcdSceneProximity` filled by this library and not modified since.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_proximity_free(p: *mut DhcdSceneProximity) {
+    let _ = guard(|| {
+        // SAFETY: caller's contract.
+        if let Some(p) = unsafe { p.as_mut() } {
+            // SAFETY: each array came from `c_array` with the lengths below, or is null.
+            unsafe {
+                free_array(p.vertex_face, 4 * p.vf_count);
+                free_array(p.vf_distance_sq, p.vf_count);
+                free_array(p.vf_type, p.vf_count);
+                free_array(p.face_vertex, 4 * p.fv_count);
+                free_array(p.fv_distance_sq, p.fv_count);
+                free_array(p.fv_type, p.fv_count);
+                free_array(p.edge_edge, 6 * p.ee_count);
+                free_array(p.ee_distance_sq, p.ee_count);
+                free_array(p.ee_type, p.ee_count);
+            }
+            *p = NO_SCENE_PROXIMITY;
         }
         Ok(())
     });

@@ -5,6 +5,7 @@
 use std::ffi::CStr;
 use std::ptr::{null, null_mut};
 
+use dhcd::distance::{EdgeEdge, PointTriangle};
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
 use dhcd::shapes::{icosphere, translated, wave};
 use dhcd::{Mesh, Method};
@@ -761,6 +762,17 @@ fn header_is_generated() {
         let name = m.name().to_uppercase();
         kinds += &format!("\n#define DHCD_METHOD_{name} {}", m.code());
     }
+    // The distance types' numbers, from the library's enums (IPC's names and numbers).
+    kinds += "\n\n/**\n * Point-triangle distance types (`vf_type`, `fv_type` of proximity results):\n * \
+              IPC's PointTriangleDistanceType.\n */";
+    for t in PointTriangle::ALL {
+        kinds += &format!("\n#define DHCD_PT_{} {}", t.ipc_name(), t as u8);
+    }
+    kinds += "\n\n/**\n * Edge-edge distance types (`ee_type` of proximity results): IPC's\n * \
+              EdgeEdgeDistanceType.\n */";
+    for t in EdgeEdge::ALL {
+        kinds += &format!("\n#define DHCD_EE_{} {}", t.ipc_name(), t as u8);
+    }
     config.after_includes = Some(kinds);
     let mut generated = Vec::new();
     cbindgen::Builder::new()
@@ -790,6 +802,13 @@ fn struct_layouts() {
         std::mem::size_of::<DhcdContacts>(),
         2 * std::mem::size_of::<usize>() + 32
     );
+    // Nine pointers and three counts, then the counters.
+    for size in [
+        std::mem::size_of::<DhcdProximity>(),
+        std::mem::size_of::<DhcdSceneProximity>(),
+    ] {
+        assert_eq!(size, 12 * std::mem::size_of::<usize>() + 32);
+    }
 }
 
 /// A pointer no valid handle or array has: what a C caller's uninitialised variable holds.
@@ -917,4 +936,1046 @@ fn thread_counts_are_checked() {
         dhcd_hierarchy_free(ha);
         dhcd_hierarchy_free(hb);
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// f64 geometry and proximity
+// ---------------------------------------------------------------------------------------------
+
+use dhcd::query::{EdgePair, FaceVertex, VertexFace};
+use dhcd::{AnyHierarchy, Counters, Options, Par, Proximity, Workspace};
+
+const METHODS: [i32; 3] = [DHCD_METHOD_DH, DHCD_METHOD_SPHERE, DHCD_METHOD_AABB];
+
+fn options4() -> Options {
+    Options {
+        levels: Some(4),
+        ..Options::default()
+    }
+}
+
+fn method_of(code: i32) -> Method {
+    Method::from_code(code).unwrap()
+}
+
+/// `positions` as `f64`, each coordinate moved off the `f32` grid by a few 1e-9 (so the
+/// `f64` hierarchy has something to be exact about).
+fn off_grid(positions: &[[f32; 3]]) -> Vec<[f64; 3]> {
+    positions
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let nudge = 1e-9 * ((k * 7 % 13) as f64 - 6.0);
+            p.map(|x| f64::from(x) + nudge)
+        })
+        .collect()
+}
+
+fn mesh64(positions: Vec<[f64; 3]>, like: &Mesh) -> Mesh {
+    Mesh::new_f64(positions, like.triangles().to_vec()).unwrap()
+}
+
+/// A C hierarchy of `mesh` (of either precision) with 4 levels.
+fn new_any(method: i32, mesh: &Mesh) -> *mut DhcdHierarchy {
+    let Some(p) = mesh.positions_f64() else {
+        return new_h(method, mesh);
+    };
+    let p: Vec<f64> = p.iter().flatten().copied().collect();
+    let t: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
+    let mut h = garbage();
+    // SAFETY: arrays of the stated lengths; `h` writable.
+    let rc = unsafe {
+        dhcd_hierarchy_new_f64(
+            method,
+            4,
+            p.as_ptr(),
+            mesh.vertex_count(),
+            t.as_ptr(),
+            mesh.triangle_count(),
+            &mut h,
+        )
+    };
+    assert_eq!(rc, DHCD_OK, "{}", last_error());
+    h
+}
+
+/// Gives a C hierarchy and its Rust twin the positions of `mesh` (either precision).
+fn update_both(h: *mut DhcdHierarchy, rust: &mut AnyHierarchy, mesh: &Mesh) {
+    // SAFETY: a live handle; arrays of the stated lengths.
+    let rc = unsafe {
+        match mesh.positions_f64() {
+            Some(p) => {
+                rust.update_positions_f64(p).unwrap();
+                let f: Vec<f64> = p.iter().flatten().copied().collect();
+                dhcd_hierarchy_update_positions_f64(h, f.as_ptr(), p.len())
+            }
+            None => {
+                rust.update_positions(mesh.positions()).unwrap();
+                let f: Vec<f32> = mesh.positions().iter().flatten().copied().collect();
+                dhcd_hierarchy_update_positions(h, f.as_ptr(), mesh.vertex_count())
+            }
+        }
+    };
+    assert_eq!(rc, DHCD_OK, "{}", last_error());
+}
+
+/// `n` elements at `ptr`; a count of 0 must come with a null pointer.
+///
+/// # Safety
+/// `ptr` holds `n` elements when `n > 0`.
+unsafe fn part<'a, T>(ptr: *const T, n: usize) -> &'a [T] {
+    if n == 0 {
+        assert!(ptr.is_null(), "an empty array is null");
+        return &[];
+    }
+    assert!(!ptr.is_null());
+    // SAFETY: caller's contract.
+    unsafe { std::slice::from_raw_parts(ptr, n) }
+}
+
+fn counters_of(c: DhcdCounters) -> Counters {
+    Counters {
+        bv_tests: c.bv_tests,
+        prim_tests: c.prim_tests,
+        bv_updates: c.bv_updates,
+        contacts: c.contacts,
+    }
+}
+
+fn no_proximity() -> DhcdProximity {
+    DhcdProximity {
+        vertex_face: garbage(),
+        vf_distance_sq: garbage(),
+        vf_type: garbage(),
+        vf_count: 9,
+        face_vertex: garbage(),
+        fv_distance_sq: garbage(),
+        fv_type: garbage(),
+        fv_count: 9,
+        edge_edge: garbage(),
+        ee_distance_sq: garbage(),
+        ee_type: garbage(),
+        ee_count: 9,
+        counters: DhcdCounters {
+            bv_tests: 1,
+            prim_tests: 2,
+            bv_updates: 3,
+            contacts: 4,
+        },
+    }
+}
+
+fn is_empty(p: &DhcdProximity) -> bool {
+    p.vertex_face.is_null()
+        && p.vf_distance_sq.is_null()
+        && p.vf_type.is_null()
+        && p.face_vertex.is_null()
+        && p.fv_distance_sq.is_null()
+        && p.fv_type.is_null()
+        && p.edge_edge.is_null()
+        && p.ee_distance_sq.is_null()
+        && p.ee_type.is_null()
+        && p.vf_count == 0
+        && p.fv_count == 0
+        && p.ee_count == 0
+        && p.counters == DhcdCounters::default()
+}
+
+fn is_empty_scene(p: &DhcdSceneProximity) -> bool {
+    p.vertex_face.is_null()
+        && p.vf_distance_sq.is_null()
+        && p.vf_type.is_null()
+        && p.face_vertex.is_null()
+        && p.fv_distance_sq.is_null()
+        && p.fv_type.is_null()
+        && p.edge_edge.is_null()
+        && p.ee_distance_sq.is_null()
+        && p.ee_type.is_null()
+        && p.vf_count == 0
+        && p.fv_count == 0
+        && p.ee_count == 0
+        && p.counters == DhcdCounters::default()
+}
+
+/// A filled `DhcdProximity` as the library's `Proximity`; the C result is released (and
+/// then empty).
+///
+/// # Safety
+/// `p` filled by the library and not released.
+unsafe fn taken_proximity(p: &mut DhcdProximity) -> Proximity {
+    let pt = |t: u8| PointTriangle::ALL[t as usize];
+    // SAFETY: the library wrote the stated number of elements at each array.
+    let out = unsafe {
+        let (vf, vd, vt) = (
+            part(p.vertex_face, 2 * p.vf_count),
+            part(p.vf_distance_sq, p.vf_count),
+            part(p.vf_type, p.vf_count),
+        );
+        let (fv, fd, ft) = (
+            part(p.face_vertex, 2 * p.fv_count),
+            part(p.fv_distance_sq, p.fv_count),
+            part(p.fv_type, p.fv_count),
+        );
+        let (ee, ed, et) = (
+            part(p.edge_edge, 4 * p.ee_count),
+            part(p.ee_distance_sq, p.ee_count),
+            part(p.ee_type, p.ee_count),
+        );
+        Proximity {
+            vertex_face: (0..p.vf_count)
+                .map(|k| VertexFace {
+                    vertex: vf[2 * k],
+                    triangle: vf[2 * k + 1],
+                    distance_sq: vd[k],
+                    kind: pt(vt[k]),
+                })
+                .collect(),
+            face_vertex: (0..p.fv_count)
+                .map(|k| FaceVertex {
+                    triangle: fv[2 * k],
+                    vertex: fv[2 * k + 1],
+                    distance_sq: fd[k],
+                    kind: pt(ft[k]),
+                })
+                .collect(),
+            edge_edge: (0..p.ee_count)
+                .map(|k| EdgePair {
+                    a: [ee[4 * k], ee[4 * k + 1]],
+                    b: [ee[4 * k + 2], ee[4 * k + 3]],
+                    distance_sq: ed[k],
+                    kind: EdgeEdge::ALL[et[k] as usize],
+                })
+                .collect(),
+            counters: counters_of(p.counters),
+        }
+    };
+    // SAFETY: filled by the library, released once (the second call is a no-op).
+    unsafe {
+        dhcd_proximity_free(p);
+        assert!(is_empty(p), "released");
+        dhcd_proximity_free(p);
+    }
+    out
+}
+
+/// `dhcd_proximity(a, b, d, threads)` as the library's type.
+fn c_proximity(a: *mut DhcdHierarchy, b: *mut DhcdHierarchy, d: f64, threads: u32) -> Proximity {
+    let mut p = no_proximity();
+    // SAFETY: live handles, writable output.
+    unsafe {
+        let rc = dhcd_proximity(a, b, d, threads, &mut p);
+        assert_eq!(rc, DHCD_OK, "{}", last_error());
+        taken_proximity(&mut p)
+    }
+}
+
+fn c_self_proximity(h: *mut DhcdHierarchy, d: f64, threads: u32) -> Proximity {
+    let mut p = no_proximity();
+    // SAFETY: a live handle, writable output.
+    unsafe {
+        let rc = dhcd_self_proximity(h, d, threads, &mut p);
+        assert_eq!(rc, DHCD_OK, "{}", last_error());
+        taken_proximity(&mut p)
+    }
+}
+
+/// The meshes of the proximity tests: a ball, a second one rippled beside it (within
+/// `0.05` of the first in places), the second in another pose, and the first crumpled (so
+/// it comes within the distance of itself); in `f32`, or `f64` off the `f32` grid.
+fn proximity_meshes(f64_positions: bool) -> [Mesh; 4] {
+    let a = icosphere(2, 1.0, [0.0; 3]);
+    let poses = [
+        a.positions().to_vec(),
+        wave(a.positions(), 0.7, 0.05, [2.0, 0.1, 0.0]),
+        wave(a.positions(), 1.9, 0.08, [1.95, -0.1, 0.05]),
+        wave(a.positions(), 1.3, 0.6, [0.0; 3]),
+    ];
+    poses.map(|p| {
+        if f64_positions {
+            mesh64(off_grid(&p), &a)
+        } else {
+            Mesh::new(p, a.triangles().to_vec()).unwrap()
+        }
+    })
+}
+
+/// `dhcd_proximity` and `dhcd_self_proximity` equal the Rust API, every field (indices,
+/// distances to the bit, types, counters), for every kind, both precisions (and a pair of
+/// one of each), after an update, on 1 and 2 threads.
+#[test]
+fn proximity_equals_the_rust_api() {
+    let d = 0.06;
+    let f32s = proximity_meshes(false);
+    let f64s = proximity_meshes(true);
+    let cases: [(&str, &[Mesh; 4], &[Mesh; 4]); 3] = [
+        ("f32", &f32s, &f32s),
+        ("f64", &f64s, &f64s),
+        ("f32 with f64", &f32s, &f64s),
+    ];
+    for method in METHODS {
+        let m = method_of(method);
+        for (name, ma, mb) in cases {
+            for threads in [1u32, 2] {
+                let what = format!("{m:?}, {name}, threads {threads}");
+                let par = Par::threads(threads as usize).unwrap();
+                let mut ws = Workspace::default();
+                let (ha, hb) = (new_any(method, &ma[0]), new_any(method, &mb[1]));
+                let mut ra = AnyHierarchy::new(m, &ma[0], options4()).unwrap();
+                let mut rb = AnyHierarchy::new(m, &mb[1], options4()).unwrap();
+                let expected = ra.proximity(&rb, d, &mut ws, par).unwrap();
+                let got = c_proximity(ha, hb, d, threads);
+                assert_eq!(got, expected, "{what}");
+                assert!(
+                    !got.vertex_face.is_empty()
+                        && !got.face_vertex.is_empty()
+                        && !got.edge_edge.is_empty(),
+                    "{what}: {} {} {}",
+                    got.vertex_face.len(),
+                    got.face_vertex.len(),
+                    got.edge_edge.len()
+                );
+                // Another pose of b: refits counted alike.
+                update_both(hb, &mut rb, &mb[2]);
+                let expected = ra.proximity(&rb, d, &mut ws, par).unwrap();
+                assert_eq!(c_proximity(ha, hb, d, threads), expected, "{what}, moved");
+                // Self-proximity of a crumpled a.
+                update_both(ha, &mut ra, &ma[3]);
+                let expected = ra.self_proximity(d, &mut ws, par).unwrap();
+                let got = c_self_proximity(ha, d, threads);
+                assert_eq!(got, expected, "{what}, self");
+                assert!(!got.vertex_face.is_empty() && !got.edge_edge.is_empty());
+                assert!(got.face_vertex.is_empty());
+                assert!(got.edge_edge.iter().all(|e| e.a < e.b && e.a[0] < e.a[1]));
+                // SAFETY: live handles, released once.
+                unsafe {
+                    dhcd_hierarchy_free(ha);
+                    dhcd_hierarchy_free(hb);
+                }
+            }
+        }
+    }
+}
+
+/// Rows of a scene result, each with its distance and type.
+type SceneRows = (
+    Vec<([u64; 4], f64, u8)>,
+    Vec<([u64; 4], f64, u8)>,
+    Vec<([u64; 6], f64, u8)>,
+    DhcdCounters,
+);
+
+/// A filled `DhcdSceneProximity` as rows; the C result is released.
+///
+/// # Safety
+/// `p` filled by the library and not released.
+unsafe fn taken_scene_proximity(p: &mut DhcdSceneProximity) -> SceneRows {
+    fn rows<const N: usize>(idx: &[u64], d: &[f64], t: &[u8]) -> Vec<([u64; N], f64, u8)> {
+        (0..d.len())
+            .map(|k| (std::array::from_fn(|i| idx[N * k + i]), d[k], t[k]))
+            .collect()
+    }
+    // SAFETY: the library wrote the stated number of elements at each array.
+    let out = unsafe {
+        (
+            rows(
+                part(p.vertex_face, 4 * p.vf_count),
+                part(p.vf_distance_sq, p.vf_count),
+                part(p.vf_type, p.vf_count),
+            ),
+            rows(
+                part(p.face_vertex, 4 * p.fv_count),
+                part(p.fv_distance_sq, p.fv_count),
+                part(p.fv_type, p.fv_count),
+            ),
+            rows(
+                part(p.edge_edge, 6 * p.ee_count),
+                part(p.ee_distance_sq, p.ee_count),
+                part(p.ee_type, p.ee_count),
+            ),
+            p.counters,
+        )
+    };
+    // SAFETY: filled by the library, released once (the second call is a no-op).
+    unsafe {
+        dhcd_scene_proximity_free(p);
+        assert!(is_empty_scene(p), "released");
+        dhcd_scene_proximity_free(p);
+    }
+    out
+}
+
+/// The Rust scene's proximity flattened as the C ABI documents it: rows with object ids,
+/// each list sorted.
+fn flattened(p: &dhcd::SceneProximity) -> SceneRows {
+    let (mut vf, mut fv, mut ee) = (Vec::new(), Vec::new(), Vec::new());
+    for pair in &p.per_pair {
+        let (a, b) = (pair.a.0, pair.b.0);
+        for x in &pair.proximity.vertex_face {
+            let row = [a, x.vertex.into(), b, x.triangle.into()];
+            vf.push((row, x.distance_sq, x.kind as u8));
+        }
+        for x in &pair.proximity.face_vertex {
+            let row = [a, x.triangle.into(), b, x.vertex.into()];
+            fv.push((row, x.distance_sq, x.kind as u8));
+        }
+        for x in &pair.proximity.edge_edge {
+            let row = [
+                a,
+                x.a[0].into(),
+                x.a[1].into(),
+                b,
+                x.b[0].into(),
+                x.b[1].into(),
+            ];
+            ee.push((row, x.distance_sq, x.kind as u8));
+        }
+    }
+    vf.sort_by_key(|r| r.0);
+    fv.sort_by_key(|r| r.0);
+    ee.sort_by_key(|r| r.0);
+    (vf, fv, ee, p.counters.into())
+}
+
+/// `dhcd_scene_proximity` equals the Rust scene's, flattened: objects of both precisions, one
+/// with self-collision on, one far away; every kind, 1 and 2 threads.
+#[test]
+fn scene_proximity_equals_the_rust_scene() {
+    let d = 0.06;
+    let [a, b, _, _] = proximity_meshes(false);
+    let [_, b64, _, crumpled64] = proximity_meshes(true);
+    let far = Mesh::new(
+        translated(a.positions(), [40.0, 0.0, 0.0]),
+        a.triangles().to_vec(),
+    )
+    .unwrap();
+    // (rest pose, pose, self-collision)
+    let objects: [(&Mesh, &Mesh, bool); 4] = [
+        (&a, &a, false),
+        (&b64, &crumpled64, true),
+        (&a, &b, false),
+        (&a, &far, false),
+    ];
+    for method in METHODS {
+        for threads in [1u32, 2] {
+            let mut rust = dhcd::Scene::new(method_of(method), options4());
+            let mut s = null_mut();
+            // SAFETY: live handles, arrays of the stated lengths, writable outputs.
+            unsafe {
+                assert_eq!(dhcd_scene_new(method, 4, &mut s), DHCD_OK);
+                for (rest, pose, self_collision) in objects {
+                    let t: Vec<u32> = rest.triangles().iter().flatten().copied().collect();
+                    let (nv, nt) = (rest.vertex_count(), rest.triangle_count());
+                    let mut id = u64::MAX;
+                    let rid = rust.add(rest).unwrap();
+                    rust.set_self_collision(rid, self_collision).unwrap();
+                    let rc = match (rest.positions_f64(), pose.positions_f64()) {
+                        (Some(p), Some(q)) => {
+                            let p: Vec<f64> = p.iter().flatten().copied().collect();
+                            let rc = dhcd_scene_add_f64(
+                                s,
+                                p.as_ptr(),
+                                nv,
+                                t.as_ptr(),
+                                nt,
+                                self_collision.into(),
+                                &mut id,
+                            );
+                            assert_eq!(rc, DHCD_OK, "{}", last_error());
+                            rust.update_positions_f64(rid, q).unwrap();
+                            let q: Vec<f64> = q.iter().flatten().copied().collect();
+                            dhcd_scene_update_positions_f64(s, id, q.as_ptr(), nv)
+                        }
+                        _ => {
+                            let (p, _) = flat(rest);
+                            let rc = dhcd_scene_add(
+                                s,
+                                p.as_ptr(),
+                                nv,
+                                t.as_ptr(),
+                                nt,
+                                self_collision.into(),
+                                &mut id,
+                            );
+                            assert_eq!(rc, DHCD_OK, "{}", last_error());
+                            rust.update_positions(rid, pose.positions()).unwrap();
+                            let (q, _) = flat(pose);
+                            dhcd_scene_update_positions(s, id, q.as_ptr(), nv)
+                        }
+                    };
+                    assert_eq!(rc, DHCD_OK, "{}", last_error());
+                    assert_eq!(id, rid.0);
+                }
+                let expected = rust
+                    .proximity(d, Par::threads(threads as usize).unwrap())
+                    .unwrap();
+                let mut p = DhcdSceneProximity {
+                    vertex_face: garbage(),
+                    vf_count: 3,
+                    ..std::mem::zeroed()
+                };
+                let rc = dhcd_scene_proximity(s, d, threads, &mut p);
+                assert_eq!(rc, DHCD_OK, "{}", last_error());
+                let got = taken_scene_proximity(&mut p);
+                assert_eq!(got, flattened(&expected), "{method}, {threads}");
+                let (vf, fv, ee, counters) = got;
+                assert!(!vf.is_empty() && !fv.is_empty() && !ee.is_empty());
+                assert_eq!(counters.contacts as usize, vf.len() + fv.len() + ee.len());
+                // Pairs between objects and inside object 1; nothing of the far object 3.
+                for q in [1, 2] {
+                    assert!(vf.iter().any(|r| r.0[0] == 0 && r.0[2] == q));
+                }
+                assert!(vf.iter().any(|r| r.0[0] == 1 && r.0[2] == 1));
+                assert!(ee.iter().any(|r| r.0[0] == 1 && r.0[3] == 1));
+                assert!(fv.iter().all(|r| r.0[0] < r.0[2]));
+                assert!(vf.iter().all(|r| r.0[0] != 3 && r.0[2] != 3));
+                dhcd_scene_free(s);
+            }
+        }
+    }
+}
+
+/// Triangle A in the plane z = 1; triangle B above it with its lowest corner `gap` above A's
+/// interior (`1 + gap` in `f64`, which rounds to `1.0f32` for a gap below 3e-8).
+fn near_pair(gap: f64) -> ([f64; 9], [f64; 9]) {
+    let a = [0.0, 0.0, 1.0, 2.0, 0.0, 1.0, 0.0, 2.0, 1.0];
+    let b = [0.5, 0.5, 1.0 + gap, 0.5, 0.5, 2.0, 0.2, 0.8, 2.0];
+    (a, b)
+}
+
+fn as_f32(p: &[f64]) -> Vec<f32> {
+    p.iter().map(|&x| x as f32).collect()
+}
+
+/// An `f64` hierarchy decides for the `double` coordinates: B 1e-9 above A touches nothing
+/// (its `float` rounding touches A), and comes within 2e-9 (not 5e-10) of it; updates in
+/// `double` move it across A's plane and back.
+#[test]
+fn f64_hierarchies_are_exact_for_doubles() {
+    let tri = [0u32, 1, 2];
+    let (a, b) = near_pair(1e-9);
+    for method in METHODS {
+        // SAFETY: arrays of the stated lengths, live handles, writable outputs.
+        unsafe {
+            let (mut ha, mut hb, mut ha32, mut hb32) = (garbage(), garbage(), garbage(), garbage());
+            for (h, p) in [(&mut ha, &a), (&mut hb, &b)] {
+                let rc = dhcd_hierarchy_new_f64(method, 0, p.as_ptr(), 3, tri.as_ptr(), 1, h);
+                assert_eq!(rc, DHCD_OK, "{}", last_error());
+            }
+            for (h, p) in [(&mut ha32, &a), (&mut hb32, &b)] {
+                let p = as_f32(p);
+                let rc = dhcd_hierarchy_new(method, 0, p.as_ptr(), 3, tri.as_ptr(), 1, h);
+                assert_eq!(rc, DHCD_OK, "{}", last_error());
+            }
+            let mut precision = 0;
+            assert_eq!(dhcd_hierarchy_precision(ha, &mut precision), DHCD_OK);
+            assert_eq!(precision, DHCD_PRECISION_F64);
+            assert_eq!(precision, 64);
+            assert_eq!(dhcd_hierarchy_precision(ha32, &mut precision), DHCD_OK);
+            assert_eq!(precision, DHCD_PRECISION_F32);
+            assert_eq!(precision, 32);
+
+            let collide = |x, y| -> Vec<[u32; 2]> {
+                let mut c = empty();
+                assert_eq!(dhcd_collide(x, y, 1, &mut c), DHCD_OK, "{}", last_error());
+                let pairs = pairs_of(&c);
+                dhcd_contacts_free(&mut c);
+                pairs
+            };
+            // Rounded to float, B's corner lies on A; in double it is above.
+            assert_eq!(collide(ha32, hb32), vec![[0, 0]]);
+            assert!(collide(ha, hb).is_empty());
+            let gap = (1.0 + 1e-9) - 1.0; // exact in f64
+            let p = c_proximity(ha, hb, 2e-9, 1);
+            assert!(p.vertex_face.is_empty() && p.edge_edge.is_empty());
+            assert_eq!(p.face_vertex.len(), 1);
+            let fv = p.face_vertex[0];
+            assert_eq!(
+                (fv.triangle, fv.vertex, fv.kind),
+                (0, 0, PointTriangle::Face)
+            );
+            assert_eq!(fv.distance_sq, gap * gap);
+            let none = c_proximity(ha, hb, 5e-10, 2);
+            assert!(none.vertex_face.is_empty() && none.face_vertex.is_empty());
+            assert!(none.edge_edge.is_empty());
+            let p32 = c_proximity(ha32, hb32, 5e-10, 1);
+            assert_eq!(p32.face_vertex.len(), 1);
+            assert_eq!(p32.face_vertex[0].distance_sq, 0.0);
+            // Round trip: below A's plane (B crosses A), then back above.
+            let (_, down) = near_pair(-1e-9);
+            assert_eq!(
+                dhcd_hierarchy_update_positions_f64(hb, down.as_ptr(), 3),
+                DHCD_OK
+            );
+            assert_eq!(collide(ha, hb), vec![[0, 0]]);
+            assert_eq!(
+                dhcd_hierarchy_update_positions_f64(hb, b.as_ptr(), 3),
+                DHCD_OK
+            );
+            assert!(collide(ha, hb).is_empty());
+            // A mixed pair: each side exact for its own coordinates.
+            assert!(collide(ha32, hb).is_empty());
+            assert_eq!(collide(ha, hb32), vec![[0, 0]]);
+            for h in [ha, hb, ha32, hb32] {
+                dhcd_hierarchy_free(h);
+            }
+        }
+    }
+}
+
+/// Positions of the other precision are `DHCD_ERR_PRECISION` with the library's message, and
+/// change nothing; `double` coordinates beyond the `float` range are an invalid mesh.
+#[test]
+fn precision_mismatches_are_errors_and_change_nothing() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let (p32, t) = flat(&m);
+    let nv = m.vertex_count();
+    let p64: Vec<f64> = p32.iter().map(|&x| f64::from(x)).collect();
+    let far64: Vec<f64> = p64.iter().map(|x| x + 10.0).collect();
+    let far32 = as_f32(&far64);
+    let h64 = new_any(DHCD_METHOD_DH, &mesh64(off_grid(m.positions()), &m));
+    let h32 = new_h(DHCD_METHOD_DH, &m);
+    let other = new_h(DHCD_METHOD_DH, &m);
+    // SAFETY: live handles; arrays of the stated lengths; writable outputs.
+    unsafe {
+        let count = |h| {
+            let mut c = empty();
+            assert_eq!(dhcd_collide(h, other, 1, &mut c), DHCD_OK);
+            let n = c.count;
+            dhcd_contacts_free(&mut c);
+            n
+        };
+        let before = (count(h64), count(h32));
+        assert!(before.0 > 0 && before.1 > 0);
+        assert_eq!(
+            dhcd_hierarchy_update_positions(h64, far32.as_ptr(), nv),
+            DHCD_ERR_PRECISION
+        );
+        assert!(
+            last_error().contains("positions are f32, but the mesh or hierarchy is f64"),
+            "{}",
+            last_error()
+        );
+        assert_eq!(
+            dhcd_hierarchy_update_positions_f64(h32, far64.as_ptr(), nv),
+            DHCD_ERR_PRECISION
+        );
+        assert!(
+            last_error().contains("positions are f64"),
+            "{}",
+            last_error()
+        );
+        assert_eq!((count(h64), count(h32)), before, "nothing moved");
+
+        // Out of float range, NaN: invalid meshes, at build and update.
+        let mut big = p64.clone();
+        big[4] = 1e39;
+        let mut nan = p64.clone();
+        nan[4] = f64::NAN;
+        for (bad, message) in [(&big, "f32 range"), (&nan, "non-finite")] {
+            let mut h = garbage();
+            let rc = dhcd_hierarchy_new_f64(
+                DHCD_METHOD_DH,
+                4,
+                bad.as_ptr(),
+                nv,
+                t.as_ptr(),
+                m.triangle_count(),
+                &mut h,
+            );
+            assert_eq!(rc, DHCD_ERR_INVALID_MESH);
+            assert!(h.is_null());
+            assert!(last_error().contains(message), "{}", last_error());
+            assert_eq!(
+                dhcd_hierarchy_update_positions_f64(h64, bad.as_ptr(), nv),
+                DHCD_ERR_INVALID_MESH
+            );
+            assert!(last_error().contains(message), "{}", last_error());
+        }
+        assert_eq!(
+            dhcd_hierarchy_update_positions_f64(h64, far64.as_ptr(), nv - 1),
+            DHCD_ERR_LENGTH_MISMATCH
+        );
+        assert_eq!((count(h64), count(h32)), before, "nothing moved");
+
+        // A scene of one f32 and one f64 object.
+        let mut s = null_mut();
+        assert_eq!(dhcd_scene_new(DHCD_METHOD_AABB, 4, &mut s), DHCD_OK);
+        let (mut a, mut b) = (u64::MAX, u64::MAX);
+        let nt = m.triangle_count();
+        assert_eq!(
+            dhcd_scene_add(s, p32.as_ptr(), nv, t.as_ptr(), nt, 0, &mut a),
+            DHCD_OK
+        );
+        assert_eq!(
+            dhcd_scene_add_f64(s, p64.as_ptr(), nv, t.as_ptr(), nt, 0, &mut b),
+            DHCD_OK
+        );
+        let mut id = 7;
+        assert_eq!(
+            dhcd_scene_add_f64(s, big.as_ptr(), nv, t.as_ptr(), nt, 0, &mut id),
+            DHCD_ERR_INVALID_MESH
+        );
+        assert_eq!(id, 7, "no id on error");
+        let before = scene_contacts(s).0;
+        assert!(!before.is_empty());
+        assert_eq!(
+            dhcd_scene_update_positions(s, b, far32.as_ptr(), nv),
+            DHCD_ERR_PRECISION
+        );
+        assert_eq!(
+            dhcd_scene_update_positions_f64(s, a, far64.as_ptr(), nv),
+            DHCD_ERR_PRECISION
+        );
+        assert_eq!(
+            dhcd_scene_update_positions_f64(s, 9, far64.as_ptr(), nv),
+            DHCD_ERR_UNKNOWN_OBJECT
+        );
+        // The batch calls take floats: an f64 object in them changes nothing.
+        let (ids, ptrs, counts) = ([a, b], [far32.as_ptr(), far32.as_ptr()], [nv, nv]);
+        assert_eq!(
+            dhcd_scene_update_many(s, ids.as_ptr(), ptrs.as_ptr(), counts.as_ptr(), 2, 2),
+            DHCD_ERR_PRECISION
+        );
+        assert!(last_error().contains("f64"), "{}", last_error());
+        assert_eq!(
+            scene_step(s, &ids, &ptrs, &counts, 1),
+            Err(DHCD_ERR_PRECISION)
+        );
+        assert_eq!(scene_contacts(s).0, before, "nothing moved");
+        // The right precision works.
+        assert_eq!(
+            dhcd_scene_update_positions_f64(s, b, far64.as_ptr(), nv),
+            DHCD_OK
+        );
+        assert!(scene_contacts(s).0.is_empty());
+        dhcd_scene_free(s);
+        for h in [h64, h32, other] {
+            dhcd_hierarchy_free(h);
+        }
+    }
+}
+
+/// A distance that is negative, NaN or infinite is `DHCD_ERR_INVALID_ARGUMENT` with the
+/// library's message, and the output is empty; 0 and -0 are distances.
+#[test]
+fn bad_distances_are_invalid_arguments() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let (ha, hb) = (new_h(DHCD_METHOD_DH, &m), new_h(DHCD_METHOD_DH, &m));
+    let (p, t) = flat(&m);
+    let mut s = null_mut();
+    // SAFETY: live handles; writable outputs.
+    unsafe {
+        assert_eq!(dhcd_scene_new(DHCD_METHOD_DH, 4, &mut s), DHCD_OK);
+        let mut id = 0;
+        let (nv, nt) = (m.vertex_count(), m.triangle_count());
+        assert_eq!(
+            dhcd_scene_add(s, p.as_ptr(), nv, t.as_ptr(), nt, 1, &mut id),
+            DHCD_OK
+        );
+        for d in [-1.0, -1e-300, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut out = no_proximity();
+            assert_eq!(
+                dhcd_proximity(ha, hb, d, 1, &mut out),
+                DHCD_ERR_INVALID_ARGUMENT
+            );
+            assert!(is_empty(&out));
+            assert!(
+                last_error().contains("is not a finite number >= 0"),
+                "{}",
+                last_error()
+            );
+            let mut out = no_proximity();
+            assert_eq!(
+                dhcd_self_proximity(ha, d, 2, &mut out),
+                DHCD_ERR_INVALID_ARGUMENT
+            );
+            assert!(is_empty(&out));
+            assert!(last_error().contains("distance"), "{}", last_error());
+            let mut out = DhcdSceneProximity {
+                edge_edge: garbage(),
+                ee_count: 5,
+                ..std::mem::zeroed()
+            };
+            assert_eq!(
+                dhcd_scene_proximity(s, d, 1, &mut out),
+                DHCD_ERR_INVALID_ARGUMENT
+            );
+            assert!(is_empty_scene(&out));
+            assert!(last_error().contains("distance"), "{}", last_error());
+        }
+        for d in [0.0, -0.0] {
+            let touching = c_proximity(ha, hb, d, 1);
+            assert!(!touching.vertex_face.is_empty(), "identical balls touch");
+            assert!(touching.vertex_face.iter().all(|x| x.distance_sq == 0.0));
+            c_self_proximity(ha, d, 1);
+        }
+        dhcd_scene_free(s);
+        dhcd_hierarchy_free(ha);
+        dhcd_hierarchy_free(hb);
+    }
+}
+
+/// Null handles or outputs, the same handle twice, kinds that differ, misaligned or null
+/// `double` arrays, thread counts out of range: error codes, and outputs left empty.
+#[test]
+fn proximity_and_f64_bad_arguments() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let (p, t) = flat(&m);
+    let p64: Vec<f64> = p.iter().map(|&x| f64::from(x)).collect();
+    let (nv, nt) = (m.vertex_count(), m.triangle_count());
+    let a = new_h(DHCD_METHOD_DH, &m);
+    let box_ = new_h(DHCD_METHOD_AABB, &m);
+    let bytes = [0u64; 16];
+    // SAFETY: every pointer is null, a live handle, or valid for its stated length (the
+    // misaligned one is rejected before it is read).
+    unsafe {
+        let odd = bytes.as_ptr().cast::<u8>().add(4).cast::<f64>();
+        let check = |rc: i32, code: i32, out: &DhcdProximity| {
+            assert_eq!(rc, code, "{}", last_error());
+            assert!(is_empty(out));
+        };
+        let mut out = no_proximity();
+        check(
+            dhcd_proximity(null_mut(), a, 0.1, 1, &mut out),
+            DHCD_ERR_NULL,
+            &out,
+        );
+        let mut out = no_proximity();
+        check(
+            dhcd_proximity(a, null_mut(), 0.1, 1, &mut out),
+            DHCD_ERR_NULL,
+            &out,
+        );
+        let mut out = no_proximity();
+        check(
+            dhcd_proximity(a, a, 0.1, 1, &mut out),
+            DHCD_ERR_INVALID_ARGUMENT,
+            &out,
+        );
+        assert!(last_error().contains("dhcd_self_proximity"));
+        let mut out = no_proximity();
+        check(
+            dhcd_proximity(a, box_, 0.1, 1, &mut out),
+            DHCD_ERR_WRONG_KIND,
+            &out,
+        );
+        let mut out = no_proximity();
+        check(
+            dhcd_proximity(a, box_, 0.1, u32::MAX, &mut out),
+            DHCD_ERR_INVALID_ARGUMENT,
+            &out,
+        );
+        let mut out = no_proximity();
+        check(
+            dhcd_self_proximity(a, 0.1, 4096, &mut out),
+            DHCD_ERR_INVALID_ARGUMENT,
+            &out,
+        );
+        let mut out = no_proximity();
+        check(
+            dhcd_self_proximity(null_mut(), 0.1, 1, &mut out),
+            DHCD_ERR_NULL,
+            &out,
+        );
+        assert_eq!(dhcd_proximity(a, box_, 0.1, 1, null_mut()), DHCD_ERR_NULL);
+        assert_eq!(dhcd_self_proximity(a, 0.1, 1, null_mut()), DHCD_ERR_NULL);
+        assert_eq!(
+            dhcd_scene_proximity(null_mut(), 0.1, 1, null_mut()),
+            DHCD_ERR_NULL
+        );
+        let mut sp = DhcdSceneProximity {
+            vertex_face: garbage(),
+            vf_count: 2,
+            ..std::mem::zeroed()
+        };
+        assert_eq!(
+            dhcd_scene_proximity(null_mut(), 0.1, 1, &mut sp),
+            DHCD_ERR_NULL
+        );
+        assert!(is_empty_scene(&sp));
+
+        // f64 builds and updates.
+        let mut h = garbage();
+        let rc = dhcd_hierarchy_new_f64(DHCD_METHOD_DH, 4, null(), nv, t.as_ptr(), nt, &mut h);
+        assert_eq!(rc, DHCD_ERR_NULL);
+        assert!(h.is_null() && last_error().contains("positions"));
+        let mut h = garbage();
+        let rc = dhcd_hierarchy_new_f64(DHCD_METHOD_DH, 4, odd, 1, t.as_ptr(), nt, &mut h);
+        assert_eq!(rc, DHCD_ERR_INVALID_ARGUMENT);
+        assert!(h.is_null() && last_error().contains("aligned"));
+        let mut h = garbage();
+        let rc = dhcd_hierarchy_new_f64(99, 4, p64.as_ptr(), nv, t.as_ptr(), nt, &mut h);
+        assert_eq!(rc, DHCD_ERR_INVALID_ARGUMENT);
+        assert!(h.is_null());
+        let rc = dhcd_hierarchy_new_f64(
+            DHCD_METHOD_DH,
+            4,
+            p64.as_ptr(),
+            nv,
+            t.as_ptr(),
+            nt,
+            null_mut(),
+        );
+        assert_eq!(rc, DHCD_ERR_NULL);
+        let rc = dhcd_hierarchy_new_f64(
+            DHCD_METHOD_DH,
+            4,
+            p64.as_ptr(),
+            usize::MAX / 4,
+            t.as_ptr(),
+            nt,
+            &mut h,
+        );
+        assert_eq!(rc, DHCD_ERR_INVALID_ARGUMENT);
+        assert_eq!(
+            dhcd_hierarchy_update_positions_f64(null_mut(), p64.as_ptr(), nv),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_hierarchy_update_positions_f64(a, null(), nv),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_hierarchy_update_positions_f64(a, odd, 1),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        let mut precision = -1;
+        assert_eq!(
+            dhcd_hierarchy_precision(null(), &mut precision),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(dhcd_hierarchy_precision(a, null_mut()), DHCD_ERR_NULL);
+        assert_eq!(precision, -1, "written only on success");
+
+        // Scene f64 calls.
+        let mut s = null_mut();
+        assert_eq!(dhcd_scene_new(DHCD_METHOD_DH, 4, &mut s), DHCD_OK);
+        let mut id = 5;
+        assert_eq!(
+            dhcd_scene_add_f64(null_mut(), p64.as_ptr(), nv, t.as_ptr(), nt, 0, &mut id),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_scene_add_f64(s, null(), nv, t.as_ptr(), nt, 0, &mut id),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_scene_add_f64(s, p64.as_ptr(), nv, null(), nt, 0, &mut id),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_scene_add_f64(s, p64.as_ptr(), nv, t.as_ptr(), nt, 0, null_mut()),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(id, 5);
+        assert_eq!(
+            dhcd_scene_add_f64(s, p64.as_ptr(), nv, t.as_ptr(), nt, 0, &mut id),
+            DHCD_OK
+        );
+        assert_eq!(id, 0, "failed adds used no id");
+        assert_eq!(
+            dhcd_scene_update_positions_f64(null_mut(), id, p64.as_ptr(), nv),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_scene_update_positions_f64(s, id, null(), nv),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_scene_update_positions_f64(s, id, odd, 1),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        assert_eq!(
+            dhcd_scene_update_positions_f64(s, id, p64.as_ptr(), nv + 1),
+            DHCD_ERR_LENGTH_MISMATCH
+        );
+        let mut sp = DhcdSceneProximity {
+            face_vertex: garbage(),
+            fv_count: 2,
+            ..std::mem::zeroed()
+        };
+        assert_eq!(
+            dhcd_scene_proximity(s, 0.1, u32::MAX, &mut sp),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        assert!(is_empty_scene(&sp));
+        dhcd_scene_free(s);
+        dhcd_hierarchy_free(a);
+        dhcd_hierarchy_free(box_);
+    }
+}
+
+/// Results with nothing in them have null arrays, and every free function takes them (and
+/// null, and a result twice).
+#[test]
+fn empty_proximity_results_free() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let far = Mesh::new(
+        translated(m.positions(), [10.0, 0.0, 0.0]),
+        m.triangles().to_vec(),
+    )
+    .unwrap();
+    let (a, b) = (
+        new_h(DHCD_METHOD_SPHERE, &m),
+        new_h(DHCD_METHOD_SPHERE, &far),
+    );
+    let (p, t) = flat(&m);
+    // SAFETY: live handles, writable outputs; results released once (then no-ops).
+    unsafe {
+        let mut out = no_proximity();
+        assert_eq!(dhcd_proximity(a, b, 0.5, 1, &mut out), DHCD_OK);
+        assert!(out.vf_count == 0 && out.fv_count == 0 && out.ee_count == 0);
+        assert!(out.vertex_face.is_null() && out.vf_distance_sq.is_null() && out.ee_type.is_null());
+        assert!(out.counters.bv_tests > 0, "counters are filled");
+        dhcd_proximity_free(&mut out);
+        assert!(is_empty(&out));
+        dhcd_proximity_free(&mut out);
+        dhcd_proximity_free(null_mut());
+        let mut zero: DhcdProximity = std::mem::zeroed();
+        dhcd_proximity_free(&mut zero);
+
+        let mut s = null_mut();
+        assert_eq!(dhcd_scene_new(DHCD_METHOD_SPHERE, 0, &mut s), DHCD_OK);
+        let mut sp: DhcdSceneProximity = std::mem::zeroed();
+        assert_eq!(
+            dhcd_scene_proximity(s, 0.5, 2, &mut sp),
+            DHCD_OK,
+            "an empty scene"
+        );
+        assert!(is_empty_scene(&sp));
+        let mut id = 0;
+        let (nv, nt) = (m.vertex_count(), m.triangle_count());
+        assert_eq!(
+            dhcd_scene_add(s, p.as_ptr(), nv, t.as_ptr(), nt, 0, &mut id),
+            DHCD_OK
+        );
+        assert_eq!(dhcd_scene_proximity(s, 0.5, 1, &mut sp), DHCD_OK);
+        assert!(is_empty_scene(&sp), "one object, self-collision off");
+        dhcd_scene_proximity_free(&mut sp);
+        dhcd_scene_proximity_free(&mut sp);
+        dhcd_scene_proximity_free(null_mut());
+        dhcd_scene_free(s);
+        dhcd_hierarchy_free(a);
+        dhcd_hierarchy_free(b);
+    }
+}
+
+/// The distance types' C numbers are the library's enums' (IPC's), in `ALL` order, and the
+/// header defines each of them.
+#[test]
+fn distance_type_numbers_are_the_library_enums() {
+    let header = include_str!("../../include/dhcd.h");
+    for (k, t) in PointTriangle::ALL.into_iter().enumerate() {
+        assert_eq!(t as usize, k);
+        let define = format!("#define DHCD_PT_{} {k}\n", t.ipc_name());
+        assert!(header.contains(&define), "{define}");
+    }
+    for (k, t) in EdgeEdge::ALL.into_iter().enumerate() {
+        assert_eq!(t as usize, k);
+        let define = format!("#define DHCD_EE_{} {k}\n", t.ipc_name());
+        assert!(header.contains(&define), "{define}");
+    }
+    assert!(header.contains("#define DHCD_PT_P_T 6\n"));
+    assert!(header.contains("#define DHCD_EE_EA_EB 8\n"));
+    assert_eq!(DHCD_ERR_PRECISION, -10);
 }

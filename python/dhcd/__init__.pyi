@@ -2,15 +2,22 @@
 
 Build a hierarchy once from a rest pose, hand it new vertex positions every step (it is
 refitted lazily, never rebuilt) and query: every pair of faces whose closed triangles
-intersect, decided exactly for the float32 coordinates, as sorted numpy arrays of the
-caller's face indices.
+intersect, and every vertex-face and edge-edge pair within a distance (proximity), decided
+exactly for the coordinates as given, as sorted numpy arrays of the caller's indices.
 
-Inputs: ``vertices`` is an ``(n, 3)`` array of real numbers (float32 is read in place; other
-dtypes are converted once to float32, the library's precision), ``faces`` an ``(m, 3)``
-integer array of vertex indices. Bad input (wrong shape, a dtype that cannot convert, NaN or
-infinite coordinates, an index out of range, a face repeating a vertex, an empty mesh, an
-unknown method, a file that cannot be parsed) raises ``ValueError`` with the library's
-message; a file that cannot be read raises ``OSError`` (``FileNotFoundError`` if missing).
+Inputs: ``vertices`` is an ``(n, 3)`` array of real numbers, ``faces`` an ``(m, 3)`` integer
+array of vertex indices. Precision follows the vertices' dtype (numpy's:
+``numpy.asarray(vertices).dtype``, so a list of Python floats is float64): float64 builds an
+``"f64"`` hierarchy, exact for the doubles (never rounded to float32); float32 and every
+other real dtype (integers, float16, longdouble) an ``"f32"`` one (others converted once to
+float32). Updates must then be of the same float type: float32 for ``"f32"``, float64 for
+``"f64"``; the other raises ``ValueError`` (mismatched precision) and changes nothing, and
+other real dtypes are converted to the hierarchy's precision. Bad input (wrong shape, a dtype
+that cannot convert, NaN or infinite coordinates, float64 coordinates beyond float32's range
+(bounds are float32), an index out of range, a face repeating a vertex, an empty mesh, an
+unknown method, a negative, NaN or infinite distance, a file that cannot be parsed) raises
+``ValueError`` with the library's message; a file that cannot be read raises ``OSError``
+(``FileNotFoundError`` if missing).
 
 Threads: queries and updates release the GIL, so Python threads may query different objects
 at the same time. One object used by two threads at once raises ``RuntimeError`` (it is
@@ -23,6 +30,7 @@ from typing import (
     Any,
     Dict,
     Iterable,
+    List,
     Literal,
     Mapping,
     Optional,
@@ -36,14 +44,32 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "EDGE_EDGE_TYPES",
+    "POINT_TRIANGLE_TYPES",
     "CollisionManager",
     "Contacts",
     "Hierarchy",
+    "Proximity",
     "Scene",
     "collide",
     "contact_segments",
     "load_mesh",
+    "proximity",
+    "self_proximity",
 ]
+
+POINT_TRIANGLE_TYPES: List[str]
+"""IPC's names of the point-triangle distance types, indexed by the numbers in
+``Proximity.vf_type`` / ``fv_type``: ``["P_T0", "P_T1", "P_T2", "P_E0", "P_E1", "P_E2",
+"P_T"]`` (closest to a corner, an open edge (edge ``i`` joins corners ``i`` and ``i + 1``),
+the open face)."""
+
+EDGE_EDGE_TYPES: List[str]
+"""IPC's names of the edge-edge distance types, indexed by the numbers in
+``Proximity.ee_type``: ``["EA0_EB0", "EA0_EB1", "EA1_EB0", "EA1_EB1", "EA_EB0", "EA_EB1",
+"EA0_EB", "EA1_EB", "EA_EB"]`` (``EA0`` the end ``a0``, ``EA`` the open edge ``a``)."""
+
+Precision = Literal["f32", "f64"]
 
 Method = Literal["dh", "sphere", "aabb", "sbv"]
 """Bounding-volume kind: ``"dh"`` (Distance Hierarchy, 8-byte nodes), ``"sphere"`` (16
@@ -70,8 +96,58 @@ class Contacts:
     def __len__(self) -> int:
         """The number of pairs."""
 
+class Proximity:
+    """The result of a proximity query: every pair of features within the distance, each
+    list sorted by its rows, with its squared distance and IPC's distance type (a number:
+    ``POINT_TRIANGLE_TYPES`` / ``EDGE_EDGE_TYPES`` name them). The decision "within ``d``"
+    is exact for the coordinates as given; the squared distance is within a few ulps.
+
+    From ``proximity(a, b, d)`` (``self_proximity`` likewise, ``face_vertex`` empty)::
+
+        vertex_face  (K, 2) [vertex of a, face of b]     (self: a face not containing it)
+        face_vertex  (K, 2) [face of a, vertex of b]
+        edge_edge    (K, 4) [a0, a1, b0, b1]             (a0 < a1, b0 < b1; self:
+                                                          (a0, a1) < (b0, b1), no shared vertex)
+
+    From ``Scene.proximity(d)``, rows with object ids (``object_a < object_b``, or ``==``
+    inside an object with self-collision on)::
+
+        vertex_face  (K, 4) [object_a, vertex, object_b, face]
+        face_vertex  (K, 4) [object_a, face, object_b, vertex]
+        edge_edge    (K, 6) [object_a, a0, a1, object_b, b0, b1]
+    """
+
+    @property
+    def vertex_face(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def vf_distance_sq(self) -> npt.NDArray[np.float64]:
+        """``(K,)`` squared distances of the ``vertex_face`` rows."""
+    @property
+    def vf_type(self) -> npt.NDArray[np.uint8]:
+        """``(K,)`` point-triangle types of the ``vertex_face`` rows."""
+    @property
+    def face_vertex(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def fv_distance_sq(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def fv_type(self) -> npt.NDArray[np.uint8]: ...
+    @property
+    def edge_edge(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def ee_distance_sq(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def ee_type(self) -> npt.NDArray[np.uint8]:
+        """``(K,)`` edge-edge types of the ``edge_edge`` rows."""
+    @property
+    def counters(self) -> Dict[str, int]:
+        """``bv_tests``, ``bv_updates`` as for contacts, ``prim_tests`` the feature pairs
+        given to the exact test, ``contacts`` the pairs reported."""
+    def __len__(self) -> int:
+        """The number of pairs of the three lists."""
+
 class Hierarchy:
-    """The bounding-volume hierarchy of one deformable mesh; ``vertices`` is its rest pose.
+    """The bounding-volume hierarchy of one deformable mesh; ``vertices`` is its rest pose
+    (float64: an ``"f64"`` hierarchy, otherwise ``"f32"``).
 
     ``levels``: ``None`` for the adaptive region tree (the default), or a fixed depth
     (the paper uses 5).
@@ -85,14 +161,18 @@ class Hierarchy:
         levels: Optional[int] = None,
     ) -> None: ...
     def update(self, vertices: Vertices) -> None:
-        """New positions of the mesh's vertices (same shape). The hierarchy is refitted
-        lazily by the next query, not rebuilt. On error nothing changes."""
+        """New positions of the mesh's vertices (same shape, the hierarchy's float type:
+        the other raises ``ValueError``). The hierarchy is refitted lazily by the next
+        query, not rebuilt. On error nothing changes."""
     def self_collide(self, threads: int = 1) -> Contacts:
         """Intersecting face pairs ``[i, j]``, ``i < j``, of this mesh; pairs sharing a
         vertex index are never reported."""
     @property
     def method(self) -> str:
         """``"dh"``, ``"sphere"`` or ``"aabb"``."""
+    @property
+    def precision(self) -> Precision:
+        """``"f32"`` or ``"f64"``: the float type the hierarchy was built from and takes."""
     @property
     def bytes_per_node(self) -> int:
         """Size of one node record: 8, 16 or 24."""
@@ -113,6 +193,15 @@ def contact_segments(
     self-contacts pass the same hierarchy twice. A pair that does not intersect in the
     current pose raises ``ValueError``."""
 
+def proximity(a: Hierarchy, b: Hierarchy, d: float, threads: int = 1) -> Proximity:
+    """Every vertex-face, face-vertex and edge-edge pair of ``a`` and ``b`` (different
+    hierarchies of the same method, either precision) whose closed features are within
+    distance ``d`` (finite, ``>= 0``), decided exactly."""
+
+def self_proximity(h: Hierarchy, d: float, threads: int = 1) -> Proximity:
+    """Every pair of one mesh within distance ``d``: a vertex and a face not containing
+    it, two edges sharing no vertex."""
+
 def load_mesh(
     path: Union[str, "os.PathLike[str]"],
     max_file_bytes: Optional[int] = None,
@@ -128,9 +217,11 @@ class Scene:
 
     def __init__(self, method: Method = "dh", levels: Optional[int] = None) -> None: ...
     def add(self, vertices: Vertices, faces: Faces, name: Optional[str] = None) -> int:
-        """Adds an object (self-collision off); returns its id."""
+        """Adds an object (self-collision off; float64 vertices make an ``"f64"`` object,
+        as ``Hierarchy``); returns its id. A scene may hold objects of both precisions."""
     def update(self, id: Union[int, str], vertices: Vertices) -> None:
-        """New vertex positions of an object; on error nothing changes."""
+        """New vertex positions of an object (its float type, as ``Hierarchy.update``); on
+        error nothing changes."""
     def update_many(
         self,
         updates: Updates,
@@ -138,10 +229,11 @@ class Scene:
     ) -> None:
         """New vertex positions of several objects in one call: ``{id: vertices}`` or
         ``[(id, vertices), ...]`` (ids or names, each object at most once; vertices as in
-        ``update``), applied in parallel with ``threads``. Every entry is checked before
-        any is applied: an unknown id, an object given twice, a wrong shape or vertex count,
-        a non-finite coordinate raise ``ValueError`` and nothing changes (an entry that is
-        not a pair raises ``TypeError``). The result equals one ``update`` per entry."""
+        ``update``), applied in parallel with ``threads`` (``"f64"`` objects one after the
+        other). Every entry is checked before any is applied: an unknown id, an object given
+        twice, a wrong shape, float type or vertex count, a non-finite coordinate raise
+        ``ValueError`` and nothing changes (an entry that is not a pair raises
+        ``TypeError``). The result equals one ``update`` per entry."""
     def step(
         self,
         updates: Updates,
@@ -156,6 +248,10 @@ class Scene:
     def contacts(self, threads: int = 1) -> Contacts:
         """Every contact: rows ``[object_a, face_a, object_b, face_b]``, sorted,
         ``object_a < object_b`` (``==`` for self-contacts, then ``face_a < face_b``)."""
+    def proximity(self, d: float, threads: int = 1) -> Proximity:
+        """Every vertex-face, face-vertex and edge-edge pair within distance ``d`` between
+        two objects, and inside each object with self-collision on: rows with object ids
+        (see ``Proximity``), sorted. Objects farther apart than ``d`` cost one box test."""
     def __len__(self) -> int: ...
 
 MeshLike = Union[Any, Tuple[Vertices, Faces]]

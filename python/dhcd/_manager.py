@@ -20,7 +20,8 @@ def _mesh_arrays(mesh):
 
 
 def _posed(vertices, transform):
-    """The vertices as float32 (the library's precision), moved by a (4, 4) transform."""
+    """The vertices as float32 (the manager's precision: the fast path), moved by a (4, 4)
+    transform."""
     if transform is None:
         return np.ascontiguousarray(vertices, dtype=np.float32)
     t = np.asarray(transform, dtype=np.float64)

@@ -3,17 +3,27 @@
 //! calls with the GIL released, numpy arrays out, library errors as `ValueError` (`OSError`
 //! for files that cannot be read).
 //!
-//! Copies: a C-contiguous float32 `(n, 3)` vertex array is read in place (the library then
-//! copies it once into its own vertex order); any other vertex array is first converted once
-//! into a float32 buffer by numpy. Faces are converted to `u32` once, at construction.
+//! Precision: a float64 vertex array builds an `f64` hierarchy (answers exact for the
+//! doubles), any other real array an `f32` one; an update must then be of the same float
+//! type (float32 for `f32`, float64 for `f64`: the other is a `ValueError`, never a silent
+//! rounding), and other real dtypes (integers, float16, ...) are converted to the
+//! hierarchy's precision.
+//!
+//! Copies: a C-contiguous `(n, 3)` vertex array of the hierarchy's float type is read in
+//! place (the library then copies it once into its own vertex order); any other vertex array
+//! is first converted once by numpy. Faces are converted to `u32` once, at construction.
 #![forbid(unsafe_code)]
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 
-use dhcd::{AnyHierarchy, Counters, Error, Mesh, Method, ObjectId, Options, Par, Workspace};
+use dhcd::distance::{EdgeEdge, PointTriangle};
+use dhcd::mesh::{check_positions, check_positions_f64};
+use dhcd::{
+    AnyHierarchy, Counters, Error, Mesh, Method, ObjectId, Options, Par, Precision, Workspace,
+};
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyString, PyTuple};
@@ -120,26 +130,99 @@ fn numeric_n3<'py>(
     Ok(arr)
 }
 
-/// Vertex positions: a float32 C-contiguous view of the caller's array when it is one, else a
-/// float32 copy made by numpy.
-struct Vertices<'py>(PyReadonlyArray2<'py, f32>);
+/// Vertex positions in a precision: a C-contiguous view of the caller's array when it is one
+/// of that float type, else a copy made by numpy.
+enum Vertices<'py> {
+    F32(PyReadonlyArray2<'py, f32>),
+    F64(PyReadonlyArray2<'py, f64>),
+}
+
+/// Borrowed positions of either precision.
+#[derive(Clone, Copy)]
+enum Positions<'a> {
+    F32(&'a [[f32; 3]]),
+    F64(&'a [[f64; 3]]),
+}
 
 impl<'py> Vertices<'py> {
+    /// The vertices of a new mesh: float64 arrays (any byte order) in `f64`, every other
+    /// real dtype in `f32` (float32 read as it is, the others converted).
     fn new(obj: &Bound<'py, PyAny>) -> PyResult<Self> {
         let arr = numeric_n3(obj, "vertices", REAL)?;
-        let np = obj.py().import("numpy")?;
-        // No copy if `arr` is already float32 and C-contiguous.
-        let arr = np.call_method1("ascontiguousarray", (arr, "float32"))?;
-        Ok(Self(arr.extract()?))
+        let precision = float_precision(&arr)?.unwrap_or(Precision::F32);
+        Self::convert(arr, precision)
     }
 
-    fn as_slice(&self) -> PyResult<&[[f32; 3]]> {
-        let flat = self
-            .0
-            .as_slice()
-            .map_err(|e| value_error(format!("vertices: {e}")))?;
-        Ok(bytemuck::cast_slice(flat))
+    /// New positions for a hierarchy or object of `precision`: a float32 or float64 array
+    /// of the other precision is the library's `PrecisionMismatch`; other real dtypes are
+    /// converted to `precision`.
+    fn update(obj: &Bound<'py, PyAny>, precision: Precision) -> PyResult<Self> {
+        let arr = numeric_n3(obj, "vertices", REAL)?;
+        match float_precision(&arr)? {
+            Some(got) if got != precision => Err(to_py(Error::PrecisionMismatch {
+                expected: precision,
+                got,
+            })),
+            _ => Self::convert(arr, precision),
+        }
     }
+
+    fn convert(arr: Bound<'py, PyAny>, precision: Precision) -> PyResult<Self> {
+        let np = arr.py().import("numpy")?;
+        // No copy if `arr` is already of that type (native byte order) and C-contiguous.
+        Ok(match precision {
+            Precision::F64 => Self::F64(
+                np.call_method1("ascontiguousarray", (arr, "float64"))?
+                    .extract()?,
+            ),
+            _ => Self::F32(
+                np.call_method1("ascontiguousarray", (arr, "float32"))?
+                    .extract()?,
+            ),
+        })
+    }
+
+    fn positions(&self) -> PyResult<Positions<'_>> {
+        let err = |e| value_error(format!("vertices: {e}"));
+        Ok(match self {
+            Self::F32(a) => Positions::F32(bytemuck::cast_slice(a.as_slice().map_err(err)?)),
+            Self::F64(a) => Positions::F64(bytemuck::cast_slice(a.as_slice().map_err(err)?)),
+        })
+    }
+}
+
+impl Positions<'_> {
+    /// A validated mesh of these positions (its precision theirs).
+    fn mesh(self, faces: Vec<[u32; 3]>) -> dhcd::Result<Mesh> {
+        match self {
+            Positions::F32(p) => Mesh::new(p.to_vec(), faces),
+            Positions::F64(p) => Mesh::new_f64(p.to_vec(), faces),
+        }
+    }
+}
+
+/// The precision of a float32 or float64 array (any byte order); `None` for other dtypes.
+fn float_precision(arr: &Bound<'_, PyAny>) -> PyResult<Option<Precision>> {
+    let dtype = arr.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    let size: usize = dtype.getattr("itemsize")?.extract()?;
+    Ok(match (kind.as_str(), size) {
+        ("f", 4) => Some(Precision::F32),
+        ("f", 8) => Some(Precision::F64),
+        _ => None,
+    })
+}
+
+/// A distance argument: a real number (its range is the library's to check); one beyond
+/// the `float` range is a `ValueError` like any other bad distance.
+fn distance_arg(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    obj.extract::<f64>().map_err(|e| {
+        if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()) {
+            value_error(format!("distance {obj} is out of range"))
+        } else {
+            e
+        }
+    })
 }
 
 /// Faces as `u32` triangles (negative or too large indices are errors here; indices beyond
@@ -246,6 +329,155 @@ impl Contacts {
     }
 }
 
+/// Rows of `N` indices, each with its squared distance and distance type.
+type Rows<const N: usize> = Vec<([u64; N], f64, u8)>;
+
+/// The three lists of a proximity result, as rows: vertex-face, face-vertex, edge-edge.
+type ProximityRows<const V: usize, const E: usize> = (Rows<V>, Rows<V>, Rows<E>, Counters);
+
+/// A pair query's result as rows (already sorted by the library).
+fn proximity_rows(p: dhcd::Proximity) -> ProximityRows<2, 4> {
+    let i = u64::from;
+    (
+        p.vertex_face
+            .iter()
+            .map(|x| ([i(x.vertex), i(x.triangle)], x.distance_sq, x.kind as u8))
+            .collect(),
+        p.face_vertex
+            .iter()
+            .map(|x| ([i(x.triangle), i(x.vertex)], x.distance_sq, x.kind as u8))
+            .collect(),
+        p.edge_edge
+            .iter()
+            .map(|x| {
+                let row = [i(x.a[0]), i(x.a[1]), i(x.b[0]), i(x.b[1])];
+                (row, x.distance_sq, x.kind as u8)
+            })
+            .collect(),
+        p.counters,
+    )
+}
+
+/// A scene's result flattened with object ids (as the C ABI's `DhcdSceneProximity`), each
+/// list sorted by its rows.
+fn scene_proximity_rows(p: dhcd::SceneProximity) -> ProximityRows<4, 6> {
+    let (mut vf, mut fv, mut ee) = (Vec::new(), Vec::new(), Vec::new());
+    let i = u64::from;
+    for pair in &p.per_pair {
+        let (a, b, q) = (pair.a.0, pair.b.0, &pair.proximity);
+        vf.extend(q.vertex_face.iter().map(|x| {
+            (
+                [a, i(x.vertex), b, i(x.triangle)],
+                x.distance_sq,
+                x.kind as u8,
+            )
+        }));
+        fv.extend(q.face_vertex.iter().map(|x| {
+            (
+                [a, i(x.triangle), b, i(x.vertex)],
+                x.distance_sq,
+                x.kind as u8,
+            )
+        }));
+        ee.extend(q.edge_edge.iter().map(|x| {
+            let row = [a, i(x.a[0]), i(x.a[1]), b, i(x.b[0]), i(x.b[1])];
+            (row, x.distance_sq, x.kind as u8)
+        }));
+    }
+    // Rows are unique (one per feature pair of one object pair): the order is total.
+    vf.sort_unstable_by_key(|r| r.0);
+    fv.sort_unstable_by_key(|r| r.0);
+    ee.sort_unstable_by_key(|r| r.0);
+    (vf, fv, ee, p.counters)
+}
+
+/// One list of a proximity result as numpy arrays: `(K, N)` int64 rows, `(K,)` float64
+/// squared distances, `(K,)` uint8 types.
+type Columns = (Py<PyArray2<i64>>, Py<PyArray1<f64>>, Py<PyArray1<u8>>);
+
+fn columns<const N: usize>(py: Python<'_>, rows: Rows<N>) -> PyResult<Columns> {
+    let k = rows.len();
+    let flat: Vec<i64> = rows.iter().flat_map(|r| r.0).map(|v| v as i64).collect();
+    let idx = Array2::from_shape_vec((k, N), flat)
+        .map_err(|e| value_error(format!("internal error: {e}")))?;
+    let dist: Vec<f64> = rows.iter().map(|r| r.1).collect();
+    let kind: Vec<u8> = rows.iter().map(|r| r.2).collect();
+    Ok((
+        idx.into_pyarray(py).unbind(),
+        dist.into_pyarray(py).unbind(),
+        kind.into_pyarray(py).unbind(),
+    ))
+}
+
+/// The result of a proximity query: every vertex-face, face-vertex and edge-edge pair within
+/// the distance, sorted, with squared distances and IPC's distance types (see the stub).
+#[pyclass(module = "dhcd", frozen)]
+struct Proximity {
+    #[pyo3(get)]
+    vertex_face: Py<PyArray2<i64>>,
+    #[pyo3(get)]
+    vf_distance_sq: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    vf_type: Py<PyArray1<u8>>,
+    #[pyo3(get)]
+    face_vertex: Py<PyArray2<i64>>,
+    #[pyo3(get)]
+    fv_distance_sq: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    fv_type: Py<PyArray1<u8>>,
+    #[pyo3(get)]
+    edge_edge: Py<PyArray2<i64>>,
+    #[pyo3(get)]
+    ee_distance_sq: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    ee_type: Py<PyArray1<u8>>,
+    #[pyo3(get)]
+    counters: Py<PyDict>,
+}
+
+impl Proximity {
+    fn new<const V: usize, const E: usize>(
+        py: Python<'_>,
+        (vf, fv, ee, c): ProximityRows<V, E>,
+    ) -> PyResult<Self> {
+        let (vertex_face, vf_distance_sq, vf_type) = columns(py, vf)?;
+        let (face_vertex, fv_distance_sq, fv_type) = columns(py, fv)?;
+        let (edge_edge, ee_distance_sq, ee_type) = columns(py, ee)?;
+        Ok(Self {
+            vertex_face,
+            vf_distance_sq,
+            vf_type,
+            face_vertex,
+            fv_distance_sq,
+            fv_type,
+            edge_edge,
+            ee_distance_sq,
+            ee_type,
+            counters: counters(py, c)?,
+        })
+    }
+
+    fn counts(&self, py: Python<'_>) -> [usize; 3] {
+        [&self.vertex_face, &self.face_vertex, &self.edge_edge].map(|a| a.bind(py).shape()[0])
+    }
+}
+
+#[pymethods]
+impl Proximity {
+    /// The number of pairs of the three lists.
+    fn __len__(&self, py: Python<'_>) -> usize {
+        self.counts(py).iter().sum()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let [vf, fv, ee] = self.counts(py);
+        Ok(format!(
+            "Proximity({vf} vertex-face, {fv} face-vertex, {ee} edge-edge pairs, counters={})",
+            self.counters.bind(py).repr()?
+        ))
+    }
+}
+
 /// The bounding-volume hierarchy of one deformable triangle mesh.
 #[pyclass(module = "dhcd")]
 struct Hierarchy {
@@ -268,12 +500,9 @@ impl Hierarchy {
         let options = self::options(levels)?;
         let v = Vertices::new(vertices)?;
         let f = self::faces(faces)?;
-        let positions = v.as_slice()?;
+        let positions = v.positions()?;
         let h = py
-            .detach(|| {
-                let mesh = Mesh::new(positions.to_vec(), f)?;
-                AnyHierarchy::new(m, &mesh, options)
-            })
+            .detach(|| AnyHierarchy::new(m, &positions.mesh(f)?, options))
             .map_err(to_py)?;
         Ok(Self {
             h,
@@ -281,14 +510,18 @@ impl Hierarchy {
         })
     }
 
-    /// New vertex positions (same shape); the hierarchy is refitted (lazily), not rebuilt.
+    /// New vertex positions (same shape, the hierarchy's float type); the hierarchy is
+    /// refitted (lazily), not rebuilt.
     fn update(&mut self, py: Python<'_>, vertices: &Bound<'_, PyAny>) -> PyResult<()> {
-        let v = Vertices::new(vertices)?;
-        let positions = v.as_slice()?;
+        let v = Vertices::update(vertices, self.h.precision())?;
+        let positions = v.positions()?;
         let h = &mut self.h;
-        py.detach(|| h.update_positions(positions))
-            .map(|_| ())
-            .map_err(to_py)
+        py.detach(|| match positions {
+            Positions::F32(p) => h.update_positions(p),
+            Positions::F64(p) => h.update_positions_f64(p),
+        })
+        .map(|_| ())
+        .map_err(to_py)
     }
 
     /// Intersecting face pairs `[i, j]`, `i < j`, of this mesh, sharing no vertex.
@@ -309,6 +542,12 @@ impl Hierarchy {
         self.h.method().name()
     }
 
+    /// `"f32"` or `"f64"`: the float type the hierarchy was built from and takes.
+    #[getter]
+    fn precision(&self) -> &'static str {
+        self.h.precision().name()
+    }
+
     #[getter]
     fn bytes_per_node(&self) -> usize {
         self.h.bytes_per_node()
@@ -326,8 +565,9 @@ impl Hierarchy {
 
     fn __repr__(&self) -> String {
         format!(
-            "Hierarchy(method={:?}, vertex_count={}, face_count={}, nodes={})",
+            "Hierarchy(method={:?}, precision={:?}, vertex_count={}, face_count={}, nodes={})",
             self.h.method().name(),
+            self.h.precision().name(),
             self.h.tree().vertex_total(),
             self.h.tree().triangle_total(),
             self.h.node_count()
@@ -382,6 +622,50 @@ fn contact_segments<'py>(
     Ok(arr.into_pyarray(py))
 }
 
+/// Every vertex-face, face-vertex and edge-edge pair of `a` and `b` within distance `d`.
+#[pyfunction]
+#[pyo3(signature = (a, b, d, threads = None), text_signature = "(a, b, d, threads=1)")]
+fn proximity(
+    py: Python<'_>,
+    a: &Bound<'_, Hierarchy>,
+    b: &Bound<'_, Hierarchy>,
+    d: &Bound<'_, PyAny>,
+    threads: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Proximity> {
+    let d = distance_arg(d)?;
+    let par = par(threads)?;
+    if a.is(b) {
+        return Err(value_error(
+            "proximity needs two different hierarchies (use self_proximity for one)".into(),
+        ));
+    }
+    let (mut a, mut b) = (a.try_borrow_mut()?, b.try_borrow_mut()?);
+    let (a, b) = (&mut *a, &mut *b);
+    let rows = py
+        .detach(|| Ok(proximity_rows(a.h.proximity(&b.h, d, &mut a.ws, par)?)))
+        .map_err(to_py)?;
+    Proximity::new(py, rows)
+}
+
+/// Every vertex-face and edge-edge pair of one mesh within distance `d`.
+#[pyfunction]
+#[pyo3(signature = (h, d, threads = None), text_signature = "(h, d, threads=1)")]
+fn self_proximity(
+    py: Python<'_>,
+    h: &Bound<'_, Hierarchy>,
+    d: &Bound<'_, PyAny>,
+    threads: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Proximity> {
+    let d = distance_arg(d)?;
+    let par = par(threads)?;
+    let mut h = h.try_borrow_mut()?;
+    let h = &mut *h;
+    let rows = py
+        .detach(|| Ok(proximity_rows(h.h.self_proximity(d, &mut h.ws, par)?)))
+        .map_err(to_py)?;
+    Proximity::new(py, rows)
+}
+
 /// `(vertices, faces)` as numpy arrays.
 type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<i64>>);
 
@@ -427,6 +711,8 @@ struct Scene {
     /// Names given to `add`, both ways; unique among the live objects.
     ids: HashMap<String, u64>,
     names: HashMap<u64, String>,
+    /// The precision of every live object (the library's scene does not report it).
+    precisions: HashMap<u64, Precision>,
 }
 
 impl Scene {
@@ -448,8 +734,14 @@ impl Scene {
         }
     }
 
+    /// The precision of a live object.
+    fn precision(&self, id: ObjectId) -> Precision {
+        self.precisions.get(&id.0).copied().unwrap_or_default()
+    }
+
     /// The entries of `update_many` or `step` (a mapping or an iterable of pairs): each
-    /// object and its vertex array, borrowed (alive, read-only) while the result lives.
+    /// object and its vertex array (in the object's precision), borrowed (alive, read-only)
+    /// while the result lives.
     fn updates<'py>(
         &self,
         updates: &Bound<'py, PyAny>,
@@ -461,20 +753,72 @@ impl Scene {
         let mut out = Vec::new();
         for (k, entry) in entries.try_iter()?.enumerate() {
             let (id, v) = update_pair(&entry?, k)?;
-            out.push((self.object(&id)?, Vertices::new(&v)?));
+            let id = self.object(&id)?;
+            out.push((id, Vertices::update(&v, self.precision(id))?));
         }
         Ok(out)
     }
 }
 
-/// One object's new positions, as the library takes them.
-type Update<'a> = (ObjectId, &'a [[f32; 3]]);
+/// One object's new positions.
+type Update<'a> = (ObjectId, Positions<'a>);
 
-/// The entries of [`Scene::updates`] as the library takes them.
+/// One object's new `f32` positions, as the library's batch calls take them.
+type Update32<'a> = (ObjectId, &'a [[f32; 3]]);
+
+/// The entries of [`Scene::updates`] as positions.
 fn as_updates<'a>(entries: &'a [(ObjectId, Vertices<'_>)]) -> PyResult<Vec<Update<'a>>> {
     entries
         .iter()
-        .map(|(id, v)| Ok((*id, v.as_slice()?)))
+        .map(|(id, v)| Ok((*id, v.positions()?)))
+        .collect()
+}
+
+/// `Scene::update_many` for entries of either precision (each already the precision of
+/// its object): every entry is checked before any is applied, so on error nothing changes.
+/// The library's batch update takes `f32` positions only; `f64` objects are then updated
+/// one by one (each `Scene::update_positions_f64` is one object's update, already checked).
+fn update_many(scene: &mut dhcd::Scene, updates: &[Update<'_>], par: Par) -> dhcd::Result<()> {
+    if let Some(f32s) = as_f32(updates) {
+        return scene.update_many(&f32s, par);
+    }
+    let f32s: Vec<Update32<'_>> = updates
+        .iter()
+        .filter_map(|&(id, p)| match p {
+            Positions::F32(p) => Some((id, p)),
+            Positions::F64(_) => None,
+        })
+        .collect();
+    let mut seen = HashSet::new();
+    for &(id, _) in updates {
+        if !seen.insert(id) {
+            return Err(Error::RepeatedObject(id.0));
+        }
+    }
+    for &(id, p) in updates {
+        let n = scene.tree(id)?.vertex_total();
+        match p {
+            Positions::F32(p) => check_positions(p, n)?,
+            Positions::F64(p) => check_positions_f64(p, n)?,
+        }
+    }
+    scene.update_many(&f32s, par)?;
+    for &(id, p) in updates {
+        if let Positions::F64(p) = p {
+            scene.update_positions_f64(id, p)?;
+        }
+    }
+    Ok(())
+}
+
+/// The entries as the library's batch calls take them, if all are `f32`.
+fn as_f32<'a>(updates: &[Update<'a>]) -> Option<Vec<Update32<'a>>> {
+    updates
+        .iter()
+        .map(|&(id, p)| match p {
+            Positions::F32(p) => Some((id, p)),
+            Positions::F64(_) => None,
+        })
         .collect()
 }
 
@@ -511,10 +855,12 @@ impl Scene {
             scene: dhcd::Scene::new(self::method(method)?, options(levels)?),
             ids: HashMap::new(),
             names: HashMap::new(),
+            precisions: HashMap::new(),
         })
     }
 
-    /// Adds an object (self-collision off); returns its id.
+    /// Adds an object (self-collision off; float64 vertices make an `f64` object); returns
+    /// its id.
     #[pyo3(signature = (vertices, faces, name = None))]
     fn add(
         &mut self,
@@ -530,11 +876,15 @@ impl Scene {
         }
         let v = Vertices::new(vertices)?;
         let f = self::faces(faces)?;
-        let positions = v.as_slice()?;
+        let positions = v.positions()?;
         let scene = &mut self.scene;
-        let id = py
-            .detach(|| scene.add(&Mesh::new(positions.to_vec(), f)?))
+        let (id, precision) = py
+            .detach(|| {
+                let mesh = positions.mesh(f)?;
+                Ok((scene.add(&mesh)?, mesh.precision()))
+            })
             .map_err(to_py)?;
+        self.precisions.insert(id.0, precision);
         if let Some(n) = name {
             self.ids.insert(n.clone(), id.0);
             self.names.insert(id.0, n);
@@ -550,11 +900,14 @@ impl Scene {
         vertices: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
         let id = self.object(id)?;
-        let v = Vertices::new(vertices)?;
-        let positions = v.as_slice()?;
+        let v = Vertices::update(vertices, self.precision(id))?;
+        let positions = v.positions()?;
         let scene = &mut self.scene;
-        py.detach(|| scene.update_positions(id, positions))
-            .map_err(to_py)
+        py.detach(|| match positions {
+            Positions::F32(p) => scene.update_positions(id, p),
+            Positions::F64(p) => scene.update_positions_f64(id, p),
+        })
+        .map_err(to_py)
     }
 
     /// New vertex positions of several objects at once: `updates` a mapping
@@ -573,7 +926,7 @@ impl Scene {
         let entries = self.updates(updates)?;
         let updates = as_updates(&entries)?;
         let scene = &mut self.scene;
-        py.detach(|| scene.update_many(&updates, par))
+        py.detach(|| update_many(scene, &updates, par))
             .map_err(to_py)
     }
 
@@ -594,7 +947,16 @@ impl Scene {
         let entries = self.updates(updates)?;
         let updates = as_updates(&entries)?;
         let scene = &mut self.scene;
-        let c = py.detach(|| scene.step(&updates, par)).map_err(to_py)?;
+        let c = py
+            .detach(|| match as_f32(&updates) {
+                // All f32: the library's step, in one trip to the thread pool.
+                Some(f32s) => scene.step(&f32s, par),
+                None => {
+                    update_many(scene, &updates, par)?;
+                    Ok(scene.contacts(par))
+                }
+            })
+            .map_err(to_py)?;
         Contacts::new(py, c.pairs, c.counters)
     }
 
@@ -602,6 +964,7 @@ impl Scene {
     fn remove(&mut self, id: &Bound<'_, PyAny>) -> PyResult<()> {
         let id = self.object(id)?;
         self.scene.remove(id).map_err(to_py)?;
+        self.precisions.remove(&id.0);
         if let Some(n) = self.names.remove(&id.0) {
             self.ids.remove(&n);
         }
@@ -627,6 +990,24 @@ impl Scene {
         Contacts::new(py, c.pairs, c.counters)
     }
 
+    /// Every vertex-face, face-vertex and edge-edge pair within distance `d` between two
+    /// objects and inside objects with self-collision on, rows with object ids, sorted.
+    #[pyo3(signature = (d, threads = None), text_signature = "(self, d, threads=1)")]
+    fn proximity(
+        &mut self,
+        py: Python<'_>,
+        d: &Bound<'_, PyAny>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Proximity> {
+        let d = distance_arg(d)?;
+        let par = par(threads)?;
+        let scene = &mut self.scene;
+        let rows = py
+            .detach(|| Ok(scene_proximity_rows(scene.proximity(d, par)?)))
+            .map_err(to_py)?;
+        Proximity::new(py, rows)
+    }
+
     fn __len__(&self) -> usize {
         self.scene.len()
     }
@@ -640,17 +1021,43 @@ impl Scene {
     }
 }
 
+/// IPC's names of the point-triangle distance types, indexed by their numbers (the
+/// `vf_type` / `fv_type` values).
+fn point_triangle_types() -> Vec<&'static str> {
+    let names: Vec<&str> = PointTriangle::ALL.iter().map(|t| t.ipc_name()).collect();
+    debug_assert!(PointTriangle::ALL
+        .iter()
+        .enumerate()
+        .all(|(k, &t)| t as usize == k));
+    names
+}
+
+/// IPC's names of the edge-edge distance types, indexed by their numbers (`ee_type`).
+fn edge_edge_types() -> Vec<&'static str> {
+    let names: Vec<&str> = EdgeEdge::ALL.iter().map(|t| t.ipc_name()).collect();
+    debug_assert!(EdgeEdge::ALL
+        .iter()
+        .enumerate()
+        .all(|(k, &t)| t as usize == k));
+    names
+}
+
 /// Collision detection between deformable triangle meshes (Distance Hierarchy, sphere and
 /// AABB hierarchies, exact contacts); the native part of the `dhcd` package.
 #[pymodule(name = "_dhcd")]
 mod dhcd_native {
     #[pymodule_export]
-    use super::{collide, contact_segments, load_mesh, Contacts, Hierarchy, Scene};
+    use super::{
+        collide, contact_segments, load_mesh, proximity, self_proximity, Contacts, Hierarchy,
+        Proximity, Scene,
+    };
 
     #[pymodule_init]
     fn init(m: &pyo3::Bound<'_, pyo3::types::PyModule>) -> pyo3::PyResult<()> {
         use pyo3::types::PyModuleMethods;
         let names: Vec<&str> = dhcd::Method::ALL.iter().map(|k| k.name()).collect();
-        m.add("METHODS", names)
+        m.add("METHODS", names)?;
+        m.add("POINT_TRIANGLE_TYPES", super::point_triangle_types())?;
+        m.add("EDGE_EDGE_TYPES", super::edge_edge_types())
     }
 }

@@ -90,14 +90,18 @@ def test_float64_int32_and_lists_are_accepted():
     va, fa = icosphere(1)
     vb = wave(va, 0.3, 0.05, (1.1, 0.0, 0.0))
     expected = brute_force_pairs(va, fa, vb, fa)
+    # float64 arrays and lists of Python floats (float64 to numpy) build f64 hierarchies; the
+    # float32 values are exact doubles, so the contacts are the same.
     a = dhcd.Hierarchy(va.astype(np.float64), fa.astype(np.int32))
     b = dhcd.Hierarchy(vb.tolist(), fa.astype(np.uint16).tolist())
+    assert a.precision == b.precision == "f64"
     np.testing.assert_array_equal(dhcd.collide(a, b).pairs, expected)
-    # A strided (non-contiguous) float32 view reads the same values.
-    wide = np.zeros((len(vb), 6), dtype=np.float32)
-    wide[:, ::2] = vb
-    b.update(wide[:, ::2])
-    np.testing.assert_array_equal(dhcd.collide(a, b).pairs, expected)
+    # A strided (non-contiguous) view of either float type reads the same values.
+    for h, dtype in [(b, np.float64), (dhcd.Hierarchy(va, fa), np.float32)]:
+        wide = np.zeros((len(vb), 6), dtype=dtype)
+        wide[:, ::2] = vb
+        h.update(wide[:, ::2])
+        np.testing.assert_array_equal(dhcd.collide(a, h).pairs, expected)
 
 
 def test_contact_segments_lie_on_both_triangles():

@@ -73,10 +73,10 @@ def test_update_many_equals_separate_updates():
                     updates = {k: poses[k] for k in moved}
                 elif step == 1:  # a list of pairs, by id and by name, in any order
                     updates = [(k if k % 2 else f"ball{k}", poses[k]) for k in moved]
-                elif step == 2:  # a generator of pairs; float64 and nested lists convert
-                    updates = ((k, poses[k].astype(np.float64)) for k in moved)
-                else:  # a dict by name, vertices as lists
-                    updates = {f"ball{k}": poses[k].tolist() for k in moved}
+                elif step == 2:  # a generator of pairs, strided float32 views
+                    updates = ((k, np.repeat(poses[k], 2, axis=0)[::2]) for k in moved)
+                else:  # a dict by name, vertices as lists of float32 rows
+                    updates = {f"ball{k}": list(poses[k]) for k in moved}
                 s.update_many(updates, threads=threads)
                 for k in set(range(n)) - set(moved):
                     s.update(k, poses[k])

@@ -69,8 +69,15 @@ def test_python_threads_query_different_objects_in_parallel():
     assert all(r == expected for r in results)
 
 
-def test_gil_is_released_and_shared_objects_are_guarded():
-    # A long self-collision query in one thread; the main thread, meanwhile, runs Python
+QUERIES = {
+    "self_collide": lambda h: h.self_collide(),
+    "self_proximity": lambda h: dhcd.self_proximity(h, 0.005),
+}
+
+
+@pytest.mark.parametrize("name", list(QUERIES))
+def test_gil_is_released_and_shared_objects_are_guarded(name):
+    # A long self-query in one thread; the main thread, meanwhile, runs Python
     # code and touches the same hierarchy: it can only do so if the query released the
     # GIL, and must then get an error (the hierarchy is in use), never a crash.
     rest, folded, faces = folded_grid(48)
@@ -81,7 +88,7 @@ def test_gil_is_released_and_shared_objects_are_guarded():
 
     def query():
         for _ in range(200):
-            h.self_collide()
+            QUERIES[name](h)
             if seen:
                 break
         done.set()
@@ -98,4 +105,4 @@ def test_gil_is_released_and_shared_objects_are_guarded():
     assert seen, "the main thread never ran while the query held the hierarchy"
     assert "borrow" in str(seen[0]).lower()
     # The hierarchy is intact.
-    assert len(h.self_collide().pairs) > 0
+    assert len(QUERIES[name](h)) > 0

@@ -1,4 +1,5 @@
-/* dhcd from C: build meshes, deform, collide, self-collide, a scene; check and print.
+/* dhcd from C: build meshes, deform, collide, self-collide, a scene, f64 hierarchies and
+ * proximity; check and print.
  * Exits non-zero on any mismatch. Built and run by capi/tests/c/run.sh. */
 #include <math.h>
 #include <stdio.h>
@@ -58,6 +59,33 @@ static int sorted2(const DhcdContacts *c) {
 static int same(const DhcdContacts *x, const DhcdContacts *y) {
   return x->count == y->count &&
          (x->count == 0 || memcmp(x->pairs, y->pairs, 2 * x->count * sizeof(uint32_t)) == 0);
+}
+
+/* Whether n elements of size `size` at x and y are equal (both NULL when n == 0). */
+static int same_array(const void *x, const void *y, size_t n, size_t size) {
+  return n == 0 ? x == NULL && y == NULL : memcmp(x, y, n * size) == 0;
+}
+
+static int same_proximity(const DhcdProximity *x, const DhcdProximity *y) {
+  return x->vf_count == y->vf_count && x->fv_count == y->fv_count &&
+         x->ee_count == y->ee_count &&
+         same_array(x->vertex_face, y->vertex_face, 2 * x->vf_count, sizeof(uint32_t)) &&
+         same_array(x->vf_distance_sq, y->vf_distance_sq, x->vf_count, sizeof(double)) &&
+         same_array(x->vf_type, y->vf_type, x->vf_count, 1) &&
+         same_array(x->face_vertex, y->face_vertex, 2 * x->fv_count, sizeof(uint32_t)) &&
+         same_array(x->fv_distance_sq, y->fv_distance_sq, x->fv_count, sizeof(double)) &&
+         same_array(x->fv_type, y->fv_type, x->fv_count, 1) &&
+         same_array(x->edge_edge, y->edge_edge, 4 * x->ee_count, sizeof(uint32_t)) &&
+         same_array(x->ee_distance_sq, y->ee_distance_sq, x->ee_count, sizeof(double)) &&
+         same_array(x->ee_type, y->ee_type, x->ee_count, 1) &&
+         memcmp(&x->counters, &y->counters, sizeof(DhcdCounters)) == 0;
+}
+
+/* The row of p->face_vertex that is [t, v], or -1. */
+static long find_face_vertex(const DhcdProximity *p, uint32_t t, uint32_t v) {
+  for (size_t k = 0; k < p->fv_count; k++)
+    if (p->face_vertex[2 * k] == t && p->face_vertex[2 * k + 1] == v) return (long)k;
+  return -1;
 }
 
 int main(void) {
@@ -241,6 +269,131 @@ int main(void) {
   dhcd_scene_contacts_free(&sc);
   dhcd_scene_free(scene);
   free(crossing);
+
+  /* 5. f64 hierarchies: triangle B's lowest corner 1e-9 above triangle A (in the plane
+   * z = 1, where a float's spacing is 1.2e-7). As doubles they do not touch; rounded to
+   * floats, B's corner would lie on A. Within 2e-9, B's corner is A's face's. */
+  const double da[9] = {0, 0, 1, 2, 0, 1, 0, 2, 1};
+  const double db[9] = {0.5, 0.5, 1 + 1e-9, 0.5, 0.5, 2, 0.2, 0.8, 2};
+  DhcdHierarchy *a64 = NULL, *b64 = NULL;
+  OK(dhcd_hierarchy_new_f64(DHCD_METHOD_DH, 0, da, 3, one, 1, &a64));
+  OK(dhcd_hierarchy_new_f64(DHCD_METHOD_DH, 0, db, 3, one, 1, &b64));
+  int precision = 0;
+  OK(dhcd_hierarchy_precision(a64, &precision));
+  CHECK(precision == DHCD_PRECISION_F64);
+  OK(dhcd_collide(a64, b64, 1, &c));
+  CHECK(c.count == 0);
+  dhcd_contacts_free(&c);
+  DhcdProximity px = {0};
+  OK(dhcd_proximity(a64, b64, 2e-9, 1, &px));
+  const double gap = (1 + 1e-9) - 1; /* exact in double */
+  CHECK(px.vf_count == 0 && px.ee_count == 0 && px.fv_count == 1);
+  CHECK(px.vertex_face == NULL && px.edge_edge == NULL);
+  if (px.fv_count == 1) {
+    CHECK(px.face_vertex[0] == 0 && px.face_vertex[1] == 0); /* A's triangle, B's vertex */
+    CHECK(px.fv_type[0] == DHCD_PT_P_T && px.fv_distance_sq[0] == gap * gap);
+  }
+  printf("f64 pair: no contact, %zu face-vertex pair within 2e-9 (distance^2 %g)\n",
+         px.fv_count, px.fv_count ? px.fv_distance_sq[0] : -1.0);
+  dhcd_proximity_free(&px);
+  CHECK(px.face_vertex == NULL && px.fv_count == 0);
+  CHECK(dhcd_proximity(a64, b64, -1.0, 1, &px) == DHCD_ERR_INVALID_ARGUMENT);
+  printf("expected error: %s\n", dhcd_last_error_message());
+  CHECK(dhcd_hierarchy_update_positions(b64, tb, 3) == DHCD_ERR_PRECISION);
+  printf("expected error: %s\n", dhcd_last_error_message());
+  /* B's corner 1e-9 below A's plane, in double: they cross. */
+  double down[9];
+  memcpy(down, db, sizeof down);
+  down[2] = 1 - 1e-9;
+  OK(dhcd_hierarchy_update_positions_f64(b64, down, 3));
+  OK(dhcd_collide(a64, b64, 1, &c));
+  CHECK(c.count == 1);
+  dhcd_contacts_free(&c);
+  dhcd_hierarchy_free(a64);
+  dhcd_hierarchy_free(b64);
+
+  /* 6. Self-proximity of an f64 mesh of two parallel grids 0.05 apart, within 0.1: every
+   * pair is within the distance, the same on 1 and 2 threads, and the pairs between the
+   * layers are exactly those of the pair query between the two grids (indices of the
+   * upper grid offset by nv and nt). */
+  const double dist = 0.1;
+  double *lower = malloc(3 * nv * sizeof(double)), *upper = malloc(3 * nv * sizeof(double));
+  double *layers = malloc(6 * nv * sizeof(double));
+  for (size_t k = 0; k < 3 * nv; k++) {
+    lower[k] = g[k];
+    upper[k] = k % 3 == 2 ? 0.05 : g[k];
+  }
+  memcpy(layers, lower, 3 * nv * sizeof(double));
+  memcpy(layers + 3 * nv, upper, 3 * nv * sizeof(double));
+  DhcdHierarchy *hl = NULL, *hu = NULL, *sheets = NULL;
+  OK(dhcd_hierarchy_new_f64(DHCD_METHOD_AABB, 4, lower, nv, gt, nt, &hl));
+  OK(dhcd_hierarchy_new_f64(DHCD_METHOD_AABB, 4, upper, nv, gt, nt, &hu));
+  OK(dhcd_hierarchy_new_f64(DHCD_METHOD_AABB, 4, layers, 2 * nv, bt, 2 * nt, &sheets));
+  DhcdProximity pair = {0}, self1 = {0}, self2 = {0};
+  OK(dhcd_proximity(hl, hu, dist, 1, &pair));
+  OK(dhcd_self_proximity(sheets, dist, 1, &self1));
+  OK(dhcd_self_proximity(sheets, dist, 2, &self2));
+  CHECK(same_proximity(&self1, &self2));
+  CHECK(pair.vf_count > 0 && pair.fv_count > 0 && pair.ee_count > 0);
+  CHECK(self1.vf_count > 0 && self1.ee_count > 0 && self1.fv_count == 0);
+  CHECK(self1.counters.contacts == self1.vf_count + self1.ee_count);
+  size_t vf_across = 0, fv_across = 0, ee_across = 0;
+  for (size_t k = 0; k < self1.vf_count; k++) {
+    const uint32_t v = self1.vertex_face[2 * k], t = self1.vertex_face[2 * k + 1];
+    const uint32_t *tri = bt + 3 * t;
+    CHECK(v != tri[0] && v != tri[1] && v != tri[2]);
+    CHECK(self1.vf_distance_sq[k] <= dist * dist * (1 + 1e-12));
+    CHECK(self1.vf_type[k] <= DHCD_PT_P_T);
+    if (v < nv && t >= nt) { /* a lower vertex, an upper triangle: the pair's vertex_face */
+      size_t j = vf_across++;
+      CHECK(j < pair.vf_count);
+      if (j < pair.vf_count) {
+        CHECK(pair.vertex_face[2 * j] == v && pair.vertex_face[2 * j + 1] == t - nt);
+        CHECK(pair.vf_distance_sq[j] == self1.vf_distance_sq[k]);
+        CHECK(pair.vf_type[j] == self1.vf_type[k]);
+      }
+    } else if (v >= nv && t < nt) { /* an upper vertex, a lower triangle: face_vertex */
+      long j = find_face_vertex(&pair, t, v - (uint32_t)nv);
+      fv_across++;
+      CHECK(j >= 0);
+      if (j >= 0) {
+        CHECK(pair.fv_distance_sq[j] == self1.vf_distance_sq[k]);
+        CHECK(pair.fv_type[j] == self1.vf_type[k]);
+      }
+    }
+  }
+  for (size_t k = 0; k < self1.ee_count; k++) {
+    const uint32_t *e = self1.edge_edge + 4 * k;
+    CHECK(e[0] < e[1] && e[2] < e[3] && (e[0] < e[2] || (e[0] == e[2] && e[1] < e[3])));
+    CHECK(e[0] != e[2] && e[0] != e[3] && e[1] != e[2] && e[1] != e[3]);
+    CHECK(self1.ee_distance_sq[k] <= dist * dist * (1 + 1e-12));
+    CHECK(self1.ee_type[k] <= DHCD_EE_EA_EB);
+    if (e[1] < nv && e[2] >= nv) { /* an edge of each layer */
+      size_t j = ee_across++;
+      CHECK(j < pair.ee_count);
+      if (j < pair.ee_count) {
+        const uint32_t *q = pair.edge_edge + 4 * j;
+        CHECK(q[0] == e[0] && q[1] == e[1] && q[2] + nv == e[2] && q[3] + nv == e[3]);
+        CHECK(pair.ee_distance_sq[j] == self1.ee_distance_sq[k]);
+        CHECK(pair.ee_type[j] == self1.ee_type[k]);
+      }
+    }
+  }
+  CHECK(vf_across == pair.vf_count && fv_across == pair.fv_count && ee_across == pair.ee_count);
+  printf("f64 self-proximity within %g: %zu vertex-face, %zu edge-edge pairs (%zu, %zu and %zu "
+         "between the layers, as the pair query)\n",
+         dist, self1.vf_count, self1.ee_count, vf_across, fv_across, ee_across);
+  dhcd_proximity_free(&pair);
+  dhcd_proximity_free(&self1);
+  dhcd_proximity_free(&self2);
+  dhcd_proximity_free(&self2); /* twice: no-op */
+  CHECK(self2.vertex_face == NULL && self2.vf_count == 0);
+  dhcd_hierarchy_free(hl);
+  dhcd_hierarchy_free(hu);
+  dhcd_hierarchy_free(sheets);
+  free(lower);
+  free(upper);
+  free(layers);
 
   dhcd_contacts_free(&first);
   free(g);
