@@ -10,8 +10,9 @@ use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
 use crate::mesh::{Mesh, Precision};
 use crate::par::Par;
 use crate::query::{
-    broad_phase, collide_with, narrow_phase, proximity_with, self_broad_phase, self_collide_with,
-    self_proximity_with, BroadPhase, Contacts, Proximity,
+    broad_phase, ccd_pair_with, collide_with, narrow_phase, proximity_with, self_broad_phase,
+    self_ccd_with, self_collide_with, self_proximity_with, BroadPhase, CcdQuery, Contacts, Impacts,
+    Motion, Proximity,
 };
 use crate::tree::RegionTree;
 use crate::walk::Workspace;
@@ -115,6 +116,33 @@ impl AnyHierarchy {
     /// [`self_proximity`](crate::self_proximity())).
     pub fn self_proximity(&self, d: f64, ws: &mut Workspace, par: Par) -> Result<Proximity> {
         each!(self, h => self_proximity_with(h, d, ws, par))
+    }
+
+    /// Colliding feature pairs between this object moving by `motion` and `other` moving by
+    /// `other_motion` over a step (see [`ccd_pair`](crate::ccd_pair())); an error if the
+    /// kinds differ or the input is invalid.
+    pub fn ccd_pair(
+        &self,
+        motion: Motion<'_>,
+        other: &AnyHierarchy,
+        other_motion: Motion<'_>,
+        query: &CcdQuery,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<Impacts> {
+        pairwise!(self, other, a, b => ccd_pair_with(a, motion, b, other_motion, query, ws, par)?)
+    }
+
+    /// Colliding feature pairs of this object moving by `motion` over a step (see
+    /// [`self_ccd`](crate::self_ccd())).
+    pub fn self_ccd(
+        &self,
+        motion: Motion<'_>,
+        query: &CcdQuery,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<Impacts> {
+        each!(self, h => self_ccd_with(h, motion, query, ws, par))
     }
 
     /// Intersection segments of contacts between `self` and `other` (see

@@ -56,8 +56,9 @@ pub use par::Par;
 pub use scene::{ObjectId, PairProximity, Scene, SceneContacts, SceneProximity};
 
 pub use query::{
-    broad_phase, collide, collide_with, narrow_phase, proximity, proximity_with, self_broad_phase,
-    self_collide, self_collide_with, self_proximity, self_proximity_with, BroadPhase, Contacts,
+    broad_phase, ccd_pair, ccd_pair_with, collide, collide_with, narrow_phase, proximity,
+    proximity_with, self_broad_phase, self_ccd, self_ccd_with, self_collide, self_collide_with,
+    self_proximity, self_proximity_with, BroadPhase, CcdMode, CcdQuery, Contacts, Impacts, Motion,
     Proximity,
 };
 pub use tree::RegionTree;

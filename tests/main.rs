@@ -3,6 +3,7 @@
 
 mod ccd_cases;
 mod ccd_frames;
+mod ccd_query;
 mod ccd_reference;
 mod ccd_samples;
 mod central;

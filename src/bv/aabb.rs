@@ -1,5 +1,6 @@
 //! Axis-aligned bounding boxes: min/max over the region's vertices (exact in f32).
 
+use super::swept::{self, Step};
 use super::{sealed, Bounds, BvKind, Method};
 use crate::hierarchy::Options;
 use crate::points::Points;
@@ -146,5 +147,55 @@ impl BvKind for Aabb {
 
     fn encloses(r: &AabbNode, _: &Points, q: [f64; 3]) -> bool {
         (0..3).all(|k| f64::from(r.min[k]) <= q[k] && q[k] <= f64::from(r.max[k]))
+    }
+
+    type Swept = Bounds<6>;
+    type SweptBlock<'a> = overlap::AabbSoa<'a>;
+
+    fn swept(tree: &RegionTree) -> Bounds<6> {
+        Bounds::new(tree)
+    }
+
+    #[inline]
+    fn swept_group<'a>(
+        swept: &'a Bounds<6>,
+        _: &AabbNodes,
+        tree: &RegionTree,
+        step: &Step,
+        g: usize,
+    ) -> (overlap::AabbSoa<'a>, bool) {
+        let (tile, fitted) = swept.group(tree, g, |n| swept::box_over_step(tree, step, n));
+        (overlap::AabbSoa::new(tile), fitted)
+    }
+
+    #[inline(always)]
+    fn swept_test<S: pulp::Simd>(
+        simd: S,
+        a: overlap::AabbSoa<'_>,
+        i: usize,
+        b: overlap::AabbSoa<'_>,
+        n: usize,
+        margin: f64,
+    ) -> u32 {
+        if margin == 0.0 {
+            Aabb::test(simd, a, i, b, n)
+        } else {
+            Aabb::test_within(simd, a, i, b, n, swept::f32_up(margin))
+        }
+    }
+
+    #[inline(always)]
+    fn swept_extent(a: overlap::AabbSoa<'_>, i: usize) -> f32 {
+        Aabb::extent(a, i)
+    }
+
+    fn swept_encloses(
+        swept: &Bounds<6>,
+        tree: &RegionTree,
+        n: usize,
+        _: f64,
+        point: [f64; 3],
+    ) -> Option<bool> {
+        Some(swept::box_encloses(swept.get(tree, n)?, point))
     }
 }

@@ -3,6 +3,7 @@
 //! whose radius is refitted after deformation. The
 //! centre moves with the mesh for free; only the radius is ever recomputed.
 
+use super::swept::{self, MovingBalls, Step};
 use super::{central, sealed, BvKind, Method};
 use super::{conservative_radius, conservative_sum, dist2_f64, exact_radius, Bounds};
 use crate::hierarchy::Options;
@@ -155,5 +156,53 @@ impl BvKind for Dh {
     fn encloses(r: &DhNode, p: &Points, point: [f64; 3]) -> bool {
         let rad = r.radius as f64;
         dist2_f64(p.get(r.vertex as usize), point) <= rad * rad
+    }
+
+    type Swept = MovingBalls;
+    type SweptBlock<'a> = overlap::MovingSphereSoa<'a>;
+
+    fn swept(tree: &RegionTree) -> MovingBalls {
+        MovingBalls::new(tree)
+    }
+
+    #[inline]
+    fn swept_group<'a>(
+        swept: &'a MovingBalls,
+        nodes: &DhNodes,
+        tree: &RegionTree,
+        step: &Step,
+        g: usize,
+    ) -> (overlap::MovingSphereSoa<'a>, bool) {
+        swept::ball_group(swept, tree, step, g, |n| {
+            let c = nodes.vertex[n] as usize;
+            (step.x0[c], step.x1[c])
+        })
+    }
+
+    #[inline(always)]
+    fn swept_test<S: pulp::Simd>(
+        simd: S,
+        a: overlap::MovingSphereSoa<'_>,
+        i: usize,
+        b: overlap::MovingSphereSoa<'_>,
+        n: usize,
+        margin: f64,
+    ) -> u32 {
+        swept::balls_test(simd, a, i, b, n, margin)
+    }
+
+    #[inline(always)]
+    fn swept_extent(a: overlap::MovingSphereSoa<'_>, i: usize) -> f32 {
+        swept::ball_extent(a, i)
+    }
+
+    fn swept_encloses(
+        swept: &MovingBalls,
+        tree: &RegionTree,
+        n: usize,
+        t: f64,
+        point: [f64; 3],
+    ) -> Option<bool> {
+        swept::ball_encloses(swept, tree, n, t, point)
     }
 }

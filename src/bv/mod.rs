@@ -7,9 +7,13 @@
 //! time; every kind is a row of the table in [`crate::kinds`].
 
 mod aabb;
+mod bounds;
 mod central;
 mod dh;
 mod sphere;
+pub(crate) mod swept;
+
+pub(crate) use bounds::Bounds;
 
 pub use aabb::{Aabb, AabbNode, AabbNodes};
 pub use dh::{Dh, DhNode, DhNodes};
@@ -20,8 +24,7 @@ pub use crate::kinds::Method;
 use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
-use dhcd_kernels::lazy::LazyTiles;
-use dhcd_kernels::Tile;
+use swept::Step;
 
 /// Relative inflation of every computed radius. Radii and overlap tests are evaluated in
 /// f32; each is off by a few ulps. Growing radii by 16 ulps keeps every sphere test
@@ -132,102 +135,43 @@ pub trait BvKind:
     /// Whether record `r` (its centres read from `p`) encloses `point` (checked in f64; for
     /// validation).
     fn encloses(r: &Self::Record, p: &Points, point: [f64; 3]) -> bool;
-}
 
-/// The lazily fitted buffers of a kind, grouped by sibling group.
-/// The lazily fitted bounds of one kind, `F` `f32` fields per node, one [`Tile`] per
-/// sibling group: the group's `F` fields over its padded slots (`tree.group_slots(g)`, its
-/// nodes first in order; see [`crate::tree::BLOCK`]), side by side in one buffer. This is
-/// the one place that knows the layout.
-#[derive(Clone, Debug)]
-pub(crate) struct Bounds<const F: usize> {
-    tiles: LazyTiles,
-}
-
-impl<const F: usize> Bounds<F> {
-    pub(crate) fn new(tree: &RegionTree) -> Self {
-        let groups = (0..tree.group_count())
-            .map(|g| {
-                let s = tree.group_slots(g);
-                F * s.start..F * s.end
-            })
-            .collect();
-        Self {
-            tiles: LazyTiles::new(F * tree.slot_count(), groups),
-        }
-    }
-
-    /// Group `g`'s tile, filled first with `fit(n)` for each of its nodes if stale.
-    #[inline]
-    pub(crate) fn group(
-        &self,
+    /// Every node's bound over a step ([`swept`]), fitted lazily per sibling group.
+    type Swept: Send + Sync;
+    /// One sibling group's bounds over a step, as the swept node test reads them.
+    type SweptBlock<'a>: Copy;
+    /// Unfitted bounds over a step for the nodes of `tree`.
+    fn swept(tree: &RegionTree) -> Self::Swept;
+    /// The bounds over `step` of sibling group `g`, fitted first if stale; whether this call
+    /// fitted it. `nodes` are the hierarchy's (DH reads its central vertices).
+    fn swept_group<'a>(
+        swept: &'a Self::Swept,
+        nodes: &Self::Nodes,
         tree: &RegionTree,
+        step: &Step,
         g: usize,
-        fit: impl Fn(usize) -> [f32; F],
-    ) -> (Tile<'_>, bool) {
-        let stride = tree.group_slots(g).len();
-        let (data, fitted) = self.tiles.get_or_fill(g, |tile| {
-            for (i, n) in tree.group_nodes(g).enumerate() {
-                for (f, v) in fit(n).into_iter().enumerate() {
-                    tile[f * stride + i] = v;
-                }
-            }
-        });
-        (Tile::new(data, stride), fitted)
-    }
-
-    #[inline]
-    pub(crate) fn is_current(&self, g: usize) -> bool {
-        self.tiles.is_current(g)
-    }
-
-    /// Node `n`'s fields if its group is current.
-    pub(crate) fn get(&self, tree: &RegionTree, n: usize) -> Option<[f32; F]> {
-        let g = tree.group_of(n);
-        let tile = self.tiles.get(g)?;
-        let (stride, i) = (tree.group_slots(g).len(), n - tree.group_nodes(g).start);
-        Some(std::array::from_fn(|f| tile[f * stride + i]))
-    }
-
-    pub(crate) fn invalidate(&mut self) {
-        self.tiles.invalidate();
-    }
-
-    /// Fits every stale group now, deepest groups first, with `fit(n, child)` for each node
-    /// (`child(c)` reads a child's fields: its group is deeper, so already current); returns
-    /// the number of nodes fitted.
-    pub(crate) fn refit_all(
-        &mut self,
+    ) -> (Self::SweptBlock<'a>, bool);
+    /// Bits of the first `n` entries of `b` whose bound comes within `margin` (finite,
+    /// `>= 0`) of entry `i`'s at some time of the step; conservative, symmetric.
+    fn swept_test<S: pulp::Simd>(
+        simd: S,
+        a: Self::SweptBlock<'_>,
+        i: usize,
+        b: Self::SweptBlock<'_>,
+        n: usize,
+        margin: f64,
+    ) -> u32;
+    /// A size of entry `i` of a swept block, to descend the larger bound of a pair.
+    fn swept_extent(a: Self::SweptBlock<'_>, i: usize) -> f32;
+    /// Whether node `n`'s fitted bound over the step encloses `point` at time `t` (checked
+    /// in f64, for validation); `None` if its group is not fitted.
+    fn swept_encloses(
+        swept: &Self::Swept,
         tree: &RegionTree,
-        fit: impl Fn(usize, &dyn Fn(usize) -> [f32; F]) -> [f32; F],
-    ) -> u64 {
-        let mut fitted = 0;
-        for g in (0..tree.group_count()).rev() {
-            if self.tiles.is_current(g) {
-                continue;
-            }
-            let values: Vec<[f32; F]> = {
-                let data: &[f32] = self.tiles.data_mut();
-                let child = |c: usize| {
-                    let g = tree.group_of(c);
-                    let s = tree.group_slots(g);
-                    let i = c - tree.group_nodes(g).start;
-                    std::array::from_fn(|f| data[F * s.start + f * s.len() + i])
-                };
-                tree.group_nodes(g).map(|n| fit(n, &child)).collect()
-            };
-            let s = tree.group_slots(g);
-            let tile = &mut self.tiles.data_mut()[F * s.start..F * s.end];
-            for (i, v) in values.iter().enumerate() {
-                for (f, &x) in v.iter().enumerate() {
-                    tile[f * s.len() + i] = x;
-                }
-            }
-            self.tiles.set_current(g);
-            fitted += values.len() as u64;
-        }
-        fitted
-    }
+        n: usize,
+        t: f64,
+        point: [f64; 3],
+    ) -> Option<bool>;
 }
 
 #[inline]

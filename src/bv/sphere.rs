@@ -1,6 +1,7 @@
 //! Sphere bounding volumes (the paper's SBV): centre = mean of the region's vertices,
 //! radius = largest distance from it. Refitting reads the region twice (mean, then radius).
 
+use super::swept::{self, MovingBalls, Step};
 use super::{conservative_radius, conservative_sum, dist2_f64, exact_radius, Bounds};
 use super::{sealed, BvKind, Method};
 use crate::hierarchy::Options;
@@ -148,6 +149,56 @@ impl BvKind for Sphere {
     fn encloses(r: &SphereNode, _: &Points, point: [f64; 3]) -> bool {
         let rad = r.radius as f64;
         dist2_f64(r.center, point) <= rad * rad
+    }
+
+    type Swept = MovingBalls;
+    type SweptBlock<'a> = overlap::MovingSphereSoa<'a>;
+
+    fn swept(tree: &RegionTree) -> MovingBalls {
+        MovingBalls::new(tree)
+    }
+
+    #[inline]
+    fn swept_group<'a>(
+        swept: &'a MovingBalls,
+        _: &SphereNodes,
+        tree: &RegionTree,
+        step: &Step,
+        g: usize,
+    ) -> (overlap::MovingSphereSoa<'a>, bool) {
+        swept::ball_group(swept, tree, step, g, |n| {
+            (
+                swept::mean(tree, &step.x0, n),
+                swept::mean(tree, &step.x1, n),
+            )
+        })
+    }
+
+    #[inline(always)]
+    fn swept_test<S: pulp::Simd>(
+        simd: S,
+        a: overlap::MovingSphereSoa<'_>,
+        i: usize,
+        b: overlap::MovingSphereSoa<'_>,
+        n: usize,
+        margin: f64,
+    ) -> u32 {
+        swept::balls_test(simd, a, i, b, n, margin)
+    }
+
+    #[inline(always)]
+    fn swept_extent(a: overlap::MovingSphereSoa<'_>, i: usize) -> f32 {
+        swept::ball_extent(a, i)
+    }
+
+    fn swept_encloses(
+        swept: &MovingBalls,
+        tree: &RegionTree,
+        n: usize,
+        t: f64,
+        point: [f64; 3],
+    ) -> Option<bool> {
+        swept::ball_encloses(swept, tree, n, t, point)
     }
 }
 

@@ -30,7 +30,8 @@ mod predicates;
 mod tritri;
 
 pub use oracle::{
-    brute_force_pairs, brute_force_proximity, brute_force_self_pairs, brute_force_self_proximity,
+    brute_force_ccd, brute_force_pairs, brute_force_proximity, brute_force_self_ccd,
+    brute_force_self_pairs, brute_force_self_proximity,
 };
 
 /// Whether the closed triangles share at least one point, decided exactly for the f32 inputs.

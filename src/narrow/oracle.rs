@@ -197,6 +197,140 @@ pub fn brute_force_self_proximity(m: &Mesh, d: f64) -> crate::query::Proximity {
     out
 }
 
+/// Every colliding vertex-triangle and edge-edge pair of meshes `a` and `b` over a step,
+/// by testing every pair with [`crate::ccd`]: the reference of [`crate::ccd_pair`] (the
+/// meshes give the triangles; the motions the positions; `toi` the least time).
+pub fn brute_force_ccd(
+    a: &Mesh,
+    am: crate::query::Motion<'_>,
+    b: &Mesh,
+    bm: crate::query::Motion<'_>,
+    options: &crate::ccd::CcdOptions,
+) -> crate::query::Impacts {
+    use crate::ccd::{edge_edge, vertex_face};
+    use crate::query::{EdgeImpact, FaceImpact, Impacts, VertexImpact};
+    let mut out = Impacts::default();
+    let vf = |vm: &crate::query::Motion<'_>, v: u32, tm: &crate::query::Motion<'_>, t: [u32; 3]| {
+        let x0 = [
+            vm.x0[v as usize],
+            tm.x0[t[0] as usize],
+            tm.x0[t[1] as usize],
+            tm.x0[t[2] as usize],
+        ];
+        let x1 = [
+            vm.x1[v as usize],
+            tm.x1[t[0] as usize],
+            tm.x1[t[1] as usize],
+            tm.x1[t[2] as usize],
+        ];
+        vertex_face(&x0, &x1, options)
+    };
+    for v in used_vertices(a) {
+        for (t, &corners) in b.triangles().iter().enumerate() {
+            if let Some(toi) = vf(&am, v, &bm, corners) {
+                out.vertex_face.push(VertexImpact {
+                    vertex: v,
+                    triangle: t as u32,
+                    toi,
+                });
+            }
+        }
+    }
+    for (t, &corners) in a.triangles().iter().enumerate() {
+        for v in used_vertices(b) {
+            if let Some(toi) = vf(&bm, v, &am, corners) {
+                out.face_vertex.push(FaceImpact {
+                    triangle: t as u32,
+                    vertex: v,
+                    toi,
+                });
+            }
+        }
+    }
+    for ea in unique_edges(a) {
+        for eb in unique_edges(b) {
+            let x0 = [
+                am.x0[ea[0] as usize],
+                am.x0[ea[1] as usize],
+                bm.x0[eb[0] as usize],
+                bm.x0[eb[1] as usize],
+            ];
+            let x1 = [
+                am.x1[ea[0] as usize],
+                am.x1[ea[1] as usize],
+                bm.x1[eb[0] as usize],
+                bm.x1[eb[1] as usize],
+            ];
+            if let Some(toi) = edge_edge(&x0, &x1, options) {
+                out.edge_edge.push(EdgeImpact { a: ea, b: eb, toi });
+            }
+        }
+    }
+    finish_impacts(&mut out);
+    out
+}
+
+/// [`brute_force_ccd`] of one mesh against itself: vertex-triangle pairs with the vertex not
+/// a corner, edge pairs sharing no vertex (`a < b`); the reference of [`crate::self_ccd`].
+pub fn brute_force_self_ccd(
+    m: &Mesh,
+    motion: crate::query::Motion<'_>,
+    options: &crate::ccd::CcdOptions,
+) -> crate::query::Impacts {
+    use crate::ccd::{edge_edge, vertex_face};
+    use crate::query::{EdgeImpact, Impacts, VertexImpact};
+    let (x0, x1) = (motion.x0, motion.x1);
+    let mut out = Impacts::default();
+    for v in used_vertices(m) {
+        for (t, corners) in m.triangles().iter().enumerate() {
+            if corners.contains(&v) {
+                continue;
+            }
+            let ids = [v, corners[0], corners[1], corners[2]];
+            let (p0, p1) = (ids.map(|i| x0[i as usize]), ids.map(|i| x1[i as usize]));
+            if let Some(toi) = vertex_face(&p0, &p1, options) {
+                out.vertex_face.push(VertexImpact {
+                    vertex: v,
+                    triangle: t as u32,
+                    toi,
+                });
+            }
+        }
+    }
+    let edges = unique_edges(m);
+    for (i, ea) in edges.iter().enumerate() {
+        for eb in &edges[i + 1..] {
+            if ea.iter().any(|v| eb.contains(v)) {
+                continue;
+            }
+            let ids = [ea[0], ea[1], eb[0], eb[1]];
+            let (p0, p1) = (ids.map(|i| x0[i as usize]), ids.map(|i| x1[i as usize]));
+            if let Some(toi) = edge_edge(&p0, &p1, options) {
+                out.edge_edge.push(EdgeImpact {
+                    a: *ea,
+                    b: *eb,
+                    toi,
+                });
+            }
+        }
+    }
+    finish_impacts(&mut out);
+    out
+}
+
+/// The earliest time and the count of an oracle's result (its lists are in order).
+fn finish_impacts(out: &mut crate::query::Impacts) {
+    out.toi = out
+        .vertex_face
+        .iter()
+        .map(|x| x.toi)
+        .chain(out.face_vertex.iter().map(|x| x.toi))
+        .chain(out.edge_edge.iter().map(|x| x.toi))
+        .reduce(f64::min);
+    out.counters.contacts =
+        (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
+}
+
 /// The vertices some triangle uses, ascending.
 fn used_vertices(m: &Mesh) -> Vec<u32> {
     let mut used = vec![false; m.vertex_count()];

@@ -5,14 +5,25 @@
 //!   the split of that query into [`broad_phase`] (overlapping leaf pairs) and
 //!   [`narrow_phase`] for calibration and benchmarks;
 //! - `proximity.rs`: every vertex-triangle and edge-edge pair within a distance
-//!   ([`proximity`], [`self_proximity`]), with distances and closest sub-features.
+//!   ([`proximity`], [`self_proximity`]), with distances and closest sub-features;
+//! - `ccd.rs`: continuous collision detection over a step ([`ccd_pair`], [`self_ccd`]): every
+//!   vertex-triangle and edge-edge pair that touches during the step with its time of
+//!   impact, or the earliest time, on the bounds of each region over the step;
+//! - `features.rs`: the feature boxes and their SIMD culling that proximity and CCD share.
 //!
 //! Queries on the current pose share [`Posed`]: two hierarchies' lazily fitted volumes and a
-//! node test ([`Overlap`], or [`Within`] a distance); they differ in the leaf action.
+//! node test ([`Overlap`], or [`Within`] a distance); they differ in the leaf action. CCD
+//! implements the walk's `Query` itself, on the bounds over a step.
 
+pub(crate) mod ccd;
 pub(crate) mod contacts;
+mod features;
 pub(crate) mod proximity;
 
+pub use ccd::{
+    ccd_pair, ccd_pair_with, self_ccd, self_ccd_with, CcdMode, CcdQuery, EdgeImpact, FaceImpact,
+    Impacts, Motion, VertexImpact,
+};
 pub use contacts::{
     broad_phase, collide, collide_with, narrow_phase, self_broad_phase, self_collide,
     self_collide_with, BroadPhase, Contacts,

@@ -18,6 +18,7 @@
 
 use pulp::Simd;
 
+use super::features::{grown, meet, meeting, ordered_edge, points_box, union_of};
 use super::{LeafAction, NodeTest, Posed, PosedQuery, Within};
 use crate::bv::BvKind;
 use crate::counters::Counters;
@@ -26,7 +27,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
 use crate::walk::{self, Workspace};
-use dhcd_kernels::overlap::{boxes_meet_with, BoxRows, MAX_BOX_ROW};
+use dhcd_kernels::overlap::{BoxRows, MAX_BOX_ROW};
 
 /// A vertex within the distance of a triangle: in a pair query, a vertex of the first
 /// hierarchy and a triangle of the second (see [`FaceVertex`] for the other way round); in a
@@ -163,59 +164,6 @@ struct Features {
 /// What a proximity walk task produces.
 struct FeatureOut {
     result: Proximity,
-}
-
-type Bounds = ([f32; 3], [f32; 3]);
-
-/// The union of the first `n` boxes of `rows` (empty: `+inf..-inf`).
-fn union_of(rows: &BoxRows, n: usize) -> Bounds {
-    let lo = |k: usize| rows[k][..n].iter().fold(f32::INFINITY, |m, &x| m.min(x));
-    let hi = |k: usize| {
-        rows[3 + k][..n]
-            .iter()
-            .fold(f32::NEG_INFINITY, |m, &x| m.max(x))
-    };
-    ([lo(0), lo(1), lo(2)], [hi(0), hi(1), hi(2)])
-}
-
-/// The bits of boxes `base..base + 64` of the first `n` of `rows` that meet `probe` (bit
-/// `j` for box `base + j`).
-#[inline(always)]
-fn meeting<S: Simd>(simd: S, probe: &Bounds, rows: &BoxRows, base: usize, n: usize) -> u64 {
-    let m = (n - base).min(MAX_BOX_ROW);
-    let part: BoxRows = std::array::from_fn(|f| &rows[f][base..]);
-    boxes_meet_with(simd, probe.0, probe.1, part, m)
-}
-
-/// Whether two closed boxes meet.
-#[inline(always)]
-fn meet(a: &Bounds, b: &Bounds) -> bool {
-    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
-}
-
-/// `b` grown by `m` along every axis, rounded outward.
-#[inline(always)]
-fn grown(b: &Bounds, m: f32) -> Bounds {
-    (
-        b.0.map(|x| (x - m).next_down()),
-        b.1.map(|x| (x + m).next_up()),
-    )
-}
-
-/// The closed box of points `p` (`f32` values of the hierarchy's positions), widened by an
-/// ulp when they are roundings of `f64` positions, so it holds the exact points too.
-#[inline(always)]
-fn points_box<const N: usize>(p: [[f32; 3]; N], rounded: bool) -> Bounds {
-    let mut b = (p[0], p[0]);
-    for q in &p[1..] {
-        b.0 = std::array::from_fn(|k| b.0[k].min(q[k]));
-        b.1 = std::array::from_fn(|k| b.1[k].max(q[k]));
-    }
-    if rounded {
-        (b.0.map(f32::next_down), b.1.map(f32::next_up))
-    } else {
-        b
-    }
 }
 
 /// One side of a leaf pair: a hierarchy and one of its leaves.
@@ -377,15 +325,6 @@ impl Features {
         let (ra, rb) = (la.h.leaf_edge_boxes(la.node), lb.h.leaf_edge_boxes(lb.node));
         let near = grown(&union_of(&rb, eb.len()), self.margin);
         let (oa, ob) = (la.h.tree().vert_order(), lb.h.tree().vert_order());
-        // Original indices, smaller first, and the internal ones in that order.
-        let ordered = |o: &[u32], [s, t]: [u32; 2]| {
-            let (os, ot) = (o[s as usize], o[t as usize]);
-            if os < ot {
-                ([os, ot], [s, t])
-            } else {
-                ([ot, os], [t, s])
-            }
-        };
         for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
             let mut near_bits = meeting(simd, &near, &ra, base_a, ea.len());
             while near_bits != 0 {
@@ -397,7 +336,7 @@ impl Features {
                     [ra[3][i], ra[4][i], ra[5][i]],
                 );
                 let probe = grown(&abox, self.margin);
-                let (a_ids, a_int) = ordered(oa, ea[i]);
+                let (a_ids, a_int) = ordered_edge(oa, ea[i]);
                 let pa = a_int.map(|v| la.h.position_f64(v as usize));
                 // A leaf with itself: only j > i.
                 let from = if same { i + 1 } else { 0 };
@@ -411,7 +350,7 @@ impl Features {
                             continue;
                         }
                         counters.prim_tests += 1;
-                        let (b_ids, b_int) = ordered(ob, eb[j]);
+                        let (b_ids, b_int) = ordered_edge(ob, eb[j]);
                         let pb = b_int.map(|v| lb.h.position_f64(v as usize));
                         // In a self query the smaller edge first; the exact test takes the
                         // endpoints in the reported order, so its type names them as reported.

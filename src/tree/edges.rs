@@ -59,7 +59,18 @@ impl LeafEdges {
     /// The own edges of the leaf of rank `r`.
     #[inline]
     pub(crate) fn of_rank(&self, r: usize) -> &[[u32; 2]] {
-        &self.edges[self.start[r] as usize..self.start[r + 1] as usize]
+        &self.edges[self.range_of_rank(r)]
+    }
+
+    /// Where the own edges of the leaf of rank `r` sit in [`LeafEdges::all`].
+    #[inline]
+    pub(crate) fn range_of_rank(&self, r: usize) -> std::ops::Range<usize> {
+        self.start[r] as usize..self.start[r + 1] as usize
+    }
+
+    /// Every unique edge, grouped by owner leaf in leaf-rank order.
+    pub(crate) fn all(&self) -> &[[u32; 2]] {
+        &self.edges
     }
 
     /// Every unique edge.

@@ -1,7 +1,8 @@
-//! `dhcd bench self FRAME...`, `dhcd bench collide --a FRAME... --b FRAME...` and
-//! `dhcd bench proximity FRAME... (--distance D | --relative R)`: the microbenchmark users
-//! run on their own meshes. Builds once on the first frame, then
-//! cycles `update_positions` through the frames, timing each step (update + query); reports
+//! `dhcd bench self FRAME...`, `dhcd bench collide --a FRAME... --b FRAME...`,
+//! `dhcd bench proximity FRAME... (--distance D | --relative R)` and
+//! `dhcd bench ccd FRAME...`: the microbenchmark users run on their own meshes. Builds once
+//! on the first frame, then cycles `update_positions` through the frames, timing each step
+//! (update + query; for CCD, the query over the step from each frame to the next); reports
 //! the build time, the median and least step time over all steps and per frame (frames of
 //! different work make the overall median fall between them), and each frame's contacts and
 //! counters.
@@ -10,9 +11,13 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use dhcd::error::escaped_path;
-use dhcd::{AnyHierarchy, CentralVertex, Counters, Mesh, Method, Options, Par, Workspace};
+use dhcd::{
+    AnyHierarchy, CcdMode, CcdQuery, CentralVertex, Counters, Mesh, Method, Motion, Options, Par,
+    Workspace,
+};
 use serde_json::json;
 
+use super::ccd::f64_positions;
 use super::input::{update, InputArgs};
 
 /// Most passes over the frames (`--repeat`): a typo must not start a day-long run.
@@ -52,6 +57,21 @@ enum What {
         /// default contact distance is 1e-3).
         #[arg(long)]
         relative: Option<f64>,
+        #[command(flatten)]
+        opts: Opts,
+    },
+    /// Continuous collision detection of one deforming mesh: step k goes from frame k to
+    /// frame k + 1 (coordinates read in f64; at least two frames).
+    Ccd {
+        /// The poses (OBJ, STL or PLY), in order.
+        #[arg(required = true, num_args = 2..)]
+        frames: Vec<PathBuf>,
+        /// Pairs collide when they come within this distance.
+        #[arg(long, default_value_t = 0.0)]
+        min_distance: f64,
+        /// Only the earliest time of impact of each step.
+        #[arg(long)]
+        earliest: bool,
         #[command(flatten)]
         opts: Opts,
     },
@@ -116,7 +136,8 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     let opts = match &args.what {
         What::SelfCollide { opts, .. }
         | What::Collide { opts, .. }
-        | What::Proximity { opts, .. } => opts,
+        | What::Proximity { opts, .. }
+        | What::Ccd { opts, .. } => opts,
     };
     let methods: Vec<Method> = if opts.method.eq_ignore_ascii_case("all") {
         Method::ALL.to_vec()
@@ -145,14 +166,40 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
             return Err(format!("{name} must be a finite number >= 0, got {x}"));
         }
     }
-    let (a, b) = match &args.what {
-        What::SelfCollide { frames, .. } | What::Proximity { frames, .. } => {
-            (load_frames(&opts.input, frames)?, None)
+    // CCD: its options, f64 input, and no broad-phase-only mode.
+    let ccd = match &args.what {
+        What::Ccd {
+            min_distance,
+            earliest,
+            ..
+        } => {
+            if opts.broad_only {
+                return Err("--broad-only is not available for ccd".into());
+            }
+            let mode = if *earliest {
+                CcdMode::Earliest
+            } else {
+                CcdMode::All
+            };
+            let q = CcdQuery {
+                mode,
+                ..CcdQuery::default()
+            }
+            .with_min_distance(*min_distance);
+            q.options.validate().map_err(|e| e.to_string())?;
+            Some(q)
         }
-        What::Collide { a, b, .. } => (
-            load_frames(&opts.input, a)?,
-            Some(load_frames(&opts.input, b)?),
-        ),
+        _ => None,
+    };
+    let input = match ccd {
+        Some(_) => opts.input.f64_only("dhcd bench ccd")?,
+        None => opts.input.clone(),
+    };
+    let (a, b) = match &args.what {
+        What::SelfCollide { frames, .. }
+        | What::Proximity { frames, .. }
+        | What::Ccd { frames, .. } => (load_frames(&input, frames)?, None),
+        What::Collide { a, b, .. } => (load_frames(&input, a)?, Some(load_frames(&input, b)?)),
     };
     // The proximity distance, in the units of the mesh.
     let distance = match &args.what {
@@ -170,7 +217,10 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         central: opts.central,
         ..Options::default()
     };
-    let steps = a.len().max(b.as_ref().map_or(0, Vec::len));
+    let steps = match ccd {
+        Some(_) => a.len() - 1,
+        None => a.len().max(b.as_ref().map_or(0, Vec::len)),
+    };
     let mut runs = Vec::new();
     for &method in &methods {
         let t = Instant::now();
@@ -186,6 +236,15 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         for _ in 0..opts.repeat {
             for (k, counters) in frames.iter_mut().enumerate() {
                 let t = Instant::now();
+                if let Some(q) = &ccd {
+                    let motion = Motion::new(f64_positions(&a[k]), f64_positions(&a[k + 1]));
+                    *counters = ha
+                        .self_ccd(motion, q, &mut ws, par)
+                        .map_err(|e| e.to_string())?
+                        .counters;
+                    steps_ms.push(t.elapsed().as_secs_f64() * 1e3);
+                    continue;
+                }
                 update(&mut ha, &a[k % a.len()]).map_err(|e| e.to_string())?;
                 *counters = match (&mut hb, &b) {
                     (Some(hb), Some(b)) => {
@@ -220,7 +279,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     let out = if opts.json {
         let values: Vec<serde_json::Value> = runs
             .iter()
-            .map(|r| to_json(r, threads, opts, distance))
+            .map(|r| to_json(r, threads, opts, &input, distance, ccd.as_ref()))
             .collect();
         let v = if methods.len() == 1 {
             values.into_iter().next().unwrap_or_default()
@@ -229,7 +288,15 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         };
         format!("{v}\n")
     } else {
-        text(&runs, opts, threads, &a, b.as_deref(), distance)
+        text(
+            &runs,
+            opts,
+            threads,
+            &a,
+            b.as_deref(),
+            distance,
+            ccd.as_ref(),
+        )
     };
     super::emit(&out).map_err(|e| e.to_string())
 }
@@ -299,11 +366,18 @@ fn counters_json(c: &Counters) -> serde_json::Value {
 /// `{"method", "precision", "threads", "broad_only", ("distance",) "build_ms", "step_ms":
 /// {"median", "min"}, "frames": [{"contacts", "counters", "step_ms": {"median", "min"}}...]}`
 /// (`distance` for proximity; its `contacts` are the pairs within it).
-fn to_json(r: &Run, threads: usize, opts: &Opts, distance: Option<f64>) -> serde_json::Value {
+fn to_json(
+    r: &Run,
+    threads: usize,
+    opts: &Opts,
+    input: &InputArgs,
+    distance: Option<f64>,
+    ccd: Option<&CcdQuery>,
+) -> serde_json::Value {
     let (median, min) = median_min(&r.steps_ms);
     let mut v = json!({
         "method": r.method.name(),
-        "precision": opts.input.precision.name(),
+        "precision": input.precision().name(),
         "threads": threads,
         "broad_only": opts.broad_only,
         "build_ms": r.build_ms,
@@ -320,6 +394,10 @@ fn to_json(r: &Run, threads: usize, opts: &Opts, distance: Option<f64>) -> serde
     if let (Some(d), Some(o)) = (distance, v.as_object_mut()) {
         o.insert("distance".into(), d.into());
     }
+    if let (Some(q), Some(o)) = (ccd, v.as_object_mut()) {
+        o.insert("min_distance".into(), q.options.min_distance.into());
+        o.insert("earliest".into(), (q.mode == CcdMode::Earliest).into());
+    }
     v
 }
 
@@ -330,25 +408,35 @@ fn text(
     a: &[Mesh],
     b: Option<&[Mesh]>,
     distance: Option<f64>,
+    ccd: Option<&CcdQuery>,
 ) -> String {
     use std::fmt::Write;
     let mut s = String::new();
     let what = match (b, distance) {
+        _ if ccd.is_some() => format!(
+            "continuous collision detection{} of {} triangles (f64)",
+            if ccd.is_some_and(|q| q.mode == CcdMode::Earliest) {
+                " (earliest time)"
+            } else {
+                ""
+            },
+            a[0].triangle_count()
+        ),
         (None, Some(d)) => format!(
             "self-proximity within {d} of {} triangles ({})",
             a[0].triangle_count(),
-            opts.input.precision
+            opts.input.precision()
         ),
         (None, None) => format!(
             "self-collision of {} triangles ({})",
             a[0].triangle_count(),
-            opts.input.precision
+            opts.input.precision()
         ),
         (Some(b), _) => format!(
             "{} against {} triangles ({})",
             a[0].triangle_count(),
             b[0].triangle_count(),
-            opts.input.precision
+            opts.input.precision()
         ),
     };
     let _ = writeln!(

@@ -29,7 +29,7 @@ pub fn run(args: CollideArgs) -> dhcd::Result<()> {
     let levels = a.tree().levels().max(b.tree().levels());
     q.report(
         "contacts",
-        args.input.precision,
+        args.input.precision(),
         levels,
         &contacts.pairs,
         contacts.counters,

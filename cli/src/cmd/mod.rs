@@ -1,6 +1,7 @@
 //! Command-line front end. Every failure is one line on stderr and a non-zero exit code.
 
 mod bench;
+mod ccd;
 mod collide;
 mod experiment;
 mod input;
@@ -39,6 +40,10 @@ enum Command {
     Scene(scene::SceneArgs),
     /// Every vertex-triangle and edge-edge pair within a distance, in one mesh or between two.
     Proximity(proximity::ProximityArgs),
+    /// Continuous collision detection over a step: every vertex-triangle and edge-edge pair
+    /// of one mesh that touches while it moves from pose T0 to pose T1, with its time of
+    /// impact (f64, exact).
+    Ccd(ccd::CcdArgs),
     /// The paper's experiment (eight deforming pawns) and the cost-model report.
     Experiment(experiment::ExperimentArgs),
     /// Time the steps of a deforming mesh (or pair) given as frames: build once, then
@@ -65,6 +70,7 @@ pub fn run() -> i32 {
         Command::SelfCollide(args) => self_cmd::run(args).map_err(|e| e.to_string()),
         Command::Scene(args) => scene::run(args).map_err(|e| e.to_string()),
         Command::Proximity(args) => proximity::run(args).map_err(|e| e.to_string()),
+        Command::Ccd(args) => ccd::run(args),
         Command::Experiment(args) => experiment::run(args),
         Command::Bench(args) => bench::run(args),
     };

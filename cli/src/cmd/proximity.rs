@@ -64,7 +64,7 @@ fn write_json(out: &mut dyn Write, args: &ProximityArgs, p: &Proximity) -> std::
         out,
         "{{\"method\":\"{}\",\"precision\":\"{}\",\"distance\":{},\"vertex_face\":[",
         args.query.method.name(),
-        args.input.precision.name(),
+        args.input.precision().name(),
         num(args.distance)
     )?;
     for (k, x) in p.vertex_face.iter().enumerate() {
@@ -124,7 +124,7 @@ fn write_text(out: &mut dyn Write, args: &ProximityArgs, p: &Proximity) -> std::
         p.edge_edge.len(),
         args.distance,
         args.query.method,
-        args.input.precision,
+        args.input.precision(),
         c.bv_tests,
         c.prim_tests,
         c.bv_updates

@@ -48,7 +48,7 @@ pub fn run(args: SceneArgs) -> dhcd::Result<()> {
     }
     q.report(
         &what,
-        args.input.precision,
+        args.input.precision(),
         levels,
         &contacts.pairs,
         contacts.counters,

@@ -24,7 +24,7 @@ pub fn run(args: SelfArgs) -> dhcd::Result<()> {
     let contacts = h.self_collide(&mut Workspace::default(), Par::Seq);
     q.report(
         "self-contacts",
-        args.input.precision,
+        args.input.precision(),
         h.tree().levels(),
         &contacts.pairs,
         contacts.counters,

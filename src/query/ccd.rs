@@ -1,0 +1,713 @@
+//! Continuous collision detection over a step: every vertex-triangle and edge-edge pair
+//! that touches at some time of the step, with its time of impact, or only the earliest.
+//!
+//! Every vertex moves on the straight line from its position at t0 to its position at t1
+//! (`t` in `[0, 1]`). The walk is the one of every query, on the bounds of each region over
+//! the whole step ([`crate::bv::swept`]: the union box, or the moving ball of DH and
+//! spheres), tested with SIMD kernels; two regions whose features touch during the step
+//! have bounds that meet during the step, so every colliding pair lies in a leaf pair the
+//! walk reaches. As for proximity, each vertex and each edge belongs to one leaf (so each
+//! feature pair is met in one leaf pair, however many triangles share it), and each leaf
+//! pair first culls its feature pairs by their own boxes over the step (in `f32`, rounded
+//! outward, grown by the minimum distance) before the exact test of [`crate::ccd`]:
+//! whether the pair touches in `[0, t_max]` is exact for the `f64` input, and the time of
+//! impact is never later than the true one and at most [`crate::ccd::TOI_TOLERANCE`]
+//! earlier.
+//!
+//! **Modes** ([`CcdMode`]). `All` reports every colliding pair with its time of impact.
+//! `Earliest` is what a line search asks: the walk keeps the earliest time found so far
+//! (shared by all threads) and tests each later pair only up to it (plus twice the
+//! tolerance), so most pairs stop early. Its answer does not depend on the order or the
+//! threads: the pairs found within the tolerance of the best are tested again over the
+//! whole interval, and the result is the least of those times with the pairs that reach it.
+//! (Its work counters do depend on the order.)
+//!
+//! Results are in the caller's original indices, sorted, the same for every kind and thread
+//! count. `prim_tests` counts the feature pairs given to the exact test, `contacts` the
+//! pairs reported, `bv_updates` the bounds fitted over the step.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use pulp::Simd;
+
+use super::features::{grown, meet, meeting, ordered_edge, points_box_f64, union_of};
+use crate::bv::swept::{f32_up, Step};
+use crate::bv::BvKind;
+use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
+use crate::counters::Counters;
+use crate::error::Result;
+use crate::hierarchy::Hierarchy;
+use crate::mesh::check_positions_f64;
+use crate::par::Par;
+use crate::tree::RegionTree;
+use crate::walk::{self, Query, Side, Workspace};
+use dhcd_kernels::overlap::{BoxRows, MAX_BOX_ROW};
+
+/// One mesh's motion over a step: every vertex's position at t0 and at t1, in the mesh's
+/// vertex order (`f64`, finite and within the `f32` range, as [`crate::Mesh::new_f64`]
+/// asks).
+#[derive(Clone, Copy, Debug)]
+pub struct Motion<'a> {
+    pub x0: &'a [[f64; 3]],
+    pub x1: &'a [[f64; 3]],
+}
+
+impl<'a> Motion<'a> {
+    pub fn new(x0: &'a [[f64; 3]], x1: &'a [[f64; 3]]) -> Self {
+        Self { x0, x1 }
+    }
+}
+
+/// What a CCD query reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CcdMode {
+    /// Every colliding pair with its time of impact.
+    #[default]
+    All,
+    /// The earliest time of impact, with the pairs that reach it.
+    Earliest,
+}
+
+/// A CCD query: the narrow-phase options (time limit, minimum distance) and the mode.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CcdQuery {
+    pub options: CcdOptions,
+    pub mode: CcdMode,
+}
+
+impl CcdQuery {
+    /// Every colliding pair over the whole step, at distance 0.
+    pub fn all() -> Self {
+        Self::default()
+    }
+
+    /// The earliest time of impact over the whole step, at distance 0.
+    pub fn earliest() -> Self {
+        Self {
+            mode: CcdMode::Earliest,
+            ..Self::default()
+        }
+    }
+
+    /// Pairs collide when they come within `d` (checked by the query: finite, `>= 0`).
+    pub fn with_min_distance(mut self, d: f64) -> Self {
+        self.options.min_distance = d;
+        self
+    }
+
+    /// Only times in `[0, t_max]` count (checked by the query: `t_max` in `[0, 1]`).
+    pub fn with_t_max(mut self, t_max: f64) -> Self {
+        self.options.t_max = t_max;
+        self
+    }
+}
+
+/// A vertex that meets a triangle during the step: in a pair query, a vertex of the first
+/// mesh and a triangle of the second (see [`FaceImpact`] for the other way round); in a self
+/// query, a vertex and a triangle not containing it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexImpact {
+    pub vertex: u32,
+    pub triangle: u32,
+    /// Time of impact in `[0, t_max]`: never after the first contact, at most
+    /// [`TOI_TOLERANCE`] before it.
+    pub toi: f64,
+}
+
+/// A triangle of the first mesh met by a vertex of the second during the step (pair
+/// queries only).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceImpact {
+    pub triangle: u32,
+    pub vertex: u32,
+    pub toi: f64,
+}
+
+/// Two edges that meet during the step: `a` of the first mesh and `b` of the second (pair
+/// queries), or two edges of one mesh sharing no vertex with `a < b` (self queries); each
+/// edge is its two vertices' original indices, smaller first.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeImpact {
+    pub a: [u32; 2],
+    pub b: [u32; 2],
+    pub toi: f64,
+}
+
+/// Result of a CCD query, in the caller's original indices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Impacts {
+    /// Sorted by `(vertex, triangle)`.
+    pub vertex_face: Vec<VertexImpact>,
+    /// Sorted by `(triangle, vertex)`; empty in a self query.
+    pub face_vertex: Vec<FaceImpact>,
+    /// Sorted by `(a, b)`.
+    pub edge_edge: Vec<EdgeImpact>,
+    /// The earliest time of impact of the step (`None`: nothing collides).
+    pub toi: Option<f64>,
+    /// `bv_tests` (node pairs tested over the step), `bv_updates` (bounds fitted over the
+    /// step), `prim_tests` (feature pairs given to the exact test), `contacts` (pairs
+    /// reported).
+    pub counters: Counters,
+}
+
+/// Every vertex-triangle and edge-edge pair of `a` and `b` that collides during the step
+/// (`a_motion`, `b_motion`), on the calling thread. Errors: invalid options
+/// ([`crate::Error::InvalidTimeLimit`], [`crate::Error::InvalidMinDistance`]) or
+/// positions ([`crate::Error::WrongVertexCount`], [`crate::Error::NonFinite`]), nothing
+/// computed.
+pub fn ccd_pair<K: BvKind>(
+    a: &Hierarchy<K>,
+    a_motion: Motion<'_>,
+    b: &Hierarchy<K>,
+    b_motion: Motion<'_>,
+    query: &CcdQuery,
+) -> Result<Impacts> {
+    ccd_pair_with(
+        a,
+        a_motion,
+        b,
+        b_motion,
+        query,
+        &mut Workspace::default(),
+        Par::Seq,
+    )
+}
+
+/// [`ccd_pair`] with caller-owned scratch and a choice of parallelism. The result does not
+/// depend on `par`.
+pub fn ccd_pair_with<K: BvKind>(
+    a: &Hierarchy<K>,
+    a_motion: Motion<'_>,
+    b: &Hierarchy<K>,
+    b_motion: Motion<'_>,
+    query: &CcdQuery,
+    ws: &mut Workspace,
+    par: Par,
+) -> Result<Impacts> {
+    query.options.validate()?;
+    let sa = Swept::new(a, a_motion)?;
+    let sb = Swept::new(b, b_motion)?;
+    Ok(run(&sa, &sb, false, query, ws, par))
+}
+
+/// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
+/// (sharing no vertex) of one mesh that collides during the step, on the calling thread.
+pub fn self_ccd<K: BvKind>(
+    h: &Hierarchy<K>,
+    motion: Motion<'_>,
+    query: &CcdQuery,
+) -> Result<Impacts> {
+    self_ccd_with(h, motion, query, &mut Workspace::default(), Par::Seq)
+}
+
+/// [`self_ccd`] with caller-owned scratch and a choice of parallelism.
+pub fn self_ccd_with<K: BvKind>(
+    h: &Hierarchy<K>,
+    motion: Motion<'_>,
+    query: &CcdQuery,
+    ws: &mut Workspace,
+    par: Par,
+) -> Result<Impacts> {
+    query.options.validate()?;
+    let s = Swept::new(h, motion)?;
+    Ok(run(&s, &s, true, query, ws, par))
+}
+
+/// One hierarchy over a step: its positions at t0 and t1 (internal order), its node bounds
+/// over the step (fitted lazily by the walk), and the boxes over the step of its triangles
+/// (internal order) and own edges (leaf-edge order), as six rows each.
+pub(crate) struct Swept<'h, K: BvKind> {
+    h: &'h Hierarchy<K>,
+    step: Step,
+    bounds: K::Swept,
+    tri_rows: [Vec<f32>; 6],
+    edge_rows: [Vec<f32>; 6],
+}
+
+/// Six rows of boxes, one per point set.
+fn box_rows<const N: usize>(
+    sets: impl ExactSizeIterator<Item = [usize; N]>,
+    step: &Step,
+) -> [Vec<f32>; 6] {
+    let mut rows: [Vec<f32>; 6] = std::array::from_fn(|_| Vec::with_capacity(sets.len()));
+    for s in sets {
+        let mut p = [[0.0; 3]; 8];
+        for (k, &v) in s.iter().enumerate() {
+            p[2 * k] = step.x0[v];
+            p[2 * k + 1] = step.x1[v];
+        }
+        // The box of the 2N points: the unused entries repeat the first.
+        for k in 2 * N..8 {
+            p[k] = p[0];
+        }
+        let (lo, hi) = points_box_f64(p);
+        for k in 0..3 {
+            rows[k].push(lo[k]);
+            rows[3 + k].push(hi[k]);
+        }
+    }
+    rows
+}
+
+impl<'h, K: BvKind> Swept<'h, K> {
+    pub(crate) fn new(h: &'h Hierarchy<K>, motion: Motion<'_>) -> Result<Self> {
+        let tree = h.tree();
+        check_positions_f64(motion.x0, tree.vertex_total())?;
+        check_positions_f64(motion.x1, tree.vertex_total())?;
+        let step = Step::gather(tree, motion.x0, motion.x1);
+        let tri_rows = box_rows(
+            tree.triangles().iter().map(|t| t.map(|v| v as usize)),
+            &step,
+        );
+        let edge_rows = box_rows(
+            tree.leaf_edges()
+                .all()
+                .iter()
+                .map(|e| e.map(|v| v as usize)),
+            &step,
+        );
+        Ok(Self {
+            h,
+            bounds: K::swept(tree),
+            step,
+            tri_rows,
+            edge_rows,
+        })
+    }
+
+    fn tree(&self) -> &'h RegionTree {
+        self.h.tree()
+    }
+
+    /// The boxes over the step of leaf `leaf`'s triangles.
+    fn tri_boxes(&self, leaf: usize) -> BoxRows<'_> {
+        let r = self.tree().tri_range(leaf);
+        std::array::from_fn(|f| &self.tri_rows[f][r.clone()])
+    }
+
+    /// Leaf `leaf`'s own edges and their boxes over the step.
+    fn own_edges(&self, leaf: usize) -> (&'h [[u32; 2]], BoxRows<'_>) {
+        let tree = self.tree();
+        let rank = tree.leaf_rank(leaf).expect("a leaf");
+        let edges = tree.leaf_edges();
+        let r = edges.range_of_rank(rank);
+        (
+            edges.of_rank(rank),
+            std::array::from_fn(|f| &self.edge_rows[f][r.clone()]),
+        )
+    }
+}
+
+/// Twice the time-of-impact tolerance: in earliest mode a pair is tested up to the best
+/// time so far plus this, so every pair that can reach the final answer is found.
+const PRUNE_SLACK: f64 = 4.0 * TOI_TOLERANCE;
+
+/// The CCD walk: two hierarchies over a step, the exact test and the mode.
+struct SweptQuery<'s, 'h, K: BvKind> {
+    a: &'s Swept<'h, K>,
+    b: &'s Swept<'h, K>,
+    self_query: bool,
+    options: CcdOptions,
+    /// The minimum distance as an `f32` not below it: the feature boxes' growth.
+    margin: f32,
+    /// Earliest mode: the least time of impact found so far (`f64` bits; all are `>= 0`,
+    /// so their order is the integers').
+    best: Option<AtomicU64>,
+}
+
+#[derive(Default)]
+struct ImpactOut {
+    vertex_face: Vec<VertexImpact>,
+    face_vertex: Vec<FaceImpact>,
+    edge_edge: Vec<EdgeImpact>,
+}
+
+fn run<K: BvKind>(
+    a: &Swept<'_, K>,
+    b: &Swept<'_, K>,
+    self_query: bool,
+    query: &CcdQuery,
+    ws: &mut Workspace,
+    par: Par,
+) -> Impacts {
+    let q = SweptQuery {
+        a,
+        b,
+        self_query,
+        options: query.options,
+        margin: f32_up(query.options.min_distance),
+        best: (query.mode == CcdMode::Earliest).then(|| AtomicU64::new(f64::INFINITY.to_bits())),
+    };
+    let w = walk::walk(&q, ws, par);
+    let mut out = w.out;
+    if query.mode == CcdMode::Earliest {
+        q.settle_earliest(&mut out);
+    }
+    out.vertex_face
+        .sort_unstable_by_key(|x| (u64::from(x.vertex) << 32) | u64::from(x.triangle));
+    out.face_vertex
+        .sort_unstable_by_key(|x| (u64::from(x.triangle) << 32) | u64::from(x.vertex));
+    out.edge_edge.sort_unstable_by_key(|x| (x.a, x.b));
+    let toi = out
+        .vertex_face
+        .iter()
+        .map(|x| x.toi)
+        .chain(out.face_vertex.iter().map(|x| x.toi))
+        .chain(out.edge_edge.iter().map(|x| x.toi))
+        .reduce(f64::min);
+    let mut counters = w.counters;
+    counters.contacts =
+        (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
+    Impacts {
+        vertex_face: out.vertex_face,
+        face_vertex: out.face_vertex,
+        edge_edge: out.edge_edge,
+        toi,
+        counters,
+    }
+}
+
+impl<K: BvKind> SweptQuery<'_, '_, K> {
+    fn side(&self, side: Side) -> &Swept<'_, K> {
+        match side {
+            Side::A => self.a,
+            Side::B => self.b,
+        }
+    }
+
+    /// The options of the next exact test: in earliest mode, up to the best time so far
+    /// plus [`PRUNE_SLACK`].
+    #[inline(always)]
+    fn options_now(&self) -> CcdOptions {
+        let mut o = self.options;
+        if let Some(best) = &self.best {
+            let b = f64::from_bits(best.load(Ordering::Relaxed));
+            o.t_max = o.t_max.min((b + PRUNE_SLACK).next_up());
+        }
+        o
+    }
+
+    #[inline(always)]
+    fn found(&self, toi: f64) {
+        if let Some(best) = &self.best {
+            best.fetch_min(toi.to_bits(), Ordering::Relaxed);
+        }
+    }
+
+    /// Earliest mode, after the walk: every pair found within [`PRUNE_SLACK`] of the best is
+    /// tested again over the whole interval; the least of those times and the pairs reaching
+    /// it are the answer (the same whatever the order of the walk).
+    fn settle_earliest(&self, out: &mut ImpactOut) {
+        let best = out
+            .vertex_face
+            .iter()
+            .map(|x| x.toi)
+            .chain(out.face_vertex.iter().map(|x| x.toi))
+            .chain(out.edge_edge.iter().map(|x| x.toi))
+            .fold(f64::INFINITY, f64::min);
+        let near = |toi: f64| toi <= best + PRUNE_SLACK;
+        let (a, b) = (self.a, self.b);
+        let o = &self.options;
+        // Original -> internal indices of each side.
+        let [va, vb] = [a, b].map(|s| inverse(s.tree().vert_order()));
+        let [ta, tb] = [a, b].map(|s| inverse(s.tree().tri_order()));
+        let (va, vb, ta, tb) = (&va, &vb, &ta, &tb);
+        let vf = |v: u32, t: u32, a_has_vertex: bool| {
+            let (sv, st, iv, it) = if a_has_vertex {
+                (a, b, va, tb)
+            } else {
+                (b, a, vb, ta)
+            };
+            vertex_face_toi(sv, iv[v as usize] as usize, st, it[t as usize] as usize, o)
+        };
+        let mut vertex_face: Vec<VertexImpact> = Vec::new();
+        for x in out.vertex_face.iter().filter(|x| near(x.toi)) {
+            if let Some(toi) = vf(x.vertex, x.triangle, true) {
+                vertex_face.push(VertexImpact { toi, ..*x });
+            }
+        }
+        let mut face_vertex: Vec<FaceImpact> = Vec::new();
+        for x in out.face_vertex.iter().filter(|x| near(x.toi)) {
+            if let Some(toi) = vf(x.vertex, x.triangle, false) {
+                face_vertex.push(FaceImpact { toi, ..*x });
+            }
+        }
+        let mut edge_edge: Vec<EdgeImpact> = Vec::new();
+        for x in out.edge_edge.iter().filter(|x| near(x.toi)) {
+            // Pair queries: `a` is the first mesh's; self queries: both are one mesh's.
+            let pa = x.a.map(|v| a.step_at(va[v as usize] as usize));
+            let pb = x.b.map(|v| b.step_at(vb[v as usize] as usize));
+            if let Some(toi) = edge_edge_toi(pa, pb, o) {
+                edge_edge.push(EdgeImpact { toi, ..*x });
+            }
+        }
+        let least = vertex_face
+            .iter()
+            .map(|x| x.toi)
+            .chain(face_vertex.iter().map(|x| x.toi))
+            .chain(edge_edge.iter().map(|x| x.toi))
+            .fold(f64::INFINITY, f64::min);
+        vertex_face.retain(|x| x.toi == least);
+        face_vertex.retain(|x| x.toi == least);
+        edge_edge.retain(|x| x.toi == least);
+        *out = ImpactOut {
+            vertex_face,
+            face_vertex,
+            edge_edge,
+        };
+    }
+}
+
+/// The inverse of a permutation given as internal -> original indices.
+fn inverse(order: &[u32]) -> Vec<u32> {
+    let mut inv = vec![0u32; order.len()];
+    for (i, &o) in order.iter().enumerate() {
+        inv[o as usize] = i as u32;
+    }
+    inv
+}
+
+impl<K: BvKind> Swept<'_, K> {
+    /// Internal vertex `v` at t0 and t1.
+    #[inline(always)]
+    fn step_at(&self, v: usize) -> ([f64; 3], [f64; 3]) {
+        (self.step.x0[v], self.step.x1[v])
+    }
+}
+
+/// The exact vertex-face test of internal vertex `v` of `sv` and internal triangle `t` of
+/// `st`.
+#[inline(always)]
+fn vertex_face_toi<K: BvKind>(
+    sv: &Swept<'_, K>,
+    v: usize,
+    st: &Swept<'_, K>,
+    t: usize,
+    options: &CcdOptions,
+) -> Option<f64> {
+    let c = st.tree().triangles()[t].map(|c| c as usize);
+    let x0 = [
+        sv.step.x0[v],
+        st.step.x0[c[0]],
+        st.step.x0[c[1]],
+        st.step.x0[c[2]],
+    ];
+    let x1 = [
+        sv.step.x1[v],
+        st.step.x1[c[0]],
+        st.step.x1[c[1]],
+        st.step.x1[c[2]],
+    ];
+    ccd::vertex_face(&x0, &x1, options)
+}
+
+/// The exact edge-edge test of two edges given as their endpoints at t0 and t1.
+#[inline(always)]
+fn edge_edge_toi(
+    a: [([f64; 3], [f64; 3]); 2],
+    b: [([f64; 3], [f64; 3]); 2],
+    options: &CcdOptions,
+) -> Option<f64> {
+    let x0 = [a[0].0, a[1].0, b[0].0, b[1].0];
+    let x1 = [a[0].1, a[1].1, b[0].1, b[1].1];
+    ccd::edge_edge(&x0, &x1, options)
+}
+
+impl<'s, 'h, K: BvKind> Query for SweptQuery<'s, 'h, K> {
+    type Block = K::SweptBlock<'s>;
+    type Out = ImpactOut;
+
+    #[inline(always)]
+    fn tree(&self, side: Side) -> &RegionTree {
+        self.side(side).tree()
+    }
+
+    #[inline(always)]
+    fn is_self(&self) -> bool {
+        self.self_query
+    }
+
+    fn out(&self) -> ImpactOut {
+        ImpactOut::default()
+    }
+
+    #[inline(always)]
+    fn group(&self, side: Side, g: usize) -> (K::SweptBlock<'s>, bool) {
+        let s: &'s Swept<'h, K> = match side {
+            Side::A => self.a,
+            Side::B => self.b,
+        };
+        K::swept_group(&s.bounds, s.h.nodes(), s.h.tree(), &s.step, g)
+    }
+
+    #[inline(always)]
+    fn test<S: Simd>(&self, simd: S, a: Self::Block, i: usize, b: Self::Block, n: usize) -> u32 {
+        K::swept_test(simd, a, i, b, n, self.options.min_distance)
+    }
+
+    #[inline(always)]
+    fn extent(&self, block: Self::Block, i: usize) -> f32 {
+        K::swept_extent(block, i)
+    }
+
+    #[inline(always)]
+    fn leaf_pair<S: Simd>(
+        &self,
+        simd: S,
+        x: usize,
+        y: usize,
+        counters: &mut Counters,
+        out: &mut ImpactOut,
+    ) {
+        let (a, b, self_query) = (self.a, self.b, self.self_query);
+        let tv = |s: &Swept<'_, K>, v: usize| s.tree().vert_order()[v];
+        let tt = |s: &Swept<'_, K>, t: usize| s.tree().tri_order()[t];
+        let ImpactOut {
+            vertex_face,
+            face_vertex,
+            edge_edge,
+        } = out;
+        self.vertices_vs_triangles(simd, a, x, b, y, counters, |v, t, toi| {
+            vertex_face.push(VertexImpact {
+                vertex: tv(a, v),
+                triangle: tt(b, t),
+                toi,
+            })
+        });
+        if !(self_query && x == y) {
+            self.vertices_vs_triangles(simd, b, y, a, x, counters, |v, t, toi| {
+                if self_query {
+                    vertex_face.push(VertexImpact {
+                        vertex: tv(b, v),
+                        triangle: tt(a, t),
+                        toi,
+                    })
+                } else {
+                    face_vertex.push(FaceImpact {
+                        triangle: tt(a, t),
+                        vertex: tv(b, v),
+                        toi,
+                    })
+                }
+            });
+        }
+        self.edges_vs_edges(simd, x, y, counters, edge_edge);
+    }
+
+    fn merge(&self, out: &mut ImpactOut, other: ImpactOut) {
+        out.vertex_face.extend_from_slice(&other.vertex_face);
+        out.face_vertex.extend_from_slice(&other.face_vertex);
+        out.edge_edge.extend_from_slice(&other.edge_edge);
+    }
+}
+
+impl<K: BvKind> SweptQuery<'_, '_, K> {
+    /// The own vertices of leaf `x` of `sv` against the triangles of leaf `y` of `st`:
+    /// `emit(vertex, triangle, toi)` (internal indices) for each pair that collides.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn vertices_vs_triangles<S: Simd>(
+        &self,
+        simd: S,
+        sv: &Swept<'_, K>,
+        x: usize,
+        st: &Swept<'_, K>,
+        y: usize,
+        counters: &mut Counters,
+        mut emit: impl FnMut(usize, usize, f64),
+    ) {
+        let rows = st.tri_boxes(y);
+        let n = rows[0].len();
+        let near = grown(&union_of(&rows, n), self.margin);
+        let first = st.tree().tri_range(y).start;
+        let corners_of = st.tree().triangles();
+        for v in sv.tree().vert_run(x) {
+            let vbox = points_box_f64([sv.step.x0[v], sv.step.x1[v]]);
+            if !meet(&vbox, &near) {
+                continue;
+            }
+            let probe = grown(&vbox, self.margin);
+            // PERF: mask loops, not closures (see `proximity.rs`).
+            for base in (0..n).step_by(MAX_BOX_ROW) {
+                let mut bits = meeting(simd, &probe, &rows, base, n);
+                while bits != 0 {
+                    let t = first + base + bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    if self.self_query && corners_of[t].contains(&(v as u32)) {
+                        continue;
+                    }
+                    counters.prim_tests += 1;
+                    if let Some(toi) = vertex_face_toi(sv, v, st, t, &self.options_now()) {
+                        self.found(toi);
+                        emit(v, t, toi);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The own edges of leaf `x` of A against those of leaf `y` of B (a leaf with itself:
+    /// each unordered pair once): each pair that collides into `out`.
+    #[inline(always)]
+    fn edges_vs_edges<S: Simd>(
+        &self,
+        simd: S,
+        x: usize,
+        y: usize,
+        counters: &mut Counters,
+        out: &mut Vec<EdgeImpact>,
+    ) {
+        let (sa, sb) = (self.a, self.b);
+        let same = self.self_query && x == y;
+        let (ea, ra) = sa.own_edges(x);
+        let (eb, rb) = sb.own_edges(y);
+        let near = grown(&union_of(&rb, eb.len()), self.margin);
+        let (oa, ob) = (sa.tree().vert_order(), sb.tree().vert_order());
+        for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
+            let mut near_bits = meeting(simd, &near, &ra, base_a, ea.len());
+            while near_bits != 0 {
+                let i = base_a + near_bits.trailing_zeros() as usize;
+                near_bits &= near_bits - 1;
+                let [u0, u1] = ea[i];
+                let abox = (
+                    [ra[0][i], ra[1][i], ra[2][i]],
+                    [ra[3][i], ra[4][i], ra[5][i]],
+                );
+                let probe = grown(&abox, self.margin);
+                let (a_ids, a_int) = ordered_edge(oa, ea[i]);
+                let pa = a_int.map(|v| sa.step_at(v as usize));
+                let from = if same { i + 1 } else { 0 };
+                for base in (from..eb.len()).step_by(MAX_BOX_ROW) {
+                    let mut bits = meeting(simd, &probe, &rb, base, eb.len());
+                    while bits != 0 {
+                        let j = base + bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        let [w0, w1] = eb[j];
+                        if self.self_query && (u0 == w0 || u0 == w1 || u1 == w0 || u1 == w1) {
+                            continue;
+                        }
+                        counters.prim_tests += 1;
+                        let (b_ids, b_int) = ordered_edge(ob, eb[j]);
+                        let pb = b_int.map(|v| sb.step_at(v as usize));
+                        // In a self query the smaller edge first: the exact test takes the
+                        // edges in the reported order.
+                        let swap = self.self_query && b_ids < a_ids;
+                        let (ids_x, ids_y, px, py) = if swap {
+                            (b_ids, a_ids, pb, pa)
+                        } else {
+                            (a_ids, b_ids, pa, pb)
+                        };
+                        if let Some(toi) = edge_edge_toi(px, py, &self.options_now()) {
+                            self.found(toi);
+                            out.push(EdgeImpact {
+                                a: ids_x,
+                                b: ids_y,
+                                toi,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

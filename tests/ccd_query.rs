@@ -1,0 +1,333 @@
+//! CCD over whole meshes ([`dhcd::self_ccd`], [`dhcd::ccd_pair`]): every colliding
+//! vertex-triangle and edge-edge pair equal to the brute force over every pair (the exact
+//! tests of `dhcd::ccd`), for every kind, 1 and 2 threads, both modes, minimum distances;
+//! and every labelled pair of the real simulation steps through the whole pipeline.
+
+use dhcd::bv::BvKind;
+use dhcd::ccd::CcdOptions;
+use dhcd::io::{load_as, Limits};
+use dhcd::narrow::{brute_force_ccd, brute_force_self_ccd};
+use dhcd::shapes::{grid, icosphere, jitter, splitmix64, wave};
+use dhcd::{
+    ccd_pair_with, for_each_kind, self_ccd_with, CcdMode, CcdQuery, Error, Hierarchy, Impacts,
+    Mesh, Motion, Options, Par, Precision, Workspace,
+};
+
+fn f64s(p: &[[f32; 3]]) -> Vec<[f64; 3]> {
+    p.iter().map(|q| q.map(f64::from)).collect()
+}
+
+/// The pairs and times equal (the query tests each pair with the same inputs in the same
+/// order as the brute force, so times agree to the bit).
+fn assert_same(got: &Impacts, want: &Impacts, what: &str) {
+    assert_eq!(got.vertex_face, want.vertex_face, "{what}: vertex-face");
+    assert_eq!(got.face_vertex, want.face_vertex, "{what}: face-vertex");
+    assert_eq!(got.edge_edge, want.edge_edge, "{what}: edge-edge");
+    assert_eq!(got.toi, want.toi, "{what}: toi");
+    assert_eq!(got.counters.contacts, want.counters.contacts, "{what}");
+    assert!(got.counters.prim_tests >= got.counters.contacts, "{what}");
+}
+
+/// What earliest mode must return: the least time, and the pairs reaching it.
+fn earliest_of(all: &Impacts) -> Impacts {
+    let mut e = all.clone();
+    let t = all.toi.unwrap_or(f64::INFINITY);
+    e.vertex_face.retain(|x| x.toi == t);
+    e.face_vertex.retain(|x| x.toi == t);
+    e.edge_edge.retain(|x| x.toi == t);
+    e.counters.contacts = (e.vertex_face.len() + e.face_vertex.len() + e.edge_edge.len()) as u64;
+    e
+}
+
+fn check_self<K: BvKind>(m: &Mesh, x0: &[[f64; 3]], x1: &[[f64; 3]], deltas: &[f64], what: &str) {
+    let h = Hierarchy::<K>::new(m, Options::default()).unwrap();
+    let motion = Motion::new(x0, x1);
+    for &d in deltas {
+        let options = CcdOptions::new(1.0, d).unwrap();
+        let want = brute_force_self_ccd(m, motion, &options);
+        for mode in [CcdMode::All, CcdMode::Earliest] {
+            let want = match mode {
+                CcdMode::All => want.clone(),
+                CcdMode::Earliest => earliest_of(&want),
+            };
+            for par in [Par::Seq, Par::Rayon(2)] {
+                let q = CcdQuery { options, mode };
+                let got = self_ccd_with(&h, motion, &q, &mut Workspace::default(), par).unwrap();
+                let what = format!("{what} {:?} delta={d} {mode:?} {par:?}", K::METHOD);
+                assert_same(&got, &want, &what);
+            }
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn check_pair<K: BvKind>(
+    a: &Mesh,
+    am: Motion<'_>,
+    b: &Mesh,
+    bm: Motion<'_>,
+    deltas: &[f64],
+    what: &str,
+) {
+    let (ha, hb) = (
+        Hierarchy::<K>::new(a, Options::default()).unwrap(),
+        Hierarchy::<K>::new(b, Options::default()).unwrap(),
+    );
+    for &d in deltas {
+        let options = CcdOptions::new(1.0, d).unwrap();
+        let want = brute_force_ccd(a, am, b, bm, &options);
+        for mode in [CcdMode::All, CcdMode::Earliest] {
+            let want = match mode {
+                CcdMode::All => want.clone(),
+                CcdMode::Earliest => earliest_of(&want),
+            };
+            for par in [Par::Seq, Par::Rayon(2)] {
+                let q = CcdQuery { options, mode };
+                let got =
+                    ccd_pair_with(&ha, am, &hb, bm, &q, &mut Workspace::default(), par).unwrap();
+                let what = format!("{what} {:?} delta={d} {mode:?} {par:?}", K::METHOD);
+                assert_same(&got, &want, &what);
+            }
+        }
+    }
+}
+
+/// Two spheres flying through each other within the step: at t0 and t1 apart, so a
+/// discrete test at either end sees nothing (tunnelling); every kind finds the same pairs.
+#[test]
+fn spheres_tunnelling_through_each_other() {
+    let a = icosphere(1, 0.5, [0.0; 3]);
+    let b = icosphere(1, 0.4, [0.3, 0.05, 0.0]);
+    let a0 = f64s(&jitter(a.positions(), [0.01; 3], 1));
+    let a1: Vec<[f64; 3]> = a0.iter().map(|p| [p[0] + 0.1, p[1], p[2] + 0.02]).collect();
+    // b starts to the right of a... and ends to its left.
+    let b0: Vec<[f64; 3]> = f64s(b.positions())
+        .iter()
+        .map(|p| [p[0] + 1.0, p[1], p[2]])
+        .collect();
+    let b1: Vec<[f64; 3]> = b0.iter().map(|p| [p[0] - 2.6, p[1] + 0.1, p[2]]).collect();
+    let (am, bm) = (Motion::new(&a0, &a1), Motion::new(&b0, &b1));
+    let all = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
+    assert!(all.counters.contacts > 20 && all.toi.unwrap() > 0.0 && all.toi.unwrap() < 1.0);
+    for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "spheres"));
+}
+
+/// A sheet folding onto itself over the step, with jitter: self-CCD against the brute
+/// force, neighbours (sharing a vertex) excluded.
+#[test]
+fn folding_sheet_self_ccd() {
+    let g = grid(8, 8, 0.1, [0.0; 3]);
+    let x0 = f64s(&jitter(g.positions(), [0.002; 3], 5));
+    let x1: Vec<[f64; 3]> = x0
+        .iter()
+        .map(|p| {
+            if p[0] > 0.45 {
+                // Folded over x = 0.45 and pushed through the lower half.
+                [0.9 - p[0], p[1] + 0.013, -0.04 + 0.01 * (p[1] * 7.0).sin()]
+            } else {
+                *p
+            }
+        })
+        .collect();
+    let all = brute_force_self_ccd(&g, Motion::new(&x0, &x1), &CcdOptions::default());
+    assert!(all.counters.contacts > 0);
+    for_each_kind!(K => check_self::<K>(&g, &x0, &x1, &[0.0], "folding sheet"));
+}
+
+/// Random motions of a deformed sphere (vertices moving far relative to the triangles), and
+/// a still mesh (every pair already apart or touching stays so).
+#[test]
+fn random_motions_and_still_meshes() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let x0 = f64s(&wave(m.positions(), 0.7, 0.2, [0.0; 3]));
+    let mut state = 17u64;
+    let x1: Vec<[f64; 3]> = x0
+        .iter()
+        .map(|p| {
+            p.map(|c| {
+                let r = (splitmix64(&mut state) >> 11) as f64 / (1u64 << 53) as f64;
+                c + (r - 0.5) * 0.9
+            })
+        })
+        .collect();
+    for_each_kind!(K => check_self::<K>(&m, &x0, &x1, &[0.0], "random"));
+    for_each_kind!(K => check_self::<K>(&m, &x0, &x0, &[0.0], "still"));
+}
+
+/// Degenerate motions: grids sliding in their common plane (coplanar motion all step,
+/// touching along edges), and two grids meeting exactly at t = 1.
+#[test]
+fn coplanar_sliding_and_contact_at_the_end() {
+    let a = grid(3, 3, 0.25, [0.0; 3]);
+    let b = grid(3, 3, 0.25, [0.0; 3]);
+    let a0 = f64s(a.positions());
+    let b0: Vec<[f64; 3]> = a0
+        .iter()
+        .map(|p| [p[0] + 1.0, p[1] + 0.125, p[2]])
+        .collect();
+    let b1: Vec<[f64; 3]> = a0
+        .iter()
+        .map(|p| [p[0] + 0.5, p[1] + 0.125, p[2]])
+        .collect();
+    let (am, bm) = (Motion::new(&a0, &a0), Motion::new(&b0, &b1));
+    let all = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
+    assert!(all.counters.contacts > 0);
+    for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "coplanar"));
+    // b descends onto a, touching at exactly t = 1.
+    let b0: Vec<[f64; 3]> = a0.iter().map(|p| [p[0] + 0.1, p[1] + 0.1, 0.5]).collect();
+    let b1: Vec<[f64; 3]> = a0.iter().map(|p| [p[0] + 0.1, p[1] + 0.1, 0.0]).collect();
+    let bm = Motion::new(&b0, &b1);
+    let all = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
+    assert_eq!(all.toi, Some(1.0));
+    for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "contact at t = 1"));
+}
+
+/// A minimum distance `delta > 0` (pairs collide when they come within it): small meshes,
+/// since pairs passing near each other take the exact path (about a millisecond each).
+#[test]
+fn minimum_distance_small_meshes() {
+    let a = icosphere(0, 0.5, [0.0; 3]);
+    let b = icosphere(0, 0.4, [0.0; 3]);
+    let a0 = f64s(a.positions());
+    let a1 = a0.clone();
+    let b0: Vec<[f64; 3]> = f64s(b.positions())
+        .iter()
+        .map(|p| [p[0] + 1.2, p[1] + 0.3, p[2]])
+        .collect();
+    let b1: Vec<[f64; 3]> = b0.iter().map(|p| [p[0] - 0.5, p[1], p[2] + 0.1]).collect();
+    let (am, bm) = (Motion::new(&a0, &a1), Motion::new(&b0, &b1));
+    let near = brute_force_ccd(&a, am, &b, bm, &CcdOptions::new(1.0, 0.1).unwrap());
+    let touch = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
+    assert!(near.counters.contacts > touch.counters.contacts);
+    for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.05], "spheres near"));
+    let g = grid(3, 3, 0.1, [0.0; 3]);
+    let x0 = f64s(g.positions());
+    let x1: Vec<[f64; 3]> = x0
+        .iter()
+        .map(|p| {
+            if p[0] > 0.15 {
+                [0.3 - p[0], p[1] + 0.01, 0.02]
+            } else {
+                *p
+            }
+        })
+        .collect();
+    for_each_kind!(K => check_self::<K>(&g, &x0, &x1, &[0.03], "folding near"));
+}
+
+#[test]
+fn bad_input_is_a_typed_error() {
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let h = Hierarchy::<dhcd::bv::Dh>::new(&m, Options::default()).unwrap();
+    let x = f64s(m.positions());
+    let mut ws = Workspace::default();
+    let run = |x0: &[[f64; 3]], x1: &[[f64; 3]], q: CcdQuery, ws: &mut Workspace| {
+        self_ccd_with(&h, Motion::new(x0, x1), &q, ws, Par::Seq)
+    };
+    assert!(matches!(
+        run(&x[1..], &x, CcdQuery::all(), &mut ws),
+        Err(Error::WrongVertexCount { .. })
+    ));
+    let mut bad = x.clone();
+    bad[3][1] = f64::NAN;
+    assert!(matches!(
+        run(&x, &bad, CcdQuery::all(), &mut ws),
+        Err(Error::NonFinite { vertex: 3, .. })
+    ));
+    assert!(matches!(
+        run(&x, &x, CcdQuery::all().with_t_max(1.5), &mut ws),
+        Err(Error::InvalidTimeLimit(_))
+    ));
+    assert!(matches!(
+        run(
+            &x,
+            &x,
+            CcdQuery::earliest().with_min_distance(-1.0),
+            &mut ws
+        ),
+        Err(Error::InvalidMinDistance(_))
+    ));
+    // The workspace still works after the errors.
+    let ok = run(&x, &x, CcdQuery::all(), &mut ws).unwrap();
+    assert_eq!(ok.counters.contacts, 0);
+    assert_eq!(ok.toi, None);
+}
+
+/// The real simulation steps of `../shared/data/real-frames` through the whole pipeline
+/// (loader at f64, DH walk over the step, feature culling, exact test): every labelled pair
+/// of `../shared/data/ccd/frame-truth` is reported iff its label is 1. The rod-twist step
+/// also runs every kind and 1 thread against 2.
+#[test]
+fn frame_truth_through_the_pipeline() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    for (name, next) in [
+        ("rod-twist-3036", "rod-twist-3037"),
+        ("armadillo-rollers-326", "armadillo-rollers-327"),
+        ("n-body-simulation-18", "n-body-simulation-19"),
+        ("cloth-ball-92", "cloth-ball-93"),
+    ] {
+        let load = |f: &str| {
+            let path = data.join(format!("real-frames/{f}.ply"));
+            load_as(&path, &Limits::default(), Precision::F64).unwrap()
+        };
+        let (m0, m1) = (load(name), load(next));
+        let (x0, x1) = (m0.positions_f64().unwrap(), m1.positions_f64().unwrap());
+        let motion = Motion::new(x0, x1);
+        let h = Hierarchy::<dhcd::bv::Dh>::new(&m0, Options::default()).unwrap();
+        let got = self_ccd_with(
+            &h,
+            motion,
+            &CcdQuery::all(),
+            &mut Workspace::default(),
+            Par::Rayon(2),
+        )
+        .unwrap();
+        let vf: std::collections::HashSet<(u32, u32)> = got
+            .vertex_face
+            .iter()
+            .map(|x| (x.vertex, x.triangle))
+            .collect();
+        let ee: std::collections::HashSet<([u32; 2], [u32; 2])> =
+            got.edge_edge.iter().map(|x| (x.a, x.b)).collect();
+        let text =
+            std::fs::read_to_string(data.join(format!("ccd/frame-truth/{name}.tsv"))).unwrap();
+        let (mut labels, mut wrong) = (0usize, Vec::new());
+        for line in text.lines().filter(|l| !l.trim().is_empty()) {
+            let w: Vec<&str> = line.split_whitespace().collect();
+            let n = |i: usize| w[i].parse::<u32>().unwrap();
+            let (found, label) = match w[0] {
+                "vf" => (vf.contains(&(n(1), n(2))), w[3] == "1"),
+                "ee" => (ee.contains(&([n(1), n(2)], [n(3), n(4)])), w[5] == "1"),
+                k => panic!("unknown label kind {k}"),
+            };
+            labels += 1;
+            if found != label {
+                wrong.push(format!("{name}: {line}: reported {found}"));
+            }
+        }
+        println!(
+            "{name}: {} vf + {} ee colliding, toi {:?}, {labels} labels checked, {:?}",
+            got.vertex_face.len(),
+            got.edge_edge.len(),
+            got.toi,
+            got.counters
+        );
+        assert!(
+            wrong.is_empty(),
+            "{} wrong:\n{}",
+            wrong.len(),
+            wrong[..wrong.len().min(20)].join("\n")
+        );
+        if name.starts_with("rod") {
+            for_each_kind!(K => {
+                let hk = Hierarchy::<K>::new(&m0, Options::default()).unwrap();
+                for (par, mode) in [(Par::Seq, CcdMode::All), (Par::Rayon(2), CcdMode::Earliest)] {
+                    let q = CcdQuery { mode, ..CcdQuery::default() };
+                    let other = self_ccd_with(&hk, motion, &q, &mut Workspace::default(), par).unwrap();
+                    let want = if mode == CcdMode::All { got.clone() } else { earliest_of(&got) };
+                    assert_same(&other, &want, &format!("{name} {:?} {par:?} {mode:?}", K::METHOD));
+                }
+            });
+        }
+    }
+}
