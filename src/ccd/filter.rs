@@ -288,6 +288,26 @@ fn decide(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], d: &Diffs, t_max: f64, test: S
     roots_and_test(x0, x1, b, e, t_max, test)
 }
 
+/// Widths at which a root's interval is tested before it is narrowed to [`ROOT_WIDTH`]:
+/// the first test on the isolating interval as found.
+const COARSE_WIDTHS: [f64; 3] = [1.0, 1.0 / 1024.0, 1.0 / (1u64 << 20) as f64];
+
+/// Bisects the root interval `[s0, s1]` of the cubic with Bernstein coefficients `c` (sign
+/// `sign0` at `s0`) down to `width` while f's sign at the midpoint is certain; false if it
+/// stopped early on an uncertain sign.
+#[inline(always)]
+fn bisect(c: &[Iv; 4], sign0: i8, s0: &mut f64, s1: &mut f64, width: f64) -> bool {
+    while *s1 - *s0 > width {
+        let m = 0.5 * (*s0 + *s1);
+        match eval_at(c, m).sign() {
+            0 => return false,
+            s if s == sign0 => *s0 = m,
+            _ => *s1 = m,
+        }
+    }
+    true
+}
+
 #[inline(never)]
 fn roots_and_test(
     x0: &[[f64; 3]; 4],
@@ -329,20 +349,29 @@ fn roots_and_test(
                 _ => s1 = t_max,
             }
         }
+        // Most roots of f are plane crossings far from the feature: the static test on the
+        // root's interval, coarse then narrower, rules them out before the narrowing to
+        // 2^-40 that only a contact's time needs.
+        let mut narrow = true;
+        let mut ruled_out = false;
+        for width in COARSE_WIDTHS {
+            narrow = bisect(&c, r.sign0, &mut s0, &mut s1, width);
+            if test(x0, x1, Iv { lo: s0, hi: s1 }) == Some(false) {
+                ruled_out = true;
+                break;
+            }
+            if !narrow {
+                break;
+            }
+        }
+        if ruled_out {
+            continue;
+        }
         // Narrow the root while f's sign at the midpoint is certain. With small motions
         // f is flat and its float error (~u m^3) hides the sign before 2^-40: the interval
         // then stays wider, and a contact's time is narrowed exactly (`Refine`).
-        let mut narrow = true;
-        while s1 - s0 > ROOT_WIDTH {
-            let m = 0.5 * (s0 + s1);
-            match eval_at(&c, m).sign() {
-                0 => {
-                    narrow = false;
-                    break;
-                }
-                s if s == r.sign0 => s0 = m,
-                _ => s1 = m,
-            }
+        if narrow {
+            narrow = bisect(&c, r.sign0, &mut s0, &mut s1, ROOT_WIDTH);
         }
         match test(x0, x1, Iv { lo: s0, hi: s1 }) {
             Some(true) if narrow => return Verdict::Hit(s0),
