@@ -12,14 +12,17 @@ pub(crate) trait Ring: Clone {
 
 pub(crate) type V3<R> = [R; 3];
 
+#[inline(always)]
 pub(crate) fn sub3<R: Ring>(a: &V3<R>, b: &V3<R>) -> V3<R> {
     [a[0].sub(&b[0]), a[1].sub(&b[1]), a[2].sub(&b[2])]
 }
 
+#[inline(always)]
 pub(crate) fn add3<R: Ring>(a: &V3<R>, b: &V3<R>) -> V3<R> {
     [a[0].add(&b[0]), a[1].add(&b[1]), a[2].add(&b[2])]
 }
 
+#[inline(always)]
 pub(crate) fn cross<R: Ring>(a: &V3<R>, b: &V3<R>) -> V3<R> {
     [
         a[1].mul(&b[2]).sub(&a[2].mul(&b[1])),
@@ -28,6 +31,7 @@ pub(crate) fn cross<R: Ring>(a: &V3<R>, b: &V3<R>) -> V3<R> {
     ]
 }
 
+#[inline(always)]
 pub(crate) fn dot<R: Ring>(a: &V3<R>, b: &V3<R>) -> R {
     a[0].mul(&b[0]).add(&a[1].mul(&b[1])).add(&a[2].mul(&b[2]))
 }
@@ -43,6 +47,7 @@ pub(crate) struct VfFace<R> {
     pub n: V3<R>,
 }
 
+#[inline]
 pub(crate) fn vf_face<R: Ring>(p: &V3<R>, a: &V3<R>, b: &V3<R>, c: &V3<R>) -> VfFace<R> {
     let (aa, bb, cc) = (sub3(a, p), sub3(b, p), sub3(c, p));
     let ab = cross(&aa, &bb);
@@ -69,6 +74,7 @@ pub(crate) struct EeCross<R> {
     pub ee: R,
 }
 
+#[inline]
 pub(crate) fn ee_cross<R: Ring>(a0: &V3<R>, a1: &V3<R>, b0: &V3<R>, b1: &V3<R>) -> EeCross<R> {
     let u = sub3(a1, a0);
     let v = sub3(b1, b0);
