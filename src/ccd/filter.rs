@@ -73,6 +73,47 @@ pub(crate) fn ee_boxes_apart(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], gap: f64) -
     })
 }
 
+/// Stage 0 over `[0, t_max]`: the features' boxes over that time are certainly more than
+/// `gap` apart. A point's box over `[0, t_max]` spans `x0` and `x0 + t_max (x1 - x0)`; the
+/// latter is computed in floats and widened by a bound on its rounding (three operations,
+/// each within `u = 2^-53` of `|x0| + |x1 - x0|`: `2^-50` of it, plus an absolute term for
+/// underflow).
+#[inline(always)]
+pub(crate) fn boxes_apart_until(
+    kind: super::exact::Kind,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    t_max: f64,
+    gap: f64,
+) -> bool {
+    let mut lo = [[0.0f64; 3]; 4];
+    let mut hi = [[0.0f64; 3]; 4];
+    for i in 0..4 {
+        for k in 0..3 {
+            let (a, d) = (x0[i][k], x1[i][k] - x0[i][k]);
+            let end = a + t_max * d;
+            let err = (a.abs() + d.abs()) * 2f64.powi(-50) + 2f64.powi(-1000);
+            lo[i][k] = a.min(end - err);
+            hi[i][k] = a.max(end + err);
+        }
+    }
+    let vf = matches!(kind, super::exact::Kind::VertexFace);
+    (0..3).any(|k| {
+        let (first, second) = if vf { (1, 3) } else { (2, 2) };
+        let amin = lo[..first].iter().fold(f64::INFINITY, |m, p| m.min(p[k]));
+        let amax = hi[..first]
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, p| m.max(p[k]));
+        let bmin = lo[4 - second..]
+            .iter()
+            .fold(f64::INFINITY, |m, p| m.min(p[k]));
+        let bmax = hi[4 - second..]
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, p| m.max(p[k]));
+        apart(amin, amax, bmin, bmax, gap)
+    })
+}
+
 /// Intervals [a0, a1] and [b0, b1] certainly more than `gap` apart. With gap = 0 a plain
 /// comparison; otherwise the rounded difference stepped down one ulp (a lower bound of the
 /// exact difference) must exceed the gap.

@@ -242,6 +242,11 @@ fn query(
         return None;
     }
     let delta = options.min_distance;
+    // A time limit below 1 (the earliest-time mode's pruning): the boxes over [0, t_max]
+    // first, which are far smaller than over the whole step when t_max is small.
+    if options.t_max < 1.0 && filter::boxes_apart_until(kind, x0, x1, options.t_max, delta) {
+        return None;
+    }
     if delta == 0.0 {
         let verdict = match kind {
             exact::Kind::VertexFace => filter::vertex_face(x0, x1, options.t_max),
