@@ -22,7 +22,8 @@ unknown method, a negative, NaN or infinite distance, a file that cannot be pars
 (``FileNotFoundError`` if missing).
 
 CCD positions are float64 only, for hierarchies of either precision: any other dtype
-raises ``ValueError`` (never converted: the answers are exact for the doubles).
+raises ``ValueError`` and is never converted (the answers are exact for the doubles given;
+convert explicitly, e.g. ``x.astype(numpy.float64)``).
 
 Threads: queries and updates release the GIL, so Python threads may query different objects
 at the same time. One object used by two threads at once raises ``RuntimeError`` (it is

@@ -14,8 +14,9 @@
 //! is first converted once by numpy. Faces are converted to `u32` once, at construction.
 //!
 //! Continuous collision detection (`ccd`, `vertex_face_ccd`, `edge_edge_ccd`) takes float64
-//! positions only, for hierarchies of either precision: any other dtype is a `ValueError`
-//! (the answers are exact for the doubles, so a conversion would change them silently).
+//! positions only, for hierarchies of either precision: any other dtype is a `ValueError`,
+//! never converted (the answers are exact for the doubles given; the caller converts, and
+//! sees what is rounded).
 #![forbid(unsafe_code)]
 
 use std::collections::{HashMap, HashSet};
@@ -690,7 +691,7 @@ fn real_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<f64> {
 /// `numpy.asarray(obj)` checked to be a float64 array of shape `(n, *tail)`, as a
 /// C-contiguous float64 array (the caller's when it already is one; a copy of the same
 /// values when its byte order or strides differ). Any other dtype is an error naming
-/// `what`: CCD answers are exact for the doubles, so nothing is converted.
+/// `what`, never a conversion.
 fn float64_rows<'py>(
     obj: &Bound<'py, PyAny>,
     what: &str,
