@@ -7,7 +7,8 @@
  *
  * Conventions:
  *  - fallible functions return DHCD_OK (0) or a negative DHCD_ERR_* code; then
- *    dhcd_last_error_message() describes the failure (per thread);
+ *    dhcd_last_error_message() describes the failure (per thread). The single-pair CCD
+ *    calls (dhcd_vertex_face_ccd, dhcd_edge_edge_ccd) return 1 (collide) or 0 on success;
  *  - arrays are flat: positions are x,y,z per vertex (3 * vertex_count floats, or
  *    doubles for the *_f64 calls), triangles are 3 vertex indices each
  *    (3 * triangle_count uint32_t);
@@ -74,20 +75,24 @@
 
 /**
  * A bad argument: unknown method, levels out of range, misaligned or oversized array,
- * the same hierarchy passed twice to `dhcd_collide` or `dhcd_proximity`, a thread count
- * above 1024, a proximity distance that is negative, NaN or infinite.
+ * the same hierarchy passed twice to `dhcd_collide`, `dhcd_proximity` or `dhcd_ccd`, a
+ * thread count above 1024, a proximity distance or CCD minimum distance that is
+ * negative, NaN or infinite, a CCD time limit outside `[0, 1]` or NaN, a NaN or infinite
+ * coordinate of a single CCD query (`dhcd_vertex_face_ccd`, `dhcd_edge_edge_ccd`).
  */
 #define DHCD_ERR_INVALID_ARGUMENT -2
 
 /**
  * The mesh is invalid: no vertices or triangles, an index out of range, a repeated index
  * in a triangle, a non-finite coordinate, a `double` coordinate beyond the `float` range
- * (about 3.4e38: bounding volumes are `float`).
+ * (about 3.4e38: bounding volumes are `float`); likewise for the positions at t0 and t1
+ * of `dhcd_self_ccd` and `dhcd_ccd`.
  */
 #define DHCD_ERR_INVALID_MESH -3
 
 /**
- * A position update whose vertex count differs from the mesh's.
+ * A position update (or CCD positions at t0 and t1) whose vertex count differs from the
+ * mesh's.
  */
 #define DHCD_ERR_LENGTH_MISMATCH -4
 
@@ -195,6 +200,41 @@ typedef struct DhcdProximity {
   size_t ee_count;
   struct DhcdCounters counters;
 } DhcdProximity;
+
+/**
+ * Colliding feature pairs over a step, from `dhcd_ccd` / `dhcd_self_ccd` (release with
+ * `dhcd_impacts_free`). Three lists, each of `*_count` rows sorted by its index rows, every
+ * row with its time of impact (`*_toi[k]`, in `[0, t_max]`); indices are original vertex
+ * and triangle indices; every array is null when its count is 0.
+ * - `vertex_face`: `[vertex, triangle]` at `vertex_face[2k..2k+2]`: a vertex of `a` and a
+ *   triangle of `b` (self: a vertex and a triangle not containing it);
+ * - `face_vertex`: `[triangle of a, vertex of b]` (pair queries only; empty for self);
+ * - `edge_edge`: `[a0, a1, b0, b1]` at `edge_edge[4k..4k+4]`, an edge of `a` and one of
+ *   `b` (self: two edges sharing no vertex, `(a0, a1) < (b0, b1)`), each as its two
+ *   vertices, smaller first.
+ *
+ * `toi` is the earliest time of impact of the step (the least of the rows' times), or
+ * `+inf` when nothing collides. In earliest mode the lists hold only the pairs reaching
+ * it. Whether a pair collides is decided exactly for the `double` input; a time of impact
+ * is never later than the pair's first contact and at most 1e-12 earlier.
+ *
+ * `counters.bv_tests` counts the node pairs tested over the step, `bv_updates` the bounds
+ * fitted over the step, `prim_tests` the feature pairs given to the exact test,
+ * `contacts` the rows of the three lists.
+ */
+typedef struct DhcdImpacts {
+  uint32_t *vertex_face;
+  double *vf_toi;
+  size_t vf_count;
+  uint32_t *face_vertex;
+  double *fv_toi;
+  size_t fv_count;
+  uint32_t *edge_edge;
+  double *ee_toi;
+  size_t ee_count;
+  double toi;
+  struct DhcdCounters counters;
+} DhcdImpacts;
 
 /**
  * Contacts of `dhcd_scene_contacts`: `count` quadruples `[object_a, tri_a, object_b,
@@ -415,6 +455,111 @@ int dhcd_self_proximity(struct DhcdHierarchy *h,
  * `p` null or a `DhcdProximity` filled by this library and not modified since.
  */
 void dhcd_proximity_free(struct DhcdProximity *p);
+
+/**
+ * Continuous collision detection of one mesh over a step: every vertex-triangle pair (the
+ * triangle not containing the vertex) and edge-edge pair (sharing no vertex) that touches
+ * at some time `t` in `[0, t_max]` while every vertex moves on the straight line from its
+ * position in `x0` (t = 0) to its position in `x1` (t = 1), into `*out` (see
+ * `DhcdImpacts`; `face_vertex` is empty; release with `dhcd_impacts_free`).
+ *
+ * `x0` and `x1` hold `3 * vertex_count` doubles each, in the mesh's vertex order, for a
+ * hierarchy of either precision (finite, within the `float` range: else
+ * `DHCD_ERR_INVALID_MESH`; another vertex count: `DHCD_ERR_LENGTH_MISMATCH`); the pairs
+ * found depend on `x0` and `x1` alone, and the hierarchy's pose is not changed. `t_max` in
+ * `[0, 1]`; pairs collide when they come within `min_distance` (finite, `>= 0`; 0: when
+ * they touch). `earliest` non-zero: only the earliest time of impact and the pairs
+ * reaching it (what a line search asks; pairs are tested only up to the best time found so
+ * far), else every colliding pair. Decided exactly for the doubles; times of impact never
+ * later than the first contact and at most 1e-12 earlier. The result does not depend on
+ * `threads` (the work counters of earliest mode may).
+ *
+ * # Safety
+ * `h` null or a live handle; `x0`, `x1` hold `3 * vertex_count` doubles; `out` null or
+ * valid for a write.
+ */
+int dhcd_self_ccd(struct DhcdHierarchy *h,
+                  const double *x0,
+                  const double *x1,
+                  size_t vertex_count,
+                  double t_max,
+                  double min_distance,
+                  int earliest,
+                  uint32_t threads,
+                  struct DhcdImpacts *out);
+
+/**
+ * Continuous collision detection between two meshes over a step: every vertex of `a`
+ * against every triangle of `b` (`vertex_face`), every triangle of `a` against every
+ * vertex of `b` (`face_vertex`) and every edge of `a` against every edge of `b`
+ * (`edge_edge`) that touches during the step, `a` moving from `a0` to `a1` (`3 *
+ * a_vertex_count` doubles each) and `b` from `b0` to `b1`, into `*out` (see `DhcdImpacts`;
+ * release with `dhcd_impacts_free`). `a` and `b` are different handles of the same kind
+ * (use `dhcd_self_ccd` for one mesh), of either precision; the other arguments as in
+ * `dhcd_self_ccd`.
+ *
+ * # Safety
+ * `a`, `b` null or live handles; `a0`, `a1` hold `3 * a_vertex_count` doubles, `b0`, `b1`
+ * `3 * b_vertex_count`; `out` null or valid for a write.
+ */
+int dhcd_ccd(struct DhcdHierarchy *a,
+             const double *a0,
+             const double *a1,
+             size_t a_vertex_count,
+             struct DhcdHierarchy *b,
+             const double *b0,
+             const double *b1,
+             size_t b_vertex_count,
+             double t_max,
+             double min_distance,
+             int earliest,
+             uint32_t threads,
+             struct DhcdImpacts *out);
+
+/**
+ * Releases the arrays of a `DhcdImpacts` and resets it to empty (`toi` `+inf`). Null, or
+ * an already released or empty result, is a no-op.
+ *
+ * # Safety
+ * `p` null or a `DhcdImpacts` filled by this library and not modified since.
+ */
+void dhcd_impacts_free(struct DhcdImpacts *p);
+
+/**
+ * Vertex-face CCD of one pair: `x0` holds the vertex and the triangle's three corners at
+ * t = 0 (`[v, f0, f1, f2]`, 12 doubles), `x1` the same points at t = 1; every point moves
+ * on the straight line between them. Returns 1 when the vertex lies in the closed
+ * triangle (or within `min_distance` of it) at some t in `[0, t_max]`, and writes the time
+ * of impact into `*toi`; returns 0 otherwise, with `*toi = +inf`. Decided exactly for the
+ * doubles (no tolerance; degenerate and coplanar cases included); the time of impact is
+ * never later than the first contact and at most 1e-12 earlier. Errors (negative codes,
+ * `*toi` unchanged): a NaN or infinite coordinate, `t_max` outside `[0, 1]`, a negative or
+ * non-finite `min_distance` (`DHCD_ERR_INVALID_ARGUMENT`), a null pointer
+ * (`DHCD_ERR_NULL`).
+ *
+ * # Safety
+ * `x0`, `x1` null or 12 doubles each; `toi` null or valid for a write.
+ */
+int dhcd_vertex_face_ccd(const double *x0,
+                         const double *x1,
+                         double t_max,
+                         double min_distance,
+                         double *toi);
+
+/**
+ * Edge-edge CCD of one pair: `x0` holds the two edges' endpoints at t = 0
+ * (`[a0, a1, b0, b1]`, 12 doubles), `x1` at t = 1. Returns 1 when the closed segments meet
+ * (or come within `min_distance`) at some t in `[0, t_max]`, with the time of impact in
+ * `*toi`, else 0 with `*toi = +inf`; exactness and errors as `dhcd_vertex_face_ccd`.
+ *
+ * # Safety
+ * `x0`, `x1` null or 12 doubles each; `toi` null or valid for a write.
+ */
+int dhcd_edge_edge_ccd(const double *x0,
+                       const double *x1,
+                       double t_max,
+                       double min_distance,
+                       double *toi);
 
 /**
  * A new empty scene whose objects get `method` hierarchies of `levels` levels.

@@ -3,23 +3,27 @@
 //!
 //! Conventions:
 //! - every fallible function returns an `int`: [`DHCD_OK`] (0) or a negative `DHCD_ERR_*`
-//!   code, and then [`dhcd_last_error_message`] describes the failure (per thread);
+//!   code, and then [`dhcd_last_error_message`] describes the failure (per thread); the
+//!   single-pair CCD calls return 1 (collide) or 0 (do not) on success;
 //! - no panic crosses the boundary: every entry runs inside `catch_unwind` and a panic
 //!   becomes [`DHCD_ERR_PANIC`];
 //! - null pointers, misaligned arrays, mismatched lengths and hierarchies of different kinds
 //!   are errors, never undefined behaviour on the library's side;
 //! - handles (`DhcdHierarchy`, `DhcdScene`) are created by `*_new` and released by
 //!   `*_free`; results (`DhcdContacts`, `DhcdSceneContacts`, `DhcdProximity`,
-//!   `DhcdSceneProximity`) own library-allocated arrays released by their `*_free`
-//!   (an array is null when its count is 0);
+//!   `DhcdSceneProximity`, `DhcdImpacts`) own library-allocated arrays released by their
+//!   `*_free` (an array is null when its count is 0);
 //! - a handle must not be used from two threads at once (queries refit it lazily).
 //!
 //! - a function with a handle or result output (`*out`) empties it first (NULL handle,
 //!   empty result), so it is empty after any error; scalar outputs (`dhcd_hierarchy_method`,
 //!   `dhcd_hierarchy_precision`, `dhcd_scene_add`'s id, `dhcd_contact_segments`' segments)
-//!   are written only on success;
+//!   are written only on success, as is the `toi` of `dhcd_vertex_face_ccd` and
+//!   `dhcd_edge_edge_ccd`;
 //! - `*_f64` calls take `double` positions and make or update `f64` hierarchies and objects
-//!   (exact for the doubles); positions of the other precision are `DHCD_ERR_PRECISION`.
+//!   (exact for the doubles); positions of the other precision are `DHCD_ERR_PRECISION`;
+//! - continuous collision detection (`dhcd_self_ccd`, `dhcd_ccd`) takes `double` positions
+//!   at t0 and t1 for a hierarchy of either precision.
 //!
 //! `threads` arguments: `1` runs on the calling thread, `0` on rayon's global pool (all
 //! cores), `n` on a pool of `n` threads but never more than the machine's cores; above
@@ -31,27 +35,32 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use dhcd::any::AnyHierarchy;
 use dhcd::bv::Method;
+use dhcd::ccd::CcdOptions;
 use dhcd::counters::Counters;
 use dhcd::error::Error;
 use dhcd::hierarchy::Options;
 use dhcd::mesh::{Mesh, Precision};
 use dhcd::par::Par;
 use dhcd::scene::{ObjectId, Scene};
-use dhcd::{Contacts, Proximity, SceneProximity, Workspace};
+use dhcd::{CcdMode, CcdQuery, Contacts, Impacts, Motion, Proximity, SceneProximity, Workspace};
 
 /// Success.
 pub const DHCD_OK: c_int = 0;
 /// A required pointer argument is null.
 pub const DHCD_ERR_NULL: c_int = -1;
 /// A bad argument: unknown method, levels out of range, misaligned or oversized array,
-/// the same hierarchy passed twice to `dhcd_collide` or `dhcd_proximity`, a thread count
-/// above 1024, a proximity distance that is negative, NaN or infinite.
+/// the same hierarchy passed twice to `dhcd_collide`, `dhcd_proximity` or `dhcd_ccd`, a
+/// thread count above 1024, a proximity distance or CCD minimum distance that is
+/// negative, NaN or infinite, a CCD time limit outside `[0, 1]` or NaN, a NaN or infinite
+/// coordinate of a single CCD query (`dhcd_vertex_face_ccd`, `dhcd_edge_edge_ccd`).
 pub const DHCD_ERR_INVALID_ARGUMENT: c_int = -2;
 /// The mesh is invalid: no vertices or triangles, an index out of range, a repeated index
 /// in a triangle, a non-finite coordinate, a `double` coordinate beyond the `float` range
-/// (about 3.4e38: bounding volumes are `float`).
+/// (about 3.4e38: bounding volumes are `float`); likewise for the positions at t0 and t1
+/// of `dhcd_self_ccd` and `dhcd_ccd`.
 pub const DHCD_ERR_INVALID_MESH: c_int = -3;
-/// A position update whose vertex count differs from the mesh's.
+/// A position update (or CCD positions at t0 and t1) whose vertex count differs from the
+/// mesh's.
 pub const DHCD_ERR_LENGTH_MISMATCH: c_int = -4;
 /// Two hierarchies of different kinds.
 pub const DHCD_ERR_WRONG_KIND: c_int = -5;
@@ -180,6 +189,41 @@ pub struct DhcdSceneProximity {
     pub counters: DhcdCounters,
 }
 
+/// Colliding feature pairs over a step, from `dhcd_ccd` / `dhcd_self_ccd` (release with
+/// `dhcd_impacts_free`). Three lists, each of `*_count` rows sorted by its index rows, every
+/// row with its time of impact (`*_toi[k]`, in `[0, t_max]`); indices are original vertex
+/// and triangle indices; every array is null when its count is 0.
+/// - `vertex_face`: `[vertex, triangle]` at `vertex_face[2k..2k+2]`: a vertex of `a` and a
+///   triangle of `b` (self: a vertex and a triangle not containing it);
+/// - `face_vertex`: `[triangle of a, vertex of b]` (pair queries only; empty for self);
+/// - `edge_edge`: `[a0, a1, b0, b1]` at `edge_edge[4k..4k+4]`, an edge of `a` and one of
+///   `b` (self: two edges sharing no vertex, `(a0, a1) < (b0, b1)`), each as its two
+///   vertices, smaller first.
+///
+/// `toi` is the earliest time of impact of the step (the least of the rows' times), or
+/// `+inf` when nothing collides. In earliest mode the lists hold only the pairs reaching
+/// it. Whether a pair collides is decided exactly for the `double` input; a time of impact
+/// is never later than the pair's first contact and at most 1e-12 earlier.
+///
+/// `counters.bv_tests` counts the node pairs tested over the step, `bv_updates` the bounds
+/// fitted over the step, `prim_tests` the feature pairs given to the exact test,
+/// `contacts` the rows of the three lists.
+#[repr(C)]
+#[derive(Debug)]
+pub struct DhcdImpacts {
+    pub vertex_face: *mut u32,
+    pub vf_toi: *mut f64,
+    pub vf_count: usize,
+    pub face_vertex: *mut u32,
+    pub fv_toi: *mut f64,
+    pub fv_count: usize,
+    pub edge_edge: *mut u32,
+    pub ee_toi: *mut f64,
+    pub ee_count: usize,
+    pub toi: f64,
+    pub counters: DhcdCounters,
+}
+
 /// Opaque: one object's hierarchy (and its query scratch).
 pub struct DhcdHierarchy {
     h: AnyHierarchy,
@@ -229,6 +273,9 @@ impl From<Error> for Fail {
             | Error::FileTooLarge { .. }
             | Error::Parse { .. }
             | Error::InvalidDistance(_)
+            | Error::InvalidTimeLimit(_)
+            | Error::InvalidMinDistance(_)
+            | Error::NonFiniteCcdPoint { .. }
             | Error::UnknownPrecision(_) => DHCD_ERR_INVALID_ARGUMENT,
             // `Error` is non-exhaustive: a variant added later is a bad argument until it
             // gets a code of its own.
@@ -433,6 +480,30 @@ unsafe fn free_array<T>(ptr: *mut T, len: usize) {
     }
 }
 
+/// The C result of a CCD query.
+fn impacts_out(p: Impacts) -> DhcdImpacts {
+    let vf = &p.vertex_face;
+    let fv = &p.face_vertex;
+    let ee = &p.edge_edge;
+    DhcdImpacts {
+        vertex_face: c_pairs(vf.iter().map(|x| [x.vertex, x.triangle]).collect()),
+        vf_toi: c_array(vf.iter().map(|x| x.toi).collect()),
+        vf_count: vf.len(),
+        face_vertex: c_pairs(fv.iter().map(|x| [x.triangle, x.vertex]).collect()),
+        fv_toi: c_array(fv.iter().map(|x| x.toi).collect()),
+        fv_count: fv.len(),
+        edge_edge: c_pairs(
+            ee.iter()
+                .map(|x| [x.a[0], x.a[1], x.b[0], x.b[1]])
+                .collect(),
+        ),
+        ee_toi: c_array(ee.iter().map(|x| x.toi).collect()),
+        ee_count: ee.len(),
+        toi: p.toi.unwrap_or(f64::INFINITY),
+        counters: p.counters.into(),
+    }
+}
+
 /// The C result of a proximity query.
 fn proximity_out(p: Proximity) -> DhcdProximity {
     let vf = &p.vertex_face;
@@ -576,6 +647,20 @@ const NO_SCENE_PROXIMITY: DhcdSceneProximity = DhcdSceneProximity {
     ee_distance_sq: std::ptr::null_mut(),
     ee_type: std::ptr::null_mut(),
     ee_count: 0,
+    counters: NO_CONTACTS.counters,
+};
+
+const NO_IMPACTS: DhcdImpacts = DhcdImpacts {
+    vertex_face: std::ptr::null_mut(),
+    vf_toi: std::ptr::null_mut(),
+    vf_count: 0,
+    face_vertex: std::ptr::null_mut(),
+    fv_toi: std::ptr::null_mut(),
+    fv_count: 0,
+    edge_edge: std::ptr::null_mut(),
+    ee_toi: std::ptr::null_mut(),
+    ee_count: 0,
+    toi: f64::INFINITY,
     counters: NO_CONTACTS.counters,
 };
 
@@ -974,6 +1059,261 @@ pub unsafe extern "C" fn dhcd_proximity_free(p: *mut DhcdProximity) {
         }
         Ok(())
     });
+}
+
+/// The CCD query of the C arguments (checked by the library's query).
+fn ccd_query(t_max: f64, min_distance: f64, earliest: c_int) -> CcdQuery {
+    CcdQuery {
+        options: CcdOptions {
+            t_max,
+            min_distance,
+        },
+        mode: if earliest != 0 {
+            CcdMode::Earliest
+        } else {
+            CcdMode::All
+        },
+    }
+}
+
+/// The motion of `vertex_count` vertices from `x0` (t = 0) to `x1` (t = 1), `3 *
+/// vertex_count` doubles each.
+///
+/// # Safety
+/// As [`positions_f64`], for both arrays.
+unsafe fn motion<'a>(
+    x0: *const f64,
+    x1: *const f64,
+    vertex_count: usize,
+    what: &str,
+) -> Result<Motion<'a>, Fail> {
+    let named = |Fail(code, msg): Fail| Fail(code, format!("{what}: {msg}"));
+    // SAFETY: forwarded contract.
+    let (p0, p1) = unsafe {
+        (
+            positions_f64(x0, vertex_count).map_err(named)?,
+            positions_f64(x1, vertex_count).map_err(named)?,
+        )
+    };
+    Ok(Motion::new(p0, p1))
+}
+
+/// Continuous collision detection of one mesh over a step: every vertex-triangle pair (the
+/// triangle not containing the vertex) and edge-edge pair (sharing no vertex) that touches
+/// at some time `t` in `[0, t_max]` while every vertex moves on the straight line from its
+/// position in `x0` (t = 0) to its position in `x1` (t = 1), into `*out` (see
+/// `DhcdImpacts`; `face_vertex` is empty; release with `dhcd_impacts_free`).
+///
+/// `x0` and `x1` hold `3 * vertex_count` doubles each, in the mesh's vertex order, for a
+/// hierarchy of either precision (finite, within the `float` range: else
+/// `DHCD_ERR_INVALID_MESH`; another vertex count: `DHCD_ERR_LENGTH_MISMATCH`); the pairs
+/// found depend on `x0` and `x1` alone, and the hierarchy's pose is not changed. `t_max` in
+/// `[0, 1]`; pairs collide when they come within `min_distance` (finite, `>= 0`; 0: when
+/// they touch). `earliest` non-zero: only the earliest time of impact and the pairs
+/// reaching it (what a line search asks; pairs are tested only up to the best time found so
+/// far), else every colliding pair. Decided exactly for the doubles; times of impact never
+/// later than the first contact and at most 1e-12 earlier. The result does not depend on
+/// `threads` (the work counters of earliest mode may).
+///
+/// # Safety
+/// `h` null or a live handle; `x0`, `x1` hold `3 * vertex_count` doubles; `out` null or
+/// valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_self_ccd(
+    h: *mut DhcdHierarchy,
+    x0: *const f64,
+    x1: *const f64,
+    vertex_count: usize,
+    t_max: f64,
+    min_distance: f64,
+    earliest: c_int,
+    threads: u32,
+    out: *mut DhcdImpacts,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on `out`: empty until there is a result.
+        unsafe { write(out, NO_IMPACTS, "out")? };
+        // SAFETY: caller's contract on `h` and the arrays.
+        let (h, m) = unsafe {
+            (
+                handle(h, "hierarchy")?,
+                motion(x0, x1, vertex_count, "x0, x1")?,
+            )
+        };
+        let q = ccd_query(t_max, min_distance, earliest);
+        let p = h.h.self_ccd(m, &q, &mut h.ws, par(threads)?)?;
+        // SAFETY: caller's contract on `out` (written above).
+        unsafe { write(out, impacts_out(p), "out") }
+    })
+}
+
+/// Continuous collision detection between two meshes over a step: every vertex of `a`
+/// against every triangle of `b` (`vertex_face`), every triangle of `a` against every
+/// vertex of `b` (`face_vertex`) and every edge of `a` against every edge of `b`
+/// (`edge_edge`) that touches during the step, `a` moving from `a0` to `a1` (`3 *
+/// a_vertex_count` doubles each) and `b` from `b0` to `b1`, into `*out` (see `DhcdImpacts`;
+/// release with `dhcd_impacts_free`). `a` and `b` are different handles of the same kind
+/// (use `dhcd_self_ccd` for one mesh), of either precision; the other arguments as in
+/// `dhcd_self_ccd`.
+///
+/// # Safety
+/// `a`, `b` null or live handles; `a0`, `a1` hold `3 * a_vertex_count` doubles, `b0`, `b1`
+/// `3 * b_vertex_count`; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_ccd(
+    a: *mut DhcdHierarchy,
+    a0: *const f64,
+    a1: *const f64,
+    a_vertex_count: usize,
+    b: *mut DhcdHierarchy,
+    b0: *const f64,
+    b1: *const f64,
+    b_vertex_count: usize,
+    t_max: f64,
+    min_distance: f64,
+    earliest: c_int,
+    threads: u32,
+    out: *mut DhcdImpacts,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on `out`: empty until there is a result.
+        unsafe { write(out, NO_IMPACTS, "out")? };
+        if a == b && !a.is_null() {
+            return Err(Fail(
+                DHCD_ERR_INVALID_ARGUMENT,
+                "dhcd_ccd needs two different hierarchies (use dhcd_self_ccd)".into(),
+            ));
+        }
+        // SAFETY: live, distinct handles (checked above), so the two `&mut` do not alias;
+        // the arrays by the caller's contract.
+        let (a, b, ma, mb) = unsafe {
+            (
+                handle(a, "a")?,
+                handle(b, "b")?,
+                motion(a0, a1, a_vertex_count, "a0, a1")?,
+                motion(b0, b1, b_vertex_count, "b0, b1")?,
+            )
+        };
+        let q = ccd_query(t_max, min_distance, earliest);
+        let p = a.h.ccd_pair(ma, &b.h, mb, &q, &mut a.ws, par(threads)?)?;
+        // SAFETY: caller's contract on `out` (written above).
+        unsafe { write(out, impacts_out(p), "out") }
+    })
+}
+
+/// Releases the arrays of a `DhcdImpacts` and resets it to empty (`toi` `+inf`). Null, or
+/// an already released or empty result, is a no-op.
+///
+/// # Safety
+/// `p` null or a `DhcdImpacts` filled by this library and not modified since.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_impacts_free(p: *mut DhcdImpacts) {
+    let _ = guard(|| {
+        // SAFETY: caller's contract.
+        if let Some(p) = unsafe { p.as_mut() } {
+            // SAFETY: each array came from `c_array` with the lengths below, or is null.
+            unsafe {
+                free_array(p.vertex_face, 2 * p.vf_count);
+                free_array(p.vf_toi, p.vf_count);
+                free_array(p.face_vertex, 2 * p.fv_count);
+                free_array(p.fv_toi, p.fv_count);
+                free_array(p.edge_edge, 4 * p.ee_count);
+                free_array(p.ee_toi, p.ee_count);
+            }
+            *p = NO_IMPACTS;
+        }
+        Ok(())
+    });
+}
+
+/// One CCD query of four points: `x0` and `x1` hold 12 doubles each, the points at t = 0
+/// and t = 1 (x, y, z each).
+type CcdTest = fn(&[[f64; 3]; 4], &[[f64; 3]; 4], &CcdOptions) -> dhcd::Result<Option<f64>>;
+
+/// Runs a single CCD query: 1 (collide, `*toi` the time of impact) or 0 (`*toi` `+inf`),
+/// or a negative error code with `*toi` unchanged.
+///
+/// # Safety
+/// `x0`, `x1` null or 12 doubles each; `toi` null or valid for a write.
+unsafe fn single_ccd(
+    test: CcdTest,
+    x0: *const f64,
+    x1: *const f64,
+    t_max: f64,
+    min_distance: f64,
+    toi: *mut f64,
+) -> c_int {
+    let mut hit = false;
+    let rc = guard(|| {
+        // SAFETY: 12 doubles each (caller's contract); `[[f64; 3]; 4]` has the alignment
+        // of `f64` and the size of twelve.
+        let (p0, p1) = unsafe {
+            (
+                slice(x0.cast::<[[f64; 3]; 4]>(), 1, "x0")?,
+                slice(x1.cast::<[[f64; 3]; 4]>(), 1, "x1")?,
+            )
+        };
+        if toi.is_null() {
+            return Err(null("toi"));
+        }
+        let options = CcdOptions {
+            t_max,
+            min_distance,
+        };
+        let t = test(&p0[0], &p1[0], &options)?;
+        hit = t.is_some();
+        // SAFETY: non-null, valid for a write (caller's contract).
+        unsafe { write(toi, t.unwrap_or(f64::INFINITY), "toi") }
+    });
+    if rc == DHCD_OK {
+        c_int::from(hit)
+    } else {
+        rc
+    }
+}
+
+/// Vertex-face CCD of one pair: `x0` holds the vertex and the triangle's three corners at
+/// t = 0 (`[v, f0, f1, f2]`, 12 doubles), `x1` the same points at t = 1; every point moves
+/// on the straight line between them. Returns 1 when the vertex lies in the closed
+/// triangle (or within `min_distance` of it) at some t in `[0, t_max]`, and writes the time
+/// of impact into `*toi`; returns 0 otherwise, with `*toi = +inf`. Decided exactly for the
+/// doubles (no tolerance; degenerate and coplanar cases included); the time of impact is
+/// never later than the first contact and at most 1e-12 earlier. Errors (negative codes,
+/// `*toi` unchanged): a NaN or infinite coordinate, `t_max` outside `[0, 1]`, a negative or
+/// non-finite `min_distance` (`DHCD_ERR_INVALID_ARGUMENT`), a null pointer
+/// (`DHCD_ERR_NULL`).
+///
+/// # Safety
+/// `x0`, `x1` null or 12 doubles each; `toi` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_vertex_face_ccd(
+    x0: *const f64,
+    x1: *const f64,
+    t_max: f64,
+    min_distance: f64,
+    toi: *mut f64,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { single_ccd(dhcd::ccd::try_vertex_face, x0, x1, t_max, min_distance, toi) }
+}
+
+/// Edge-edge CCD of one pair: `x0` holds the two edges' endpoints at t = 0
+/// (`[a0, a1, b0, b1]`, 12 doubles), `x1` at t = 1. Returns 1 when the closed segments meet
+/// (or come within `min_distance`) at some t in `[0, t_max]`, with the time of impact in
+/// `*toi`, else 0 with `*toi = +inf`; exactness and errors as `dhcd_vertex_face_ccd`.
+///
+/// # Safety
+/// `x0`, `x1` null or 12 doubles each; `toi` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_edge_edge_ccd(
+    x0: *const f64,
+    x1: *const f64,
+    t_max: f64,
+    min_distance: f64,
+    toi: *mut f64,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { single_ccd(dhcd::ccd::try_edge_edge, x0, x1, t_max, min_distance, toi) }
 }
 
 /// A new empty scene whose objects get `method` hierarchies of `levels` levels.

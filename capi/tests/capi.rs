@@ -1979,3 +1979,721 @@ fn distance_type_numbers_are_the_library_enums() {
     assert!(header.contains("#define DHCD_EE_EA_EB 8\n"));
     assert_eq!(DHCD_ERR_PRECISION, -10);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Continuous collision detection
+// ---------------------------------------------------------------------------------------------
+
+use dhcd::ccd::CcdOptions;
+use dhcd::narrow::{brute_force_ccd, brute_force_self_ccd};
+use dhcd::query::{EdgeImpact, FaceImpact, VertexImpact};
+use dhcd::shapes::{grid, jitter};
+use dhcd::{CcdMode, CcdQuery, Impacts, Motion};
+
+fn f64s(p: &[[f32; 3]]) -> Vec<[f64; 3]> {
+    p.iter().map(|q| q.map(f64::from)).collect()
+}
+
+fn flat64(p: &[[f64; 3]]) -> Vec<f64> {
+    p.iter().flatten().copied().collect()
+}
+
+/// A result no call wrote: what a C caller's uninitialised variable holds.
+fn garbage_impacts() -> DhcdImpacts {
+    DhcdImpacts {
+        vertex_face: garbage(),
+        vf_toi: garbage(),
+        vf_count: 9,
+        face_vertex: garbage(),
+        fv_toi: garbage(),
+        fv_count: 9,
+        edge_edge: garbage(),
+        ee_toi: garbage(),
+        ee_count: 9,
+        toi: 0.25,
+        counters: DhcdCounters {
+            bv_tests: 1,
+            prim_tests: 2,
+            bv_updates: 3,
+            contacts: 4,
+        },
+    }
+}
+
+fn is_empty_impacts(p: &DhcdImpacts) -> bool {
+    p.vertex_face.is_null()
+        && p.vf_toi.is_null()
+        && p.face_vertex.is_null()
+        && p.fv_toi.is_null()
+        && p.edge_edge.is_null()
+        && p.ee_toi.is_null()
+        && p.vf_count == 0
+        && p.fv_count == 0
+        && p.ee_count == 0
+        && p.toi == f64::INFINITY
+        && p.counters == DhcdCounters::default()
+}
+
+/// A filled `DhcdImpacts` as the library's `Impacts`; the C result is released (and then
+/// empty).
+///
+/// # Safety
+/// `p` filled by the library and not released.
+unsafe fn taken_impacts(p: &mut DhcdImpacts) -> Impacts {
+    // SAFETY: the library wrote the stated number of elements at each array.
+    let out = unsafe {
+        let (vf, vt) = (
+            part(p.vertex_face, 2 * p.vf_count),
+            part(p.vf_toi, p.vf_count),
+        );
+        let (fv, ft) = (
+            part(p.face_vertex, 2 * p.fv_count),
+            part(p.fv_toi, p.fv_count),
+        );
+        let (ee, et) = (
+            part(p.edge_edge, 4 * p.ee_count),
+            part(p.ee_toi, p.ee_count),
+        );
+        Impacts {
+            vertex_face: (0..p.vf_count)
+                .map(|k| VertexImpact {
+                    vertex: vf[2 * k],
+                    triangle: vf[2 * k + 1],
+                    toi: vt[k],
+                })
+                .collect(),
+            face_vertex: (0..p.fv_count)
+                .map(|k| FaceImpact {
+                    triangle: fv[2 * k],
+                    vertex: fv[2 * k + 1],
+                    toi: ft[k],
+                })
+                .collect(),
+            edge_edge: (0..p.ee_count)
+                .map(|k| EdgeImpact {
+                    a: [ee[4 * k], ee[4 * k + 1]],
+                    b: [ee[4 * k + 2], ee[4 * k + 3]],
+                    toi: et[k],
+                })
+                .collect(),
+            toi: (p.toi != f64::INFINITY).then_some(p.toi),
+            counters: counters_of(p.counters),
+        }
+    };
+    // SAFETY: filled by the library, released once (the second call is a no-op).
+    unsafe {
+        dhcd_impacts_free(p);
+        assert!(is_empty_impacts(p), "released");
+        dhcd_impacts_free(p);
+    }
+    out
+}
+
+/// `dhcd_self_ccd` as the library's type.
+fn c_self_ccd(
+    h: *mut DhcdHierarchy,
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    q: CcdQuery,
+    threads: u32,
+) -> Impacts {
+    assert_eq!(x0.len(), x1.len());
+    let (f0, f1) = (flat64(x0), flat64(x1));
+    let mut p = garbage_impacts();
+    let earliest = i32::from(q.mode == CcdMode::Earliest);
+    let o = q.options;
+    // SAFETY: a live handle, arrays of the stated lengths, a writable output.
+    unsafe {
+        let rc = dhcd_self_ccd(
+            h,
+            f0.as_ptr(),
+            f1.as_ptr(),
+            x0.len(),
+            o.t_max,
+            o.min_distance,
+            earliest,
+            threads,
+            &mut p,
+        );
+        assert_eq!(rc, DHCD_OK, "{}", last_error());
+        taken_impacts(&mut p)
+    }
+}
+
+/// `dhcd_ccd` as the library's type.
+fn c_ccd(
+    a: *mut DhcdHierarchy,
+    am: Motion<'_>,
+    b: *mut DhcdHierarchy,
+    bm: Motion<'_>,
+    q: CcdQuery,
+    threads: u32,
+) -> Impacts {
+    let [a0, a1, b0, b1] = [am.x0, am.x1, bm.x0, bm.x1].map(flat64);
+    let mut p = garbage_impacts();
+    let earliest = i32::from(q.mode == CcdMode::Earliest);
+    let o = q.options;
+    // SAFETY: live handles, arrays of the stated lengths, a writable output.
+    unsafe {
+        let rc = dhcd_ccd(
+            a,
+            a0.as_ptr(),
+            a1.as_ptr(),
+            am.x0.len(),
+            b,
+            b0.as_ptr(),
+            b1.as_ptr(),
+            bm.x0.len(),
+            o.t_max,
+            o.min_distance,
+            earliest,
+            threads,
+            &mut p,
+        );
+        assert_eq!(rc, DHCD_OK, "{}", last_error());
+        taken_impacts(&mut p)
+    }
+}
+
+/// What earliest mode must return: the least time, and the pairs reaching it (the work
+/// counters depend on the order of the walk: compared apart).
+fn earliest_of(all: &Impacts) -> Impacts {
+    let mut e = all.clone();
+    let t = all.toi.unwrap_or(f64::INFINITY);
+    e.vertex_face.retain(|x| x.toi == t);
+    e.face_vertex.retain(|x| x.toi == t);
+    e.edge_edge.retain(|x| x.toi == t);
+    e.counters.contacts = (e.vertex_face.len() + e.face_vertex.len() + e.edge_edge.len()) as u64;
+    e
+}
+
+/// Pairs, times (to the bit) and contact count equal.
+fn assert_same_impacts(got: &Impacts, want: &Impacts, what: &str) {
+    assert_eq!(got.vertex_face, want.vertex_face, "{what}: vertex-face");
+    assert_eq!(got.face_vertex, want.face_vertex, "{what}: face-vertex");
+    assert_eq!(got.edge_edge, want.edge_edge, "{what}: edge-edge");
+    assert_eq!(got.toi, want.toi, "{what}: toi");
+    assert_eq!(got.counters.contacts, want.counters.contacts, "{what}");
+    assert!(got.counters.prim_tests >= got.counters.contacts, "{what}");
+}
+
+/// Two parallel 4 x 4 sheets in one mesh (the upper one's indices after the lower's); over
+/// the step the upper one passes right through the lower one, from 0.3 above to 0.3
+/// below, so neither end pose has a self-contact (tunnelling).
+fn tunnelling_sheets() -> (Mesh, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let g = grid(4, 4, 0.25, [0.0; 3]);
+    let n = g.vertex_count() as u32;
+    let lower = f64s(&jitter(g.positions(), [0.01, 0.01, 0.02], 3));
+    let upper: Vec<[f64; 3]> = lower
+        .iter()
+        .map(|p| [p[0] + 0.07, p[1] + 0.05, p[2] + 0.3])
+        .collect();
+    let below: Vec<[f64; 3]> = upper
+        .iter()
+        .map(|p| [p[0] + 0.02, p[1] - 0.03, p[2] - 0.6])
+        .collect();
+    let mut triangles = g.triangles().to_vec();
+    triangles.extend(g.triangles().iter().map(|t| t.map(|v| v + n)));
+    let x0: Vec<[f64; 3]> = lower.iter().chain(&upper).copied().collect();
+    let x1: Vec<[f64; 3]> = lower.iter().chain(&below).copied().collect();
+    (Mesh::new_f64(x0.clone(), triangles).unwrap(), x0, x1)
+}
+
+/// A C hierarchy of `mesh` in `f64`, or rounded to `f32`.
+fn new_ccd_h(method: i32, mesh: &Mesh, f32_hierarchy: bool) -> *mut DhcdHierarchy {
+    if f32_hierarchy {
+        let p: Vec<[f32; 3]> = mesh
+            .to_f64_positions()
+            .iter()
+            .map(|p| p.map(|x| x as f32))
+            .collect();
+        new_h(method, &Mesh::new(p, mesh.triangles().to_vec()).unwrap())
+    } else {
+        new_any(method, mesh)
+    }
+}
+
+/// `dhcd_self_ccd` equals the brute force over every pair (`dhcd::narrow::brute_force_self_ccd`)
+/// on a tunnelling case the discrete test misses at both ends: every kind, hierarchies of
+/// both precisions (the positions are `double` either way), 1 and 2 threads, both modes.
+#[test]
+fn self_ccd_equals_the_brute_force() {
+    let (mesh, x0, x1) = tunnelling_sheets();
+    let all = brute_force_self_ccd(&mesh, Motion::new(&x0, &x1), &CcdOptions::default());
+    assert!(!all.vertex_face.is_empty() && !all.edge_edge.is_empty());
+    assert!(all.face_vertex.is_empty());
+    let toi = all.toi.unwrap();
+    assert!(toi > 0.0 && toi < 1.0, "{toi}");
+    for method in METHODS {
+        for f32_hierarchy in [false, true] {
+            let h = new_ccd_h(method, &mesh, f32_hierarchy);
+            // Neither end pose collides: the discrete test misses the whole step.
+            for x in [&x0, &x1] {
+                // SAFETY: a live handle, arrays of the stated lengths, a writable output.
+                unsafe {
+                    if !f32_hierarchy {
+                        let f = flat64(x);
+                        let rc = dhcd_hierarchy_update_positions_f64(h, f.as_ptr(), x.len());
+                        assert_eq!(rc, DHCD_OK);
+                        let mut c = empty();
+                        assert_eq!(dhcd_self_collide(h, 1, &mut c), DHCD_OK);
+                        assert_eq!(c.count, 0);
+                        dhcd_contacts_free(&mut c);
+                    }
+                }
+            }
+            for threads in [1, 2] {
+                let what = format!(
+                    "{:?} f32={f32_hierarchy} threads={threads}",
+                    method_of(method)
+                );
+                let got = c_self_ccd(h, &x0, &x1, CcdQuery::all(), threads);
+                assert_same_impacts(&got, &all, &what);
+                let got = c_self_ccd(h, &x0, &x1, CcdQuery::earliest(), threads);
+                assert_same_impacts(&got, &earliest_of(&all), &format!("{what}, earliest"));
+            }
+            // The same as the Rust API, counters included.
+            let rust = AnyHierarchy::new(method_of(method), &mesh, options4()).unwrap();
+            if !f32_hierarchy {
+                let want = rust
+                    .self_ccd(
+                        Motion::new(&x0, &x1),
+                        &CcdQuery::all(),
+                        &mut Workspace::default(),
+                        Par::Seq,
+                    )
+                    .unwrap();
+                assert_eq!(c_self_ccd(h, &x0, &x1, CcdQuery::all(), 1), want);
+            }
+            // SAFETY: a live handle, released once.
+            unsafe { dhcd_hierarchy_free(h) };
+        }
+    }
+}
+
+/// Two balls flying through each other within the step (apart at both ends).
+fn tunnelling_balls() -> (Mesh, Mesh, [Vec<[f64; 3]>; 4]) {
+    let a = icosphere(1, 0.5, [0.0; 3]);
+    let b = icosphere(1, 0.4, [0.3, 0.05, 0.0]);
+    let a0 = f64s(&jitter(a.positions(), [0.01; 3], 1));
+    let a1: Vec<[f64; 3]> = a0.iter().map(|p| [p[0] + 0.1, p[1], p[2] + 0.02]).collect();
+    let b0: Vec<[f64; 3]> = f64s(b.positions())
+        .iter()
+        .map(|p| [p[0] + 1.0, p[1], p[2]])
+        .collect();
+    let b1: Vec<[f64; 3]> = b0.iter().map(|p| [p[0] - 2.6, p[1] + 0.1, p[2]]).collect();
+    (a, b, [a0, a1, b0, b1])
+}
+
+/// `dhcd_ccd` equals `dhcd::narrow::brute_force_ccd` (all three lists) and the Rust API:
+/// every kind, mixed precisions, 1 and 2 threads, both modes, a time limit.
+#[test]
+fn pair_ccd_equals_the_brute_force() {
+    let (a, b, [a0, a1, b0, b1]) = tunnelling_balls();
+    let (am, bm) = (Motion::new(&a0, &a1), Motion::new(&b0, &b1));
+    let all = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
+    assert!(!all.vertex_face.is_empty() && !all.face_vertex.is_empty());
+    assert!(!all.edge_edge.is_empty());
+    let toi = all.toi.unwrap();
+    assert!(toi > 0.0 && toi < 1.0);
+    let early = CcdOptions::new(0.5 * toi + 0.25, 0.0).unwrap();
+    let part = brute_force_ccd(&a, am, &b, bm, &early);
+    assert!(part.counters.contacts > 0 && part.counters.contacts < all.counters.contacts);
+    let ma = Mesh::new_f64(a0.clone(), a.triangles().to_vec()).unwrap();
+    let mb = Mesh::new_f64(b0.clone(), b.triangles().to_vec()).unwrap();
+    for method in METHODS {
+        for (fa, fb) in [(false, false), (true, false), (true, true)] {
+            let (ha, hb) = (new_ccd_h(method, &ma, fa), new_ccd_h(method, &mb, fb));
+            for threads in [1, 2] {
+                let what = format!("{:?} f32=({fa}, {fb}) threads={threads}", method_of(method));
+                let got = c_ccd(ha, am, hb, bm, CcdQuery::all(), threads);
+                assert_same_impacts(&got, &all, &what);
+                let got = c_ccd(ha, am, hb, bm, CcdQuery::earliest(), threads);
+                assert_same_impacts(&got, &earliest_of(&all), &format!("{what}, earliest"));
+                let q = CcdQuery::all().with_t_max(early.t_max);
+                let got = c_ccd(ha, am, hb, bm, q, threads);
+                assert_same_impacts(&got, &part, &format!("{what}, t_max"));
+                assert!(got.vertex_face.iter().all(|x| x.toi <= early.t_max));
+            }
+            if !fa && !fb {
+                // The Rust API on the same meshes, counters included.
+                let m = method_of(method);
+                let ra = AnyHierarchy::new(m, &ma, options4()).unwrap();
+                let rb = AnyHierarchy::new(m, &mb, options4()).unwrap();
+                let q = CcdQuery::earliest();
+                let want = ra
+                    .ccd_pair(am, &rb, bm, &q, &mut Workspace::default(), Par::Seq)
+                    .unwrap();
+                assert_eq!(c_ccd(ha, am, hb, bm, q, 1), want, "{m:?}: counters too");
+            }
+            // SAFETY: live handles, released once.
+            unsafe {
+                dhcd_hierarchy_free(ha);
+                dhcd_hierarchy_free(hb);
+            }
+        }
+    }
+}
+
+/// A minimum distance: pairs passing within it collide too (small meshes: such pairs take
+/// the exact path).
+#[test]
+fn ccd_minimum_distance() {
+    let a = icosphere(0, 0.5, [0.0; 3]);
+    let b = icosphere(0, 0.4, [0.0; 3]);
+    let a0 = f64s(a.positions());
+    let b0: Vec<[f64; 3]> = f64s(b.positions())
+        .iter()
+        .map(|p| [p[0] + 1.2, p[1] + 0.3, p[2]])
+        .collect();
+    let b1: Vec<[f64; 3]> = b0.iter().map(|p| [p[0] - 0.5, p[1], p[2] + 0.1]).collect();
+    let (am, bm) = (Motion::new(&a0, &a0), Motion::new(&b0, &b1));
+    let options = CcdOptions::new(1.0, 0.05).unwrap();
+    let near = brute_force_ccd(&a, am, &b, bm, &options);
+    let touch = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
+    assert!(near.counters.contacts > touch.counters.contacts);
+    let (ha, hb) = (new_h(DHCD_METHOD_SPHERE, &a), new_h(DHCD_METHOD_SPHERE, &b));
+    let q = CcdQuery::all().with_min_distance(0.05);
+    assert_same_impacts(&c_ccd(ha, am, hb, bm, q, 2), &near, "min distance");
+    assert_same_impacts(&c_ccd(ha, am, hb, bm, CcdQuery::all(), 1), &touch, "touch");
+    // SAFETY: live handles, released once.
+    unsafe {
+        dhcd_hierarchy_free(ha);
+        dhcd_hierarchy_free(hb);
+    }
+}
+
+/// `dhcd_vertex_face_ccd` and `dhcd_edge_edge_ccd` equal `dhcd::ccd`'s queries: 1 with the
+/// time, or 0 with `+inf`.
+#[test]
+fn single_ccd_queries_equal_the_library() {
+    // A vertex falling through a triangle at t = 0.5; an edge sweeping through another.
+    let vf0 = [
+        [0.25, 0.25, 1.0],
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let vf1 = [
+        [0.25, 0.25, -1.0],
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let ee0 = [
+        [-1.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let ee1 = [
+        [-1.0, 0.0, -3.0],
+        [1.0, 0.0, -3.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let flat12 = |p: &[[f64; 3]; 4]| -> [f64; 12] { std::array::from_fn(|k| p[k / 3][k % 3]) };
+    type Lib = fn(&[[f64; 3]; 4], &[[f64; 3]; 4], &CcdOptions) -> Option<f64>;
+    type C = unsafe extern "C" fn(*const f64, *const f64, f64, f64, *mut f64) -> i32;
+    let cases: [(&str, Lib, C, _, _, f64); 2] = [
+        (
+            "vertex-face",
+            dhcd::ccd::vertex_face,
+            dhcd_vertex_face_ccd,
+            vf0,
+            vf1,
+            0.5,
+        ),
+        (
+            "edge-edge",
+            dhcd::ccd::edge_edge,
+            dhcd_edge_edge_ccd,
+            ee0,
+            ee1,
+            0.25,
+        ),
+    ];
+    for (what, lib, c, x0, x1, t_star) in cases {
+        let (f0, f1) = (flat12(&x0), flat12(&x1));
+        for (t_max, d) in [
+            (1.0, 0.0),
+            (t_star, 0.0),
+            (0.9 * t_star, 0.0),
+            (1.0, 0.1),
+            (0.0, 0.0),
+        ] {
+            let want = lib(&x0, &x1, &CcdOptions::new(t_max, d).unwrap());
+            let mut toi = -1.0;
+            // SAFETY: 12 doubles each, a writable `toi`.
+            let rc = unsafe { c(f0.as_ptr(), f1.as_ptr(), t_max, d, &mut toi) };
+            assert_eq!(rc, i32::from(want.is_some()), "{what} {t_max} {d}");
+            assert_eq!(toi, want.unwrap_or(f64::INFINITY), "{what} {t_max} {d}");
+            if d == 0.0 && t_max >= t_star {
+                assert!(toi <= t_star && t_star - toi <= 1e-12, "{what}: {toi}");
+            }
+        }
+    }
+}
+
+/// Which CCD calls an error test makes: `dhcd_self_ccd`, `dhcd_ccd` or both.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Calls {
+    Own,
+    Pair,
+    Both,
+}
+
+/// The arguments of a CCD call, changed one at a time by the error tests.
+#[derive(Clone, Copy)]
+struct CcdCall {
+    a: *mut DhcdHierarchy,
+    a0: *const f64,
+    a1: *const f64,
+    na: usize,
+    /// The second mesh of `dhcd_ccd` (unused by `dhcd_self_ccd`).
+    b: *mut DhcdHierarchy,
+    b0: *const f64,
+    b1: *const f64,
+    nb: usize,
+    t_max: f64,
+    d: f64,
+    threads: u32,
+}
+
+impl CcdCall {
+    fn with(mut self, change: impl FnOnce(&mut Self)) -> Self {
+        change(&mut self);
+        self
+    }
+
+    /// The calls `which` (`dhcd_self_ccd` on `a`, `dhcd_ccd`) fail with `code` and a
+    /// message containing `message`, in both modes, and leave their output empty whatever
+    /// it held.
+    ///
+    /// # Safety
+    /// Every pointer null, a live handle, or valid for its stated length.
+    unsafe fn fails(self, which: Calls, code: i32, message: &str) {
+        let c = self;
+        for earliest in [0, 1] {
+            // Only the pair call reads `b`.
+            if which != Calls::Pair {
+                let mut out = garbage_impacts();
+                // SAFETY: the caller's contract.
+                let rc = unsafe {
+                    dhcd_self_ccd(
+                        c.a, c.a0, c.a1, c.na, c.t_max, c.d, earliest, c.threads, &mut out,
+                    )
+                };
+                let what = format!("self, {message}: {}", last_error());
+                assert_eq!(rc, code, "{what}");
+                assert!(last_error().contains(message), "{what}");
+                assert!(is_empty_impacts(&out), "{what}");
+            }
+            if which == Calls::Own {
+                continue;
+            }
+            let mut out = garbage_impacts();
+            // SAFETY: the caller's contract.
+            let rc = unsafe {
+                dhcd_ccd(
+                    c.a, c.a0, c.a1, c.na, c.b, c.b0, c.b1, c.nb, c.t_max, c.d, earliest,
+                    c.threads, &mut out,
+                )
+            };
+            let what = format!("pair, {message}: {}", last_error());
+            assert_eq!(rc, code, "{what}");
+            assert!(last_error().contains(message), "{what}");
+            assert!(is_empty_impacts(&out), "{what}");
+        }
+    }
+}
+
+/// Every bad input of the CCD calls is a typed error code, with the result output emptied
+/// (whatever it held) and the single queries' `toi` unwritten.
+#[test]
+fn ccd_bad_input_is_an_error_code_and_writes_nothing() {
+    use Calls::{Both, Own, Pair};
+    use {
+        DHCD_ERR_INVALID_ARGUMENT as ARGUMENT, DHCD_ERR_INVALID_MESH as MESH,
+        DHCD_ERR_LENGTH_MISMATCH as LENGTH, DHCD_ERR_NULL as NULL,
+    };
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let x = f64s(m.positions());
+    let (nv, fx) = (m.vertex_count(), flat64(&x));
+    let a = new_h(DHCD_METHOD_DH, &m);
+    let b = new_h(DHCD_METHOD_DH, &m);
+    let box_ = new_h(DHCD_METHOD_AABB, &m);
+    let mut nan = fx.clone();
+    nan[7] = f64::NAN;
+    let mut big = fx.clone();
+    big[5] = 1e39;
+    let bytes = [0u64; 16];
+    let odd = bytes.as_ptr().cast::<u8>().wrapping_add(4).cast::<f64>();
+    let p = fx.as_ptr();
+    let ok = CcdCall {
+        a,
+        a0: p,
+        a1: p,
+        na: nv,
+        b,
+        b0: p,
+        b1: p,
+        nb: nv,
+        t_max: 1.0,
+        d: 0.0,
+        threads: 1,
+    };
+    // SAFETY: every pointer is null, a live handle, or valid for its stated length (the
+    // misaligned one is rejected before it is read).
+    unsafe {
+        ok.with(|c| c.a = null_mut())
+            .fails(Both, NULL, "null pointer");
+        ok.with(|c| c.b = null_mut())
+            .fails(Pair, NULL, "b is a null");
+        ok.with(|c| c.b = a).fails(Pair, ARGUMENT, "dhcd_self_ccd");
+        ok.with(|c| c.b = box_)
+            .fails(Pair, DHCD_ERR_WRONG_KIND, "aabb");
+        ok.with(|c| c.a0 = null())
+            .fails(Own, NULL, "x0, x1: positions");
+        ok.with(|c| c.a0 = null())
+            .fails(Pair, NULL, "a0, a1: positions");
+        ok.with(|c| c.a1 = null())
+            .fails(Both, NULL, "positions is a null");
+        ok.with(|c| c.b1 = null())
+            .fails(Pair, NULL, "b0, b1: positions");
+        ok.with(|c| (c.a0, c.na) = (odd, 1))
+            .fails(Both, ARGUMENT, "aligned");
+        ok.with(|c| c.na = nv - 1).fails(Both, LENGTH, "vertices");
+        ok.with(|c| c.nb = nv + 1).fails(Pair, LENGTH, "vertices");
+        ok.with(|c| c.a1 = nan.as_ptr())
+            .fails(Both, MESH, "non-finite");
+        ok.with(|c| c.b0 = nan.as_ptr())
+            .fails(Pair, MESH, "non-finite");
+        ok.with(|c| c.a0 = big.as_ptr())
+            .fails(Both, MESH, "f32 range");
+        for t_max in [1.5, -1e-300, f64::NAN, f64::INFINITY] {
+            ok.with(|c| c.t_max = t_max).fails(Both, ARGUMENT, "t_max");
+        }
+        for d in [-1.0, -1e-300, f64::NAN, f64::INFINITY] {
+            ok.with(|c| c.d = d).fails(Both, ARGUMENT, "min_distance");
+        }
+        for threads in [4096, u32::MAX] {
+            ok.with(|c| c.threads = threads)
+                .fails(Both, ARGUMENT, "threads");
+        }
+        assert_eq!(
+            dhcd_self_ccd(a, p, p, nv, 1.0, 0.0, 0, 1, null_mut()),
+            DHCD_ERR_NULL
+        );
+        assert_eq!(
+            dhcd_ccd(a, p, p, nv, b, p, p, nv, 1.0, 0.0, 0, 1, null_mut()),
+            DHCD_ERR_NULL
+        );
+        // The handles still work.
+        let ok = c_self_ccd(a, &x, &x, CcdQuery::all(), 1);
+        assert_eq!(ok.counters.contacts, 0);
+        assert_eq!(ok.toi, None);
+
+        // Single queries.
+        let q = [0.0f64; 12];
+        let mut inf = [0.0f64; 12];
+        inf[11] = f64::INFINITY;
+        let (q, inf) = (q.as_ptr(), inf.as_ptr());
+        type Single<'a> = (*const f64, *const f64, f64, f64, i32, &'a str);
+        let single: [Single; 8] = [
+            (null(), q, 1.0, 0.0, NULL, "x0"),
+            (q, null(), 1.0, 0.0, NULL, "x1"),
+            (odd, q, 1.0, 0.0, ARGUMENT, "aligned"),
+            (q, inf, 1.0, 0.0, ARGUMENT, "point 7"),
+            (q, q, 2.0, 0.0, ARGUMENT, "t_max"),
+            (q, q, -1e-9, 0.0, ARGUMENT, "t_max"),
+            (q, q, 1.0, f64::NAN, ARGUMENT, "min_distance"),
+            (q, q, 1.0, -0.5, ARGUMENT, "min_distance"),
+        ];
+        for f in [dhcd_vertex_face_ccd, dhcd_edge_edge_ccd] {
+            for (x0, x1, t_max, d, code, message) in single {
+                let mut toi = 42.0;
+                let rc = f(x0, x1, t_max, d, &mut toi);
+                assert_eq!(rc, code, "{message}: {}", last_error());
+                let what = format!("{message}: {}", last_error());
+                assert!(last_error().contains(message), "{what}");
+                assert_eq!(toi, 42.0, "{what}: toi unwritten");
+            }
+            assert_eq!(f(q, q, 1.0, 0.0, null_mut()), NULL);
+            assert!(last_error().contains("toi"));
+            // Points that do not move and all coincide touch at t = 0.
+            let mut toi = 42.0;
+            assert_eq!(f(q, q, 1.0, 0.0, &mut toi), 1);
+            assert_eq!(toi, 0.0);
+        }
+        for h in [a, b, box_] {
+            dhcd_hierarchy_free(h);
+        }
+    }
+}
+
+/// A step with nothing colliding: null arrays, `toi = +inf`, counters filled; every free
+/// takes it (and null, and a result twice); the layout the header assumes.
+#[test]
+fn empty_impacts_free() {
+    assert_eq!(
+        std::mem::size_of::<DhcdImpacts>(),
+        9 * std::mem::size_of::<usize>() + 8 + 32
+    );
+    let m = icosphere(1, 1.0, [0.0; 3]);
+    let x0 = f64s(m.positions());
+    let x1: Vec<[f64; 3]> = x0.iter().map(|p| [p[0] + 0.5, p[1], p[2]]).collect();
+    let far: Vec<[f64; 3]> = x0.iter().map(|p| [p[0] + 10.0, p[1], p[2]]).collect();
+    let (a, b) = (new_h(DHCD_METHOD_SPHERE, &m), new_h(DHCD_METHOD_SPHERE, &m));
+    // SAFETY: live handles, arrays of the stated lengths, writable outputs; results released
+    // once (then no-ops).
+    unsafe {
+        let (f0, f1, ff) = (flat64(&x0), flat64(&x1), flat64(&far));
+        let mut out = garbage_impacts();
+        let rc = dhcd_ccd(
+            a,
+            f0.as_ptr(),
+            f1.as_ptr(),
+            x0.len(),
+            b,
+            ff.as_ptr(),
+            ff.as_ptr(),
+            x0.len(),
+            1.0,
+            0.0,
+            0,
+            1,
+            &mut out,
+        );
+        assert_eq!(rc, DHCD_OK, "{}", last_error());
+        assert!(out.vf_count == 0 && out.fv_count == 0 && out.ee_count == 0);
+        assert!(out.vertex_face.is_null() && out.fv_toi.is_null() && out.ee_toi.is_null());
+        assert_eq!(out.toi, f64::INFINITY);
+        assert!(out.counters.bv_tests > 0, "counters are filled");
+        dhcd_impacts_free(&mut out);
+        assert!(is_empty_impacts(&out));
+        dhcd_impacts_free(&mut out);
+        dhcd_impacts_free(null_mut());
+        let mut zero: DhcdImpacts = std::mem::zeroed();
+        dhcd_impacts_free(&mut zero);
+        // A rigid motion of one mesh: nothing collides with itself.
+        let mut out = garbage_impacts();
+        let rc = dhcd_self_ccd(
+            a,
+            f0.as_ptr(),
+            f1.as_ptr(),
+            x0.len(),
+            1.0,
+            0.0,
+            1,
+            2,
+            &mut out,
+        );
+        assert_eq!(rc, DHCD_OK);
+        assert!(out.vertex_face.is_null() && out.edge_edge.is_null());
+        assert_eq!(out.toi, f64::INFINITY);
+        dhcd_impacts_free(&mut out);
+        dhcd_hierarchy_free(a);
+        dhcd_hierarchy_free(b);
+    }
+}

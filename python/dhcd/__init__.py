@@ -1,9 +1,9 @@
 """Collision detection between deformable triangle meshes.
 
 Distance Hierarchy (DH), sphere and AABB bounding-volume hierarchies over one region tree,
-refitted lazily after every deformation, with exact triangle-triangle contacts and exact
-proximity queries, for float32 or float64 coordinates. The API is documented in
-``__init__.pyi`` and ``docs/PYTHON.md``.
+refitted lazily after every deformation, with exact triangle-triangle contacts, exact
+proximity queries and exact continuous collision detection, for float32 or float64
+coordinates. The API is documented in ``__init__.pyi`` and ``docs/PYTHON.md``.
 """
 
 from ._dhcd import (
@@ -11,13 +11,17 @@ from ._dhcd import (
     POINT_TRIANGLE_TYPES,
     Contacts,
     Hierarchy,
+    Impacts,
     Proximity,
     Scene,
+    ccd,
     collide,
     contact_segments,
+    edge_edge_ccd,
     load_mesh,
     proximity,
     self_proximity,
+    vertex_face_ccd,
 )
 from ._manager import CollisionManager
 
@@ -27,11 +31,15 @@ __all__ = [
     "CollisionManager",
     "Contacts",
     "Hierarchy",
+    "Impacts",
     "Proximity",
     "Scene",
+    "ccd",
     "collide",
     "contact_segments",
+    "edge_edge_ccd",
     "load_mesh",
     "proximity",
     "self_proximity",
+    "vertex_face_ccd",
 ]

@@ -2,8 +2,10 @@
 
 Build a hierarchy once from a rest pose, hand it new vertex positions every step (it is
 refitted lazily, never rebuilt) and query: every pair of faces whose closed triangles
-intersect, and every vertex-face and edge-edge pair within a distance (proximity), decided
-exactly for the coordinates as given, as sorted numpy arrays of the caller's indices.
+intersect, every vertex-face and edge-edge pair within a distance (proximity), and every
+vertex-face and edge-edge pair that collides while the vertices move linearly over a step
+(continuous collision detection, CCD), decided exactly for the coordinates as given, as
+sorted numpy arrays of the caller's indices.
 
 Inputs: ``vertices`` is an ``(n, 3)`` array of real numbers, ``faces`` an ``(m, 3)`` integer
 array of vertex indices. Precision follows the vertices' dtype (numpy's:
@@ -18,6 +20,10 @@ that cannot convert, NaN or infinite coordinates, float64 coordinates beyond flo
 unknown method, a negative, NaN or infinite distance, a file that cannot be parsed) raises
 ``ValueError`` with the library's message; a file that cannot be read raises ``OSError``
 (``FileNotFoundError`` if missing).
+
+CCD positions are float64 only, for hierarchies of either precision: any other dtype
+raises ``ValueError`` and is never converted (the answers are exact for the doubles given;
+convert explicitly, e.g. ``x.astype(numpy.float64)``).
 
 Threads: queries and updates release the GIL, so Python threads may query different objects
 at the same time. One object used by two threads at once raises ``RuntimeError`` (it is
@@ -49,13 +55,17 @@ __all__ = [
     "CollisionManager",
     "Contacts",
     "Hierarchy",
+    "Impacts",
     "Proximity",
     "Scene",
+    "ccd",
     "collide",
     "contact_segments",
+    "edge_edge_ccd",
     "load_mesh",
     "proximity",
     "self_proximity",
+    "vertex_face_ccd",
 ]
 
 POINT_TRIANGLE_TYPES: List[str]
@@ -77,6 +87,11 @@ bytes; alias ``"sbv"``), ``"aabb"`` (24 bytes). Case-insensitive."""
 
 Vertices = npt.ArrayLike
 Faces = npt.ArrayLike
+Positions64 = npt.ArrayLike
+"""CCD positions: an ``(n, 3)`` float64 array (numpy's dtype of ``numpy.asarray(x)``; a
+list of Python floats is float64), in the mesh's vertex order."""
+Queries64 = npt.ArrayLike
+"""Single-pair CCD queries: an ``(N, 4, 3)`` float64 array, four points per query."""
 # `Scene.update_many` and `Scene.step`: `{id or name: vertices}` or `[(id or name, vertices)]`.
 Updates = Union[Mapping[Union[int, str], Vertices], Iterable[Tuple[Union[int, str], Vertices]]]
 
@@ -145,6 +160,50 @@ class Proximity:
     def __len__(self) -> int:
         """The number of pairs of the three lists."""
 
+class Impacts:
+    """The result of a CCD query: every vertex-face, face-vertex and edge-edge pair that
+    collides during the step, each list sorted by its rows, with its time of impact
+    (float64, in ``[0, t_max]``). Whether a pair collides (comes within ``min_distance``,
+    touching when it is 0, at some time in ``[0, t_max]``) is decided exactly for the
+    float64 positions; a time of impact is never later than the pair's first contact and at
+    most ``1e-12`` before it.
+
+    From ``ccd(a, b, a0, a1, b0, b1)`` (``ccd(h, x0, x1)`` likewise, ``face_vertex``
+    empty)::
+
+        vertex_face  (K, 2) [vertex of a, face of b]     (self: a face not containing it)
+        face_vertex  (K, 2) [face of a, vertex of b]
+        edge_edge    (K, 4) [a0, a1, b0, b1]             (a0 < a1, b0 < b1; self:
+                                                          (a0, a1) < (b0, b1), no shared vertex)
+
+    With ``earliest=True`` the lists hold only the pairs whose time of impact is ``toi``.
+    """
+
+    @property
+    def vertex_face(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def vf_toi(self) -> npt.NDArray[np.float64]:
+        """``(K,)`` times of impact of the ``vertex_face`` rows."""
+    @property
+    def face_vertex(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def fv_toi(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def edge_edge(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def ee_toi(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def toi(self) -> float:
+        """The earliest time of impact of the step (the least of the rows' times), ``inf``
+        when nothing collides."""
+    @property
+    def counters(self) -> Dict[str, int]:
+        """``bv_tests`` (node pairs tested over the step), ``bv_updates`` (bounds fitted over
+        the step), ``prim_tests`` (feature pairs given to the exact test), ``contacts``
+        (pairs reported)."""
+    def __len__(self) -> int:
+        """The number of pairs of the three lists."""
+
 class Hierarchy:
     """The bounding-volume hierarchy of one deformable mesh; ``vertices`` is its rest pose
     (float64: an ``"f64"`` hierarchy, otherwise ``"f32"``).
@@ -201,6 +260,67 @@ def proximity(a: Hierarchy, b: Hierarchy, d: float, threads: int = 1) -> Proximi
 def self_proximity(h: Hierarchy, d: float, threads: int = 1) -> Proximity:
     """Every pair of one mesh within distance ``d``: a vertex and a face not containing
     it, two edges sharing no vertex."""
+
+@overload
+def ccd(
+    h: Hierarchy,
+    x0: Positions64,
+    x1: Positions64,
+    *,
+    min_distance: float = 0.0,
+    earliest: bool = False,
+    t_max: float = 1.0,
+    threads: int = 1,
+) -> Impacts:
+    """Continuous collision detection of one mesh over a step: every vertex moves on the
+    straight line from its position in ``x0`` (t = 0) to its position in ``x1`` (t = 1);
+    every vertex-face pair (the face not containing the vertex) and edge-edge pair (sharing
+    no vertex) that comes within ``min_distance`` (``0``: touches) at some t in
+    ``[0, t_max]``. ``x0``, ``x1``: float64 ``(n, 3)``, n the mesh's vertex count (finite,
+    within float32's range), for a hierarchy of either precision (its own pose is not
+    used or changed). ``earliest=True``: only the earliest time of impact and the pairs
+    reaching it (what a line search asks). Exact for the doubles (see ``Impacts``); the
+    result does not depend on ``threads`` (the work counters of earliest mode may)."""
+
+@overload
+def ccd(
+    a: Hierarchy,
+    b: Hierarchy,
+    a0: Positions64,
+    a1: Positions64,
+    b0: Positions64,
+    b1: Positions64,
+    *,
+    min_distance: float = 0.0,
+    earliest: bool = False,
+    t_max: float = 1.0,
+    threads: int = 1,
+) -> Impacts:
+    """Continuous collision detection between two meshes over a step, ``a`` moving from
+    ``a0`` to ``a1`` and ``b`` from ``b0`` to ``b1``: every vertex of ``a`` against every
+    face of ``b`` (``vertex_face``), every face of ``a`` against every vertex of ``b``
+    (``face_vertex``) and every edge of ``a`` against every edge of ``b`` (``edge_edge``).
+    ``a`` and ``b`` are different hierarchies of the same method, either precision; the
+    rest as for one mesh."""
+
+def vertex_face_ccd(
+    x0: Queries64, x1: Queries64, *, min_distance: float = 0.0, t_max: float = 1.0
+) -> Tuple[npt.NDArray[np.bool_], npt.NDArray[np.float64]]:
+    """Vertex-face CCD of N single pairs: ``x0[k]`` holds the vertex and the face's three
+    corners ``[v, f0, f1, f2]`` at t = 0, ``x1[k]`` at t = 1 (float64 ``(N, 4, 3)`` each;
+    every point moves linearly). Returns ``(hits, toi)``: ``(N,)`` bool, whether the vertex
+    lies in the closed triangle (or within ``min_distance`` of it) at some t in
+    ``[0, t_max]``, decided exactly; ``(N,)`` float64, the time of impact (never later than
+    the first contact, at most ``1e-12`` before it), ``inf`` where there is none. A NaN or
+    infinite coordinate raises ``ValueError`` naming the query."""
+
+def edge_edge_ccd(
+    x0: Queries64, x1: Queries64, *, min_distance: float = 0.0, t_max: float = 1.0
+) -> Tuple[npt.NDArray[np.bool_], npt.NDArray[np.float64]]:
+    """Edge-edge CCD of N single pairs: ``x0[k]`` holds the two edges' endpoints
+    ``[a0, a1, b0, b1]`` at t = 0, ``x1[k]`` at t = 1. Whether the closed segments meet (or
+    come within ``min_distance``) at some t in ``[0, t_max]``, and when, as
+    ``vertex_face_ccd``."""
 
 def load_mesh(
     path: Union[str, "os.PathLike[str]"],

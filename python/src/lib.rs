@@ -12,18 +12,28 @@
 //! Copies: a C-contiguous `(n, 3)` vertex array of the hierarchy's float type is read in
 //! place (the library then copies it once into its own vertex order); any other vertex array
 //! is first converted once by numpy. Faces are converted to `u32` once, at construction.
+//!
+//! Continuous collision detection (`ccd`, `vertex_face_ccd`, `edge_edge_ccd`) takes float64
+//! positions only, for hierarchies of either precision: any other dtype is a `ValueError`,
+//! never converted (the answers are exact for the doubles given; the caller converts, and
+//! sees what is rounded).
 #![forbid(unsafe_code)]
 
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 
+use dhcd::ccd::CcdOptions;
 use dhcd::distance::{EdgeEdge, PointTriangle};
 use dhcd::mesh::{check_positions, check_positions_f64};
 use dhcd::{
-    AnyHierarchy, Counters, Error, Mesh, Method, ObjectId, Options, Par, Precision, Workspace,
+    AnyHierarchy, CcdMode, CcdQuery, Counters, Error, Mesh, Method, Motion, ObjectId, Options, Par,
+    Precision, Workspace,
 };
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyString, PyTuple};
@@ -666,6 +676,359 @@ fn self_proximity(
     Proximity::new(py, rows)
 }
 
+/// A real-number argument (`what` names it in messages; its range is the library's to
+/// check); one beyond the `float` range is a `ValueError` like any other bad value.
+fn real_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<f64> {
+    obj.extract::<f64>().map_err(|e| {
+        if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()) {
+            value_error(format!("{what} {obj} is out of range"))
+        } else {
+            e
+        }
+    })
+}
+
+/// `numpy.asarray(obj)` checked to be a float64 array of shape `(n, *tail)`, as a
+/// C-contiguous float64 array (the caller's when it already is one; a copy of the same
+/// values when its byte order or strides differ). Any other dtype is an error naming
+/// `what`, never a conversion.
+fn float64_rows<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+    tail: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    let np = obj.py().import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| value_error(format!("{what}: cannot convert to an array ({e})")))?;
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    if shape.len() != tail.len() + 1 || shape[1..] != *tail {
+        let want: Vec<String> = std::iter::once("n".to_string())
+            .chain(tail.iter().map(|d| d.to_string()))
+            .collect();
+        let got = arr.getattr("shape")?.repr()?;
+        return Err(value_error(format!(
+            "{what} must be an ({}) array, got shape {got}",
+            want.join(", ")
+        )));
+    }
+    if float_precision(&arr)? != Some(Precision::F64) {
+        let dtype = arr.getattr("dtype")?.str()?;
+        return Err(value_error(format!(
+            "{what} has dtype {dtype}; CCD positions must be float64 (no conversion: convert \
+             explicitly, e.g. with .astype(numpy.float64))"
+        )));
+    }
+    np.call_method1("ascontiguousarray", (arr, "float64"))
+}
+
+/// CCD positions of one mesh at one time: a float64 `(n, 3)` array.
+fn ccd_positions<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<PyReadonlyArray2<'py, f64>> {
+    float64_rows(obj, what, &[3])?.extract()
+}
+
+/// A read-only float64 array as rows of `[f64; N]`.
+fn rows_of<'a, const N: usize>(
+    a: &'a PyReadonlyArray2<'_, f64>,
+    what: &str,
+) -> PyResult<&'a [[f64; N]]>
+where
+    [f64; N]: bytemuck::Pod,
+{
+    let flat = a
+        .as_slice()
+        .map_err(|e| value_error(format!("{what}: {e}")))?;
+    Ok(bytemuck::cast_slice(flat))
+}
+
+/// The CCD query of the keyword arguments (checked by the library's query).
+fn ccd_query(
+    min_distance: Option<&Bound<'_, PyAny>>,
+    t_max: Option<&Bound<'_, PyAny>>,
+    earliest: bool,
+) -> PyResult<CcdQuery> {
+    Ok(CcdQuery {
+        options: ccd_options(min_distance, t_max)?,
+        mode: if earliest {
+            CcdMode::Earliest
+        } else {
+            CcdMode::All
+        },
+    })
+}
+
+/// `min_distance` (default 0) and `t_max` (default 1) as options, unchecked.
+fn ccd_options(
+    min_distance: Option<&Bound<'_, PyAny>>,
+    t_max: Option<&Bound<'_, PyAny>>,
+) -> PyResult<CcdOptions> {
+    let mut o = CcdOptions::default();
+    if let Some(d) = min_distance {
+        o.min_distance = real_arg(d, "min_distance")?;
+    }
+    if let Some(t) = t_max {
+        o.t_max = real_arg(t, "t_max")?;
+    }
+    Ok(o)
+}
+
+/// A positional argument of `ccd` that must be a `Hierarchy`.
+fn hierarchy_arg<'a, 'py>(
+    obj: &'a Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<&'a Bound<'py, Hierarchy>> {
+    obj.cast::<Hierarchy>().map_err(|_| {
+        let kind = obj
+            .get_type()
+            .name()
+            .map(|n| n.to_string())
+            .unwrap_or_default();
+        PyTypeError::new_err(format!("ccd: {what} must be a dhcd.Hierarchy, got {kind}"))
+    })
+}
+
+/// Continuous collision detection over a step: `ccd(h, x0, x1)` for one mesh,
+/// `ccd(a, b, a0, a1, b0, b1)` for two.
+#[pyfunction]
+#[pyo3(
+    signature = (*args, min_distance = None, earliest = false, t_max = None, threads = None),
+    text_signature = "(h, x0, x1, *, min_distance=0.0, earliest=False, t_max=1.0, threads=1)"
+)]
+fn ccd(
+    py: Python<'_>,
+    args: &Bound<'_, PyTuple>,
+    min_distance: Option<&Bound<'_, PyAny>>,
+    earliest: bool,
+    t_max: Option<&Bound<'_, PyAny>>,
+    threads: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Impacts> {
+    let q = ccd_query(min_distance, t_max, earliest)?;
+    let par = par(threads)?;
+    match args.len() {
+        3 => {
+            let h = args.get_item(0)?;
+            let h = hierarchy_arg(&h, "h")?;
+            let (x0, x1) = (
+                ccd_positions(&args.get_item(1)?, "x0")?,
+                ccd_positions(&args.get_item(2)?, "x1")?,
+            );
+            let m = Motion::new(rows_of(&x0, "x0")?, rows_of(&x1, "x1")?);
+            let mut h = h.try_borrow_mut()?;
+            let h = &mut *h;
+            let r = py
+                .detach(|| h.h.self_ccd(m, &q, &mut h.ws, par))
+                .map_err(to_py)?;
+            Impacts::new(py, r)
+        }
+        6 => {
+            let (a, b) = (args.get_item(0)?, args.get_item(1)?);
+            let (a, b) = (hierarchy_arg(&a, "a")?, hierarchy_arg(&b, "b")?);
+            if a.is(b) {
+                return Err(value_error(
+                    "ccd needs two different hierarchies for a pair (use ccd(h, x0, x1) for one)"
+                        .into(),
+                ));
+            }
+            let names = ["a0", "a1", "b0", "b1"];
+            let x: Vec<PyReadonlyArray2<'_, f64>> = (0..4)
+                .map(|k| ccd_positions(&args.get_item(2 + k)?, names[k]))
+                .collect::<PyResult<_>>()?;
+            let ma = Motion::new(rows_of(&x[0], "a0")?, rows_of(&x[1], "a1")?);
+            let mb = Motion::new(rows_of(&x[2], "b0")?, rows_of(&x[3], "b1")?);
+            let (mut a, mut b) = (a.try_borrow_mut()?, b.try_borrow_mut()?);
+            let (a, b) = (&mut *a, &mut *b);
+            let r = py
+                .detach(|| a.h.ccd_pair(ma, &b.h, mb, &q, &mut a.ws, par))
+                .map_err(to_py)?;
+            Impacts::new(py, r)
+        }
+        n => Err(PyTypeError::new_err(format!(
+            "ccd takes (h, x0, x1) or (a, b, a0, a1, b0, b1), got {n} positional arguments"
+        ))),
+    }
+}
+
+/// The result of a CCD query: every vertex-face, face-vertex and edge-edge pair that
+/// collides during the step, sorted, with its time of impact (see the stub).
+#[pyclass(module = "dhcd", frozen)]
+struct Impacts {
+    #[pyo3(get)]
+    vertex_face: Py<PyArray2<i64>>,
+    #[pyo3(get)]
+    vf_toi: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    face_vertex: Py<PyArray2<i64>>,
+    #[pyo3(get)]
+    fv_toi: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    edge_edge: Py<PyArray2<i64>>,
+    #[pyo3(get)]
+    ee_toi: Py<PyArray1<f64>>,
+    /// The earliest time of impact, `inf` when nothing collides.
+    #[pyo3(get)]
+    toi: f64,
+    #[pyo3(get)]
+    counters: Py<PyDict>,
+}
+
+/// `(K, N)` int64 index rows and `(K,)` float64 times of impact.
+type TimeColumns = (Py<PyArray2<i64>>, Py<PyArray1<f64>>);
+
+/// One list of a CCD result as numpy arrays.
+fn toi_columns<const N: usize>(
+    py: Python<'_>,
+    rows: Vec<([u32; N], f64)>,
+) -> PyResult<TimeColumns> {
+    let k = rows.len();
+    let flat: Vec<i64> = rows.iter().flat_map(|r| r.0).map(i64::from).collect();
+    let idx = Array2::from_shape_vec((k, N), flat)
+        .map_err(|e| value_error(format!("internal error: {e}")))?;
+    let toi: Vec<f64> = rows.iter().map(|r| r.1).collect();
+    Ok((idx.into_pyarray(py).unbind(), toi.into_pyarray(py).unbind()))
+}
+
+impl Impacts {
+    fn new(py: Python<'_>, r: dhcd::Impacts) -> PyResult<Self> {
+        let (vertex_face, vf_toi) = toi_columns(
+            py,
+            r.vertex_face
+                .iter()
+                .map(|x| ([x.vertex, x.triangle], x.toi))
+                .collect(),
+        )?;
+        let (face_vertex, fv_toi) = toi_columns(
+            py,
+            r.face_vertex
+                .iter()
+                .map(|x| ([x.triangle, x.vertex], x.toi))
+                .collect(),
+        )?;
+        let (edge_edge, ee_toi) = toi_columns(
+            py,
+            r.edge_edge
+                .iter()
+                .map(|x| ([x.a[0], x.a[1], x.b[0], x.b[1]], x.toi))
+                .collect(),
+        )?;
+        Ok(Self {
+            vertex_face,
+            vf_toi,
+            face_vertex,
+            fv_toi,
+            edge_edge,
+            ee_toi,
+            toi: r.toi.unwrap_or(f64::INFINITY),
+            counters: counters(py, r.counters)?,
+        })
+    }
+
+    fn counts(&self, py: Python<'_>) -> [usize; 3] {
+        [&self.vertex_face, &self.face_vertex, &self.edge_edge].map(|a| a.bind(py).shape()[0])
+    }
+}
+
+#[pymethods]
+impl Impacts {
+    /// The number of pairs of the three lists.
+    fn __len__(&self, py: Python<'_>) -> usize {
+        self.counts(py).iter().sum()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let [vf, fv, ee] = self.counts(py);
+        Ok(format!(
+            "Impacts({vf} vertex-face, {fv} face-vertex, {ee} edge-edge pairs, toi={}, \
+             counters={})",
+            self.toi,
+            self.counters.bind(py).repr()?
+        ))
+    }
+}
+
+/// `(hits, toi)` of a batch of single-pair CCD queries: `(N,)` bool and float64.
+type Batch<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>);
+
+/// One single-pair CCD test of the library, checked.
+type CcdTest = fn(&[[f64; 3]; 4], &[[f64; 3]; 4], &CcdOptions) -> dhcd::Result<Option<f64>>;
+
+/// `(hits, toi)` of a batch of single-pair queries: `x0` and `x1` float64 `(N, 4, 3)`.
+fn batch_ccd<'py>(
+    py: Python<'py>,
+    test: CcdTest,
+    x0: &Bound<'py, PyAny>,
+    x1: &Bound<'py, PyAny>,
+    min_distance: Option<&Bound<'py, PyAny>>,
+    t_max: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Batch<'py>> {
+    let options = ccd_options(min_distance, t_max)?;
+    options.validate().map_err(to_py)?;
+    let a0: PyReadonlyArray3<'py, f64> = float64_rows(x0, "x0", &[4, 3])?.extract()?;
+    let a1: PyReadonlyArray3<'py, f64> = float64_rows(x1, "x1", &[4, 3])?.extract()?;
+    let (n0, n1) = (a0.shape()[0], a1.shape()[0]);
+    if n0 != n1 {
+        return Err(value_error(format!(
+            "x0 and x1 must hold the same number of queries, got {n0} and {n1}"
+        )));
+    }
+    let slice = |a: &'_ PyReadonlyArray3<'py, f64>, what: &str| -> PyResult<Vec<[[f64; 3]; 4]>> {
+        let flat = a
+            .as_slice()
+            .map_err(|e| value_error(format!("{what}: {e}")))?;
+        Ok(flat
+            .chunks_exact(12)
+            .map(|q| std::array::from_fn(|p| std::array::from_fn(|c| q[3 * p + c])))
+            .collect())
+    };
+    let (q0, q1) = (slice(&a0, "x0")?, slice(&a1, "x1")?);
+    let (hits, tois) = py
+        .detach(|| -> Result<(Vec<bool>, Vec<f64>), String> {
+            let mut hits = Vec::with_capacity(q0.len());
+            let mut tois = Vec::with_capacity(q0.len());
+            for (k, (p0, p1)) in q0.iter().zip(&q1).enumerate() {
+                let toi = test(p0, p1, &options).map_err(|e| format!("query {k}: {e}"))?;
+                hits.push(toi.is_some());
+                tois.push(toi.unwrap_or(f64::INFINITY));
+            }
+            Ok((hits, tois))
+        })
+        .map_err(value_error)?;
+    Ok((hits.into_pyarray(py), tois.into_pyarray(py)))
+}
+
+/// Vertex-face CCD of a batch of single pairs: `x0`, `x1` float64 `(N, 4, 3)`, rows
+/// `[v, f0, f1, f2]` at t = 0 and t = 1.
+#[pyfunction]
+#[pyo3(
+    signature = (x0, x1, *, min_distance = None, t_max = None),
+    text_signature = "(x0, x1, *, min_distance=0.0, t_max=1.0)"
+)]
+fn vertex_face_ccd<'py>(
+    py: Python<'py>,
+    x0: &Bound<'py, PyAny>,
+    x1: &Bound<'py, PyAny>,
+    min_distance: Option<&Bound<'py, PyAny>>,
+    t_max: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Batch<'py>> {
+    batch_ccd(py, dhcd::ccd::try_vertex_face, x0, x1, min_distance, t_max)
+}
+
+/// Edge-edge CCD of a batch of single pairs: `x0`, `x1` float64 `(N, 4, 3)`, rows
+/// `[a0, a1, b0, b1]` at t = 0 and t = 1.
+#[pyfunction]
+#[pyo3(
+    signature = (x0, x1, *, min_distance = None, t_max = None),
+    text_signature = "(x0, x1, *, min_distance=0.0, t_max=1.0)"
+)]
+fn edge_edge_ccd<'py>(
+    py: Python<'py>,
+    x0: &Bound<'py, PyAny>,
+    x1: &Bound<'py, PyAny>,
+    min_distance: Option<&Bound<'py, PyAny>>,
+    t_max: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Batch<'py>> {
+    batch_ccd(py, dhcd::ccd::try_edge_edge, x0, x1, min_distance, t_max)
+}
+
 /// `(vertices, faces)` as numpy arrays.
 type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<i64>>);
 
@@ -1048,8 +1411,8 @@ fn edge_edge_types() -> Vec<&'static str> {
 mod dhcd_native {
     #[pymodule_export]
     use super::{
-        collide, contact_segments, load_mesh, proximity, self_proximity, Contacts, Hierarchy,
-        Proximity, Scene,
+        ccd, collide, contact_segments, edge_edge_ccd, load_mesh, proximity, self_proximity,
+        vertex_face_ccd, Contacts, Hierarchy, Impacts, Proximity, Scene,
     };
 
     #[pymodule_init]

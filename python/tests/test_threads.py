@@ -69,9 +69,15 @@ def test_python_threads_query_different_objects_in_parallel():
     assert all(r == expected for r in results)
 
 
+# The motion of the CCD query: the folded sheet's upper layer moving down through the lower.
+_REST, _FOLDED, _ = folded_grid(48)
+_X0 = _FOLDED.astype(np.float64)
+_X1 = _X0 - np.where(_REST[:, [0]] > 1.0, (0.0, 0.0, 0.25), 0.0)
+
 QUERIES = {
     "self_collide": lambda h: h.self_collide(),
     "self_proximity": lambda h: dhcd.self_proximity(h, 0.005),
+    "ccd": lambda h: dhcd.ccd(h, _X0, _X1),
 }
 
 

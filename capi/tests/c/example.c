@@ -1,5 +1,5 @@
-/* dhcd from C: build meshes, deform, collide, self-collide, a scene, f64 hierarchies and
- * proximity; check and print.
+/* dhcd from C: build meshes, deform, collide, self-collide, a scene, f64 hierarchies,
+ * proximity and continuous collision detection; check and print.
  * Exits non-zero on any mismatch. Built and run by capi/tests/c/run.sh. */
 #include <math.h>
 #include <stdio.h>
@@ -78,6 +78,19 @@ static int same_proximity(const DhcdProximity *x, const DhcdProximity *y) {
          same_array(x->edge_edge, y->edge_edge, 4 * x->ee_count, sizeof(uint32_t)) &&
          same_array(x->ee_distance_sq, y->ee_distance_sq, x->ee_count, sizeof(double)) &&
          same_array(x->ee_type, y->ee_type, x->ee_count, 1) &&
+         memcmp(&x->counters, &y->counters, sizeof(DhcdCounters)) == 0;
+}
+
+/* Whether two CCD results are equal, every array and the counters. */
+static int same_impacts(const DhcdImpacts *x, const DhcdImpacts *y) {
+  return x->vf_count == y->vf_count && x->fv_count == y->fv_count &&
+         x->ee_count == y->ee_count && x->toi == y->toi &&
+         same_array(x->vertex_face, y->vertex_face, 2 * x->vf_count, sizeof(uint32_t)) &&
+         same_array(x->vf_toi, y->vf_toi, x->vf_count, sizeof(double)) &&
+         same_array(x->face_vertex, y->face_vertex, 2 * x->fv_count, sizeof(uint32_t)) &&
+         same_array(x->fv_toi, y->fv_toi, x->fv_count, sizeof(double)) &&
+         same_array(x->edge_edge, y->edge_edge, 4 * x->ee_count, sizeof(uint32_t)) &&
+         same_array(x->ee_toi, y->ee_toi, x->ee_count, sizeof(double)) &&
          memcmp(&x->counters, &y->counters, sizeof(DhcdCounters)) == 0;
 }
 
@@ -394,6 +407,101 @@ int main(void) {
   free(lower);
   free(upper);
   free(layers);
+
+  /* 7. Continuous collision detection (double positions at t0 and t1, for hierarchies of
+   * either precision). A single vertex falling through a triangle: it touches at t = 0.5;
+   * the time is never later and at most 1e-12 earlier. */
+  const double vf0[12] = {0.25, 0.25, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const double vf1[12] = {0.25, 0.25, -1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+  double toi = -1;
+  CHECK(dhcd_vertex_face_ccd(vf0, vf1, 1.0, 0.0, &toi) == 1);
+  CHECK(toi <= 0.5 && 0.5 - toi <= 1e-12);
+  CHECK(dhcd_vertex_face_ccd(vf0, vf1, 0.25, 0.0, &toi) == 0 && toi == INFINITY);
+  /* Two parallel edges 1 apart that never move: within 1, never touching. */
+  const double ee[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  CHECK(dhcd_edge_edge_ccd(ee, ee, 1.0, 0.0, &toi) == 0);
+  CHECK(dhcd_edge_edge_ccd(ee, ee, 1.0, 1.0, &toi) == 1 && toi == 0.0);
+  toi = 7;
+  CHECK(dhcd_edge_edge_ccd(ee, ee, 2.0, 0.0, &toi) == DHCD_ERR_INVALID_ARGUMENT && toi == 7);
+  printf("expected error: %s\n", dhcd_last_error_message());
+
+  /* Tunnelling: one mesh of two parallel grids, the upper one 0.05 above the lower at t0
+   * and 0.05 below it at t1. Neither pose has a contact; over the step the layers meet at
+   * t = 0.5. Self-CCD of the mesh on an f32 hierarchy finds the pairs between the layers
+   * (the same on 1 and 2 threads); the pair query between the two grids finds the same
+   * ones. */
+  double *c0 = malloc(6 * nv * sizeof(double)), *c1 = malloc(6 * nv * sizeof(double));
+  for (size_t k = 0; k < 3 * nv; k++) {
+    const int axis = (int)(k % 3);
+    c0[k] = c1[k] = g[k];                                      /* the lower grid stays */
+    c0[3 * nv + k] = axis == 2 ? 0.05 : g[k] + (axis == 0 ? 0.02 : 0.03);
+    c1[3 * nv + k] = axis == 2 ? -0.05 : c0[3 * nv + k];
+  }
+  /* The hierarchies may be built from any pose: CCD takes its positions from c0 and c1. */
+  DhcdHierarchy *layered = NULL, *still = NULL, *moving = NULL;
+  OK(dhcd_hierarchy_new(DHCD_METHOD_DH, 0, both, 2 * nv, bt, 2 * nt, &layered));
+  OK(dhcd_hierarchy_new(DHCD_METHOD_DH, 0, g, nv, gt, nt, &still));
+  OK(dhcd_hierarchy_new(DHCD_METHOD_DH, 0, g, nv, gt, nt, &moving));
+  DhcdImpacts all1 = {0}, all2 = {0}, early = {0}, pair_ccd = {0};
+  OK(dhcd_self_ccd(layered, c0, c1, 2 * nv, 1.0, 0.0, 0, 1, &all1));
+  OK(dhcd_self_ccd(layered, c0, c1, 2 * nv, 1.0, 0.0, 0, 2, &all2));
+  CHECK(same_impacts(&all1, &all2));
+  CHECK(all1.vf_count > 0 && all1.ee_count > 0 && all1.fv_count == 0);
+  CHECK(all1.toi <= 0.5 && 0.5 - all1.toi <= 1e-12);
+  CHECK(all1.counters.contacts == all1.vf_count + all1.ee_count);
+  for (size_t k = 0; k < all1.vf_count; k++) {
+    const uint32_t v = all1.vertex_face[2 * k], t = all1.vertex_face[2 * k + 1];
+    CHECK((v < nv) == (t >= nt)); /* a vertex of one layer, a triangle of the other */
+    CHECK(all1.vf_toi[k] <= 0.5 && 0.5 - all1.vf_toi[k] <= 1e-12);
+  }
+  /* Earliest mode: the same first time, and only pairs reaching it. */
+  OK(dhcd_self_ccd(layered, c0, c1, 2 * nv, 1.0, 0.0, 1, 1, &early));
+  CHECK(early.toi == all1.toi);
+  CHECK(early.vf_count + early.ee_count >= 1);
+  CHECK(early.vf_count <= all1.vf_count && early.ee_count <= all1.ee_count);
+  for (size_t k = 0; k < early.vf_count; k++) CHECK(early.vf_toi[k] == early.toi);
+  for (size_t k = 0; k < early.ee_count; k++) CHECK(early.ee_toi[k] == early.toi);
+  /* The pair query: the lower grid still, the upper one moving. */
+  OK(dhcd_ccd(still, c0, c1, nv, moving, c0 + 3 * nv, c1 + 3 * nv, nv, 1.0, 0.0, 0, 2,
+              &pair_ccd));
+  CHECK(pair_ccd.vf_count + pair_ccd.fv_count == all1.vf_count);
+  CHECK(pair_ccd.ee_count == all1.ee_count && pair_ccd.toi == all1.toi);
+  size_t across = 0;
+  for (size_t k = 0; k < all1.vf_count; k++) {
+    const uint32_t v = all1.vertex_face[2 * k], t = all1.vertex_face[2 * k + 1];
+    if (v < nv) { /* a lower vertex, an upper triangle: the pair's vertex_face, in order */
+      const size_t j = across++;
+      CHECK(j < pair_ccd.vf_count);
+      if (j < pair_ccd.vf_count) {
+        CHECK(pair_ccd.vertex_face[2 * j] == v && pair_ccd.vertex_face[2 * j + 1] + nt == t);
+        CHECK(pair_ccd.vf_toi[j] == all1.vf_toi[k]);
+      }
+    }
+  }
+  CHECK(across == pair_ccd.vf_count);
+  printf("self-CCD of two layers passing through each other: %zu vertex-face, %zu edge-edge "
+         "pairs, first at t = %.17g; the pair query: %zu + %zu + %zu\n",
+         all1.vf_count, all1.ee_count, all1.toi, pair_ccd.vf_count, pair_ccd.fv_count,
+         pair_ccd.ee_count);
+  /* Errors: a time limit out of [0, 1]; the result is left empty. */
+  DhcdImpacts bad_ccd = all2;
+  CHECK(dhcd_self_ccd(layered, c0, c1, 2 * nv, 2.0, 0.0, 0, 1, &bad_ccd) ==
+        DHCD_ERR_INVALID_ARGUMENT);
+  CHECK(bad_ccd.vertex_face == NULL && bad_ccd.vf_count == 0 && bad_ccd.toi == INFINITY);
+  printf("expected error: %s\n", dhcd_last_error_message());
+  CHECK(dhcd_self_ccd(layered, c0, c1, nv, 1.0, 0.0, 0, 1, &bad_ccd) ==
+        DHCD_ERR_LENGTH_MISMATCH);
+  dhcd_impacts_free(&all1);
+  dhcd_impacts_free(&all2);
+  dhcd_impacts_free(&early);
+  dhcd_impacts_free(&pair_ccd);
+  dhcd_impacts_free(&pair_ccd); /* twice: no-op */
+  CHECK(pair_ccd.edge_edge == NULL && pair_ccd.ee_count == 0);
+  dhcd_hierarchy_free(layered);
+  dhcd_hierarchy_free(still);
+  dhcd_hierarchy_free(moving);
+  free(c0);
+  free(c1);
 
   dhcd_contacts_free(&first);
   free(g);
