@@ -153,8 +153,11 @@ pub struct Impacts {
 /// Every vertex-triangle and edge-edge pair of `a` and `b` that collides during the step
 /// (`a_motion`, `b_motion`), on the calling thread. Errors: invalid options
 /// ([`crate::Error::InvalidTimeLimit`], [`crate::Error::InvalidMinDistance`]) or
-/// positions ([`crate::Error::WrongVertexCount`], [`crate::Error::NonFinite`]), nothing
-/// computed.
+/// positions ([`crate::Error::WrongVertexCount`], [`crate::Error::NonFinite`],
+/// [`crate::Error::OutOfRange`]), nothing computed.
+///
+/// The hierarchies give their region trees and triangles (and DH its central vertices);
+/// their current poses are not read: the positions are the motions'.
 pub fn ccd_pair<K: BvKind>(
     a: &Hierarchy<K>,
     a_motion: Motion<'_>,
