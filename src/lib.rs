@@ -1,10 +1,17 @@
 //! # dhcd — Distance Hierarchy collision detection for deformable triangle meshes
 //!
 //! Three bounding-volume hierarchies over one shared region tree (the paper's Distance
-//! Hierarchy, spheres, axis-aligned boxes), lazily refitted after every deformation, a
-//! stackless level-synchronous traversal, and an exact triangle-triangle narrow phase.
+//! Hierarchy, spheres, axis-aligned boxes), lazily refitted after every deformation, one
+//! depth-first traversal with wide SIMD node tests and a bounded explicit stack, generic
+//! over the query: exact contacts ([`collide`], [`self_collide`]), feature pairs within a
+//! distance ([`proximity`], [`self_proximity`]) and continuous collision detection over a
+//! step ([`self_ccd`], [`ccd_pair`]), all exact for the input as given (`f32` or `f64`).
 //! Every query counts its work (`N_V`, `N_P`, `N_U`) for the cost model
 //! `T = N_V*C_V + N_P*C_P + N_U*C_U`.
+//!
+//! Examples (in `examples/`, each run in CI): `deforming_step` (the step loop on a real
+//! frame pair, with the counters), `scene` (several objects), `cloth_proximity_ccd`
+//! (self-contacts, proximity and CCD of a folding sheet in `f64`).
 //!
 //! ```
 //! use dhcd::{bv::Dh, collide, Hierarchy, Mesh, Options};

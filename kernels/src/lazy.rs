@@ -8,7 +8,7 @@
 //! done (and `N_U`) does not depend on scheduling. It is a `OnceLock` per group without the
 //! reset: advancing the epoch (`&mut self`) makes every group stale at once.
 //!
-//! Protocol, per group: its state is the epoch its data belongs to, or [`BUSY`] while one
+//! Protocol, per group: its state is the epoch its data belongs to, or `BUSY` while one
 //! thread fills it. A thread that finds it stale claims it with a compare-exchange, fills the
 //! group's entries, and publishes with a release store of the current epoch; a thread that
 //! finds it `BUSY` waits. Readers only read a group after an acquire load of the current

@@ -10,7 +10,7 @@ use dhcd_kernels::Tile;
 /// group: the group's `F` fields over its padded slots (`tree.group_slots(g)`, its nodes
 /// first in order; see [`crate::tree::BLOCK`]), side by side in one buffer. This is the one
 /// place that knows the layout (`f32` for the bounds of a pose, `f64` for the moving
-/// spheres of a step, [`swept`]).
+/// spheres of a step, `swept.rs`).
 #[derive(Clone, Debug)]
 pub struct Bounds<const F: usize, T: Copy + Default = f32> {
     tiles: LazyTiles<T>,

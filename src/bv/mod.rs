@@ -71,7 +71,7 @@ mod sealed {
 /// [`crate::kinds`], the set the library compares; everything generic over them is
 /// monomorphised (no per-node dispatch).
 ///
-/// Node bounds live in [`LazyTiles`] buffers grouped by *sibling group* (the children of one
+/// Node bounds live in `LazyTiles` buffers grouped by *sibling group* (the children of one
 /// node, [`RegionTree::group_nodes`]): a group is fitted as a whole, just before its first
 /// test in a step, by whichever thread needs it first. A wide test reads one node of a
 /// fitted group against a block of another fitted group.
@@ -136,7 +136,8 @@ pub trait BvKind:
     /// validation).
     fn encloses(r: &Self::Record, p: &Points, point: [f64; 3]) -> bool;
 
-    /// Every node's bound over a step ([`swept`]), fitted lazily per sibling group.
+    /// Every node's bound over a step (see `src/bv/swept.rs`), fitted lazily per sibling
+    /// group.
     type Swept: Send + Sync;
     /// One sibling group's bounds over a step, as the swept node test reads them.
     type SweptBlock<'a>: Copy;

@@ -1,4 +1,4 @@
-//! The queries: each one is an implementation of the walk engine's [`Query`] (a node test and
+//! The queries: each one is an implementation of the walk engine's `Query` (a node test and
 //! a leaf action), with its public entry points.
 //!
 //! - `contacts.rs`: exact intersecting triangle pairs ([`collide`], [`self_collide`]), and
@@ -11,8 +11,8 @@
 //!   impact, or the earliest time, on the bounds of each region over the step;
 //! - `features.rs`: the feature boxes and their SIMD culling that proximity and CCD share.
 //!
-//! Queries on the current pose share [`Posed`]: two hierarchies' lazily fitted volumes and a
-//! node test ([`Overlap`], or [`Within`] a distance); they differ in the leaf action. CCD
+//! Queries on the current pose share `Posed`: two hierarchies' lazily fitted volumes and a
+//! node test (`Overlap`, or `Within` a distance); they differ in the leaf action. CCD
 //! implements the walk's `Query` itself, on the bounds over a step.
 
 pub(crate) mod ccd;
