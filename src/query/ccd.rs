@@ -325,6 +325,18 @@ struct ImpactOut {
     edge_edge: Vec<EdgeImpact>,
 }
 
+impl ImpactOut {
+    /// The least time of impact of every pair held (`None`: no pair).
+    fn least_toi(&self) -> Option<f64> {
+        self.vertex_face
+            .iter()
+            .map(|x| x.toi)
+            .chain(self.face_vertex.iter().map(|x| x.toi))
+            .chain(self.edge_edge.iter().map(|x| x.toi))
+            .reduce(f64::min)
+    }
+}
+
 fn run<K: BvKind>(
     a: &Swept<'_, K>,
     b: &Swept<'_, K>,
@@ -351,13 +363,7 @@ fn run<K: BvKind>(
     out.face_vertex
         .sort_unstable_by_key(|x| (u64::from(x.triangle) << 32) | u64::from(x.vertex));
     out.edge_edge.sort_unstable_by_key(|x| (x.a, x.b));
-    let toi = out
-        .vertex_face
-        .iter()
-        .map(|x| x.toi)
-        .chain(out.face_vertex.iter().map(|x| x.toi))
-        .chain(out.edge_edge.iter().map(|x| x.toi))
-        .reduce(f64::min);
+    let toi = out.least_toi();
     let mut counters = w.counters;
     counters.contacts =
         (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
@@ -401,13 +407,7 @@ impl<K: BvKind> SweptQuery<'_, '_, K> {
     /// tested again over the whole interval; the least of those times and the pairs reaching
     /// it are the answer (the same whatever the order of the walk).
     fn settle_earliest(&self, out: &mut ImpactOut) {
-        let best = out
-            .vertex_face
-            .iter()
-            .map(|x| x.toi)
-            .chain(out.face_vertex.iter().map(|x| x.toi))
-            .chain(out.edge_edge.iter().map(|x| x.toi))
-            .fold(f64::INFINITY, f64::min);
+        let best = out.least_toi().unwrap_or(f64::INFINITY);
         let near = |toi: f64| toi <= best + PRUNE_SLACK;
         let (a, b) = (self.a, self.b);
         let o = &self.options;
@@ -444,20 +444,16 @@ impl<K: BvKind> SweptQuery<'_, '_, K> {
                 edge_edge.push(EdgeImpact { toi, ..*x });
             }
         }
-        let least = vertex_face
-            .iter()
-            .map(|x| x.toi)
-            .chain(face_vertex.iter().map(|x| x.toi))
-            .chain(edge_edge.iter().map(|x| x.toi))
-            .fold(f64::INFINITY, f64::min);
-        vertex_face.retain(|x| x.toi == least);
-        face_vertex.retain(|x| x.toi == least);
-        edge_edge.retain(|x| x.toi == least);
-        *out = ImpactOut {
+        let mut settled = ImpactOut {
             vertex_face,
             face_vertex,
             edge_edge,
         };
+        let least = settled.least_toi().unwrap_or(f64::INFINITY);
+        settled.vertex_face.retain(|x| x.toi == least);
+        settled.face_vertex.retain(|x| x.toi == least);
+        settled.edge_edge.retain(|x| x.toi == least);
+        *out = settled;
     }
 }
 

@@ -17,7 +17,7 @@ use dhcd::{
 };
 use serde_json::json;
 
-use super::ccd::f64_positions;
+use super::ccd::{ccd_query, f64_positions};
 use super::input::{update, InputArgs};
 
 /// Most passes over the frames (`--repeat`): a typo must not start a day-long run.
@@ -176,17 +176,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
             if opts.broad_only {
                 return Err("--broad-only is not available for ccd".into());
             }
-            let mode = if *earliest {
-                CcdMode::Earliest
-            } else {
-                CcdMode::All
-            };
-            let q = CcdQuery {
-                mode,
-                ..CcdQuery::default()
-            }
-            .with_min_distance(*min_distance);
-            q.options.validate().map_err(|e| e.to_string())?;
+            let q = ccd_query(*min_distance, *earliest).map_err(|e| e.to_string())?;
             Some(q)
         }
         _ => None,

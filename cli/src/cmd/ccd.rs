@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use dhcd::error::escaped_path;
 use dhcd::io::{self, Limits};
-use dhcd::{AnyHierarchy, CcdMode, CcdQuery, Impacts, Mesh, Motion, Par, Precision, Workspace};
+use dhcd::{AnyHierarchy, CcdQuery, Impacts, Mesh, Motion, Par, Precision, Workspace};
 
 use super::query::QueryArgs;
 
@@ -35,20 +35,16 @@ pub struct CcdArgs {
     query: QueryArgs,
 }
 
-impl CcdArgs {
-    fn ccd_query(&self) -> dhcd::Result<CcdQuery> {
-        let q = CcdQuery {
-            mode: if self.earliest {
-                CcdMode::Earliest
-            } else {
-                CcdMode::All
-            },
-            ..CcdQuery::default()
-        }
-        .with_min_distance(self.min_distance);
-        q.options.validate()?;
-        Ok(q)
+/// The CCD query of the flags `--min-distance` and `--earliest`, checked.
+pub fn ccd_query(min_distance: f64, earliest: bool) -> dhcd::Result<CcdQuery> {
+    let q = if earliest {
+        CcdQuery::earliest()
+    } else {
+        CcdQuery::all()
     }
+    .with_min_distance(min_distance);
+    q.options.validate()?;
+    Ok(q)
 }
 
 /// Loads the two poses of a step in f64; the second must have the first's triangles.
@@ -75,7 +71,7 @@ pub fn run(args: CcdArgs) -> Result<(), String> {
     let q = &args.query;
     let par = Par::threads(args.threads).map_err(|e| e.to_string())?;
     // Options are checked before any file is read.
-    let query = args.ccd_query().map_err(|e| e.to_string())?;
+    let query = ccd_query(args.min_distance, args.earliest).map_err(|e| e.to_string())?;
     let [m0, m1] = load_step(&args.t0, &args.t1, args.max_file_bytes)?;
     let h = AnyHierarchy::new(q.method, &m0, q.options()).map_err(|e| e.to_string())?;
     let motion = Motion::new(f64_positions(&m0), f64_positions(&m1));
