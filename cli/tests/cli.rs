@@ -6,7 +6,7 @@ use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
 use dhcd::shapes::{icosphere, wave};
 use dhcd::Mesh;
 
-use crate::support;
+use crate::support::{self, dhcd, json};
 
 /// Writes `mesh` as `name` in this suite's directory.
 fn write_obj(name: &str, mesh: &Mesh) -> PathBuf {
@@ -17,20 +17,6 @@ fn write_obj(name: &str, mesh: &Mesh) -> PathBuf {
         .join(name);
     support::write_obj(mesh, &path);
     path
-}
-
-/// Exit code, stdout, stderr.
-fn dhcd(args: &[&str]) -> (i32, String, String) {
-    let out = support::run_dhcd(args);
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8(out.stdout).unwrap(),
-        String::from_utf8(out.stderr).unwrap(),
-    )
-}
-
-fn json(s: &str) -> serde_json::Value {
-    serde_json::from_str(s).unwrap()
 }
 
 /// An icosphere waved at phase `t` by `amplitude`, moved by `offset`.

@@ -6,7 +6,7 @@ use dhcd::narrow::{brute_force_proximity, brute_force_self_proximity};
 use dhcd::shapes::{grid, icosphere, wave};
 use dhcd::{Mesh, Proximity};
 
-use crate::support;
+use crate::support::{self, dhcd, json};
 
 fn dir() -> &'static Path {
     static DIR: std::sync::OnceLock<support::TempDir> = std::sync::OnceLock::new();
@@ -19,32 +19,10 @@ fn write(name: &str, mesh: &Mesh) -> PathBuf {
     path
 }
 
-/// An OBJ of `f64` positions written to the last bit (`{:?}` prints the shortest decimal
-/// that reads back to the same `f64`).
 fn write_f64(name: &str, positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> PathBuf {
-    let mut text = String::new();
-    for p in positions {
-        text += &format!("v {:?} {:?} {:?}\n", p[0], p[1], p[2]);
-    }
-    for t in triangles {
-        text += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
-    }
     let path = dir().join(name);
-    std::fs::write(&path, text).unwrap();
+    support::write_obj_f64(&path, positions, triangles);
     path
-}
-
-fn dhcd(args: &[&str]) -> (i32, String, String) {
-    let out = support::run_dhcd(args);
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8(out.stdout).unwrap(),
-        String::from_utf8(out.stderr).unwrap(),
-    )
-}
-
-fn json(s: &str) -> serde_json::Value {
-    serde_json::from_str(s).unwrap_or_else(|e| panic!("{e}: {s}"))
 }
 
 /// The JSON's pairs as the library's result reports them.

@@ -3,6 +3,7 @@
 
 mod bench;
 mod cli;
+mod cli_ccd;
 mod cli_collide;
 mod cli_proximity;
 mod experiment;

@@ -66,3 +66,31 @@ pub fn run_dhcd_bounded(args: &[&str], data_kib: u64) -> Output {
         stderr: stderr.join().unwrap(),
     }
 }
+
+/// Runs `dhcd` with `args`: exit code, stdout, stderr.
+pub fn dhcd(args: &[&str]) -> (i32, String, String) {
+    let out = run_dhcd(args);
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+/// `s` parsed as JSON (the text in the panic message if it is not).
+pub fn json(s: &str) -> serde_json::Value {
+    serde_json::from_str(s).unwrap_or_else(|e| panic!("{e}: {s}"))
+}
+
+/// Writes an OBJ of `f64` positions to the last bit (`{:?}` prints the shortest decimal
+/// that reads back to the same `f64`).
+pub fn write_obj_f64(path: &Path, positions: &[[f64; 3]], triangles: &[[u32; 3]]) {
+    let mut text = String::new();
+    for p in positions {
+        text += &format!("v {:?} {:?} {:?}\n", p[0], p[1], p[2]);
+    }
+    for t in triangles {
+        text += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(path, text).unwrap();
+}
