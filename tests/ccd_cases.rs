@@ -507,27 +507,58 @@ fn invalid_input_is_a_typed_error() {
     assert!(msg.contains("point 3") && !msg.contains('\n'));
 }
 
+/// The filtered and the exact answers agree: the same decision, and both times within the
+/// tolerance below the true one (so within it of each other).
+fn agree(what: &str, filtered: Option<f64>, exact: Option<f64>) {
+    match (filtered, exact) {
+        (None, None) => {}
+        (Some(a), Some(b)) => assert!((a - b).abs() <= TOI_TOLERANCE, "{what}: {a} vs {b}"),
+        _ => panic!("{what}: filtered {filtered:?}, exact {exact:?}"),
+    }
+}
+
 #[test]
 fn minimum_distance_filter_agrees_with_the_exact_path() {
-    // The delta > 0 filter only rejects: on the first queries of every sample set, at
-    // three distances, the filtered entry equals the exact path alone.
+    // The delta > 0 filter decides in interval arithmetic where it can: on the first queries
+    // of every sample set at three distances, and on random motions of points in the unit
+    // cube passing each other at about those distances, the filtered entry decides as the
+    // exact path alone.
     let mut counts = [0usize; 2];
+    let mut run = |what: &str, vf: bool, x0: &Q, x1: &Q, o: &CcdOptions| {
+        let (a, b) = if vf {
+            (
+                ccd::vertex_face(x0, x1, o),
+                ccd::vertex_face_exact(x0, x1, o),
+            )
+        } else {
+            (ccd::edge_edge(x0, x1, o), ccd::edge_edge_exact(x0, x1, o))
+        };
+        agree(
+            &format!("{what} delta {}: {x0:?} -> {x1:?}", o.min_distance),
+            a,
+            b,
+        );
+        counts[a.is_some() as usize] += 1;
+    };
     for delta in [1e-6, 1e-3, 0.1] {
         let o = opts(1.0, delta);
         for (_, kind, qs) in super::ccd_samples::all_samples() {
             for (x0, x1, _) in qs.iter().take(8) {
-                let (a, b) = if kind == "vertex-face" {
-                    (
-                        ccd::vertex_face(x0, x1, &o),
-                        ccd::vertex_face_exact(x0, x1, &o),
-                    )
-                } else {
-                    (ccd::edge_edge(x0, x1, &o), ccd::edge_edge_exact(x0, x1, &o))
-                };
-                assert_eq!(a, b, "{kind} delta {delta}: {x0:?} -> {x1:?}");
-                counts[a.is_some() as usize] += 1;
+                run(kind, kind == "vertex-face", x0, x1, &o);
             }
         }
     }
-    assert!(counts[0] > 0 && counts[1] > 0, "{counts:?}");
+    let mut state = 99u64;
+    let mut unit = || (dhcd::shapes::splitmix64(&mut state) >> 11) as f64 / (1u64 << 53) as f64;
+    for delta in [1e-3, 0.05, 0.2] {
+        for t_max in [1.0, 0.6] {
+            let o = opts(t_max, delta);
+            for k in 0..48 {
+                let x0: Q = std::array::from_fn(|_| std::array::from_fn(|_| unit()));
+                let x1: Q = std::array::from_fn(|_| std::array::from_fn(|_| unit()));
+                run("random", k % 2 == 0, &x0, &x1, &o);
+            }
+        }
+    }
+    assert!(counts[0] > 20 && counts[1] > 20, "{counts:?}");
 }

@@ -182,8 +182,8 @@ fn coplanar_sliding_and_contact_at_the_end() {
     for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "contact at t = 1"));
 }
 
-/// A minimum distance `delta > 0` (pairs collide when they come within it): small meshes,
-/// since pairs passing near each other take the exact path (about a millisecond each).
+/// A minimum distance `delta > 0` (pairs collide when they come within it): two spheres
+/// passing each other and a folding sheet.
 #[test]
 fn minimum_distance_small_meshes() {
     let a = icosphere(0, 0.5, [0.0; 3]);

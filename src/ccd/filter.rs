@@ -35,7 +35,7 @@ pub(crate) enum Verdict {
 /// overflow).
 const MAX_MAGNITUDE: f64 = 1.606_938_044_258_990_3e60; // 2^200
 /// Root intervals are narrowed to this width.
-const ROOT_WIDTH: f64 = 9.094_947_017_729_282e-13; // 2^-40
+pub(crate) const ROOT_WIDTH: f64 = 9.094_947_017_729_282e-13; // 2^-40
 /// Subdivision depth of the root isolation before giving up.
 const MAX_DEPTH: u32 = 12;
 
@@ -287,7 +287,7 @@ fn isolate(p: &Piece, depth: u32, out: &mut [RootIv; 3], n: &mut usize) -> bool 
 type Static = fn(&[[f64; 3]; 4], &[[f64; 3]; 4], Iv) -> Option<bool>;
 
 #[inline(always)]
-fn moving(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t: Iv) -> [V3<Iv>; 4] {
+pub(crate) fn moving(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t: Iv) -> [V3<Iv>; 4] {
     let mut out = [[Iv::point(0.0); 3]; 4];
     for i in 0..4 {
         for k in 0..3 {
@@ -486,74 +486,4 @@ pub(crate) fn edge_edge(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> V
     }
     let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
     decide(x0, x1, &[at(x0), at(x1)], t_max, ee_static)
-}
-
-/// Depth of the time subdivision of [`far_apart`].
-const FAR_DEPTH: u32 = 5;
-
-/// For `min_distance = delta > 0`: true if the features are certainly farther apart than
-/// `delta` at every t in `[0, t_max]` (false: unknown). The step is cut into time pieces
-/// (bisection, up to 2^5 pieces where needed); on each, with the positions enclosed by
-/// intervals, one of these must hold for certain:
-/// - the features' boxes over the piece are more than delta apart on an axis;
-/// - the distance between the vertex and the triangle's plane (the two edges' lines)
-///   exceeds delta: `f^2 > delta^2 |n|^2` with `n` the triangle's normal (`u x v` for the
-///   edges), whose `|f| / |n|` is that distance. (Where `n = 0`, `f = 0` too, so the strict
-///   inequality cannot be certified there.) The distance to a plane or line bounds the
-///   distance to any part of it from below.
-pub(crate) fn far_apart(
-    vf: bool,
-    x0: &[[f64; 3]; 4],
-    x1: &[[f64; 3]; 4],
-    t_max: f64,
-    delta: f64,
-) -> bool {
-    let dd = Iv::point(delta).mul(&Iv::point(delta));
-    let mut stack = [(0.0f64, 0.0f64, 0u32); FAR_DEPTH as usize + 2];
-    stack[0] = (0.0, t_max, 0);
-    let mut n = 1;
-    while n > 0 {
-        n -= 1;
-        let (lo, hi, depth) = stack[n];
-        let pts = moving(x0, x1, Iv { lo, hi });
-        if !piece_apart(vf, &pts, dd, delta) {
-            if depth == FAR_DEPTH {
-                return false;
-            }
-            let mid = 0.5 * (lo + hi); // any split point: the pieces cover [lo, hi]
-            stack[n] = (mid, hi, depth + 1);
-            stack[n + 1] = (lo, mid, depth + 1);
-            n += 2;
-        }
-    }
-    true
-}
-
-fn piece_apart(vf: bool, pts: &[V3<Iv>; 4], dd: Iv, delta: f64) -> bool {
-    let split = if vf { 1 } else { 2 };
-    let (first, second) = pts.split_at(split);
-    let boxed = |ps: &[V3<Iv>], k: usize| {
-        ps.iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
-                (l.min(p[k].lo), h.max(p[k].hi))
-            })
-    };
-    for k in 0..3 {
-        let (l1, h1) = boxed(first, k);
-        let (l2, h2) = boxed(second, k);
-        if (l2 - h1).next_down() > delta || (l1 - h2).next_down() > delta {
-            return true;
-        }
-    }
-    let [p0, p1, p2, p3] = pts;
-    let (f, nrm) = if vf {
-        let face = ring::vf_face(p0, p1, p2, p3);
-        (face.f, face.n)
-    } else {
-        let u = ring::sub3(p1, p0);
-        let v = ring::sub3(p3, p2);
-        let nrm = ring::cross(&u, &v);
-        (ring::dot(&ring::sub3(p2, p0), &nrm), nrm)
-    };
-    f.mul(&f).sub(&dd.mul(&ring::dot(&nrm, &nrm))).pos()
 }

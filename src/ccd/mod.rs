@@ -95,13 +95,17 @@
 //! and `|A x B|^2 <= delta^2 |b - a|^2`); for edges, an endpoint within delta of the other
 //! segment, or the closest points of the two non-parallel lines inside both segments and
 //! within delta (polynomials of degree <= 6). This is **exact** too (delta is an f64, so
-//! `delta^2` is rational and scales with the coordinates). Its float filter only rejects:
-//! swept boxes inflated by delta, then time pieces on which the boxes or the distance to
-//! the triangle's plane (between the edges' lines) certainly exceed delta. A pair that
-//! comes within about delta of the other feature's plane or line is decided in
-//! big-number arithmetic: about a millisecond a query (against ~0.05-2 us for
-//! `delta = 0`). A filter that also accepts for `delta > 0` is future work.
-//!
+//! `delta^2` is rational and scales with the coordinates). Its float filter (`near.rs`)
+//! comes first: swept boxes inflated by delta, then time pieces of `[0, t_max]` visited
+//! earliest first, each certified apart (the boxes, the plane or lines, or the feature's
+//! parts farther than delta) or within (a corner, a foot on an edge, the foot in the
+//! triangle, or the lines' closest points on both segments within delta) in interval
+//! arithmetic, and split where neither; the contact time is the start of the first piece
+//! not certified apart, within `2^-40`. Only pairs whose distance touches delta without
+//! crossing it, or crosses it too slowly for floats to place within `2^-40`, go to the
+//! exact path. On a folding 8 x 8 sheet with `delta = 0.004` (1,065 colliding pairs of
+//! 3,581 tested), 3 queries reach it.
+
 //! # Limits
 //!
 //! None on the input range: any finite f64 coordinates are decided exactly (huge or tiny
@@ -113,6 +117,7 @@
 mod exact;
 mod filter;
 mod interval;
+mod near;
 mod ring;
 
 use crate::error::{Error, Result};
@@ -263,11 +268,14 @@ fn query(
             exact::Kind::VertexFace => filter::vf_boxes_apart(x0, x1, delta),
             exact::Kind::EdgeEdge => filter::ee_boxes_apart(x0, x1, delta),
         };
+        if apart {
+            return None;
+        }
         let vf = kind == exact::Kind::VertexFace;
-        if apart || filter::far_apart(vf, x0, x1, options.t_max, delta) {
-            None
-        } else {
-            exact::solve(kind, x0, x1, options.t_max, delta)
+        match near::decide(vf, x0, x1, options.t_max, delta) {
+            filter::Verdict::Miss => None,
+            filter::Verdict::Hit(t) => Some(t),
+            _ => exact::solve(kind, x0, x1, options.t_max, delta),
         }
     }
 }
