@@ -8,7 +8,7 @@ e.g. `benches/scripts/leaf-size-sweep.py 4 32,48,64,80 target/release/dhcd`. Eac
 pair, binary and size back to back (interleaved, so a noisy minute hits every size alike),
 and keeps the least step per (frame, kind, binary, size). Prints one line per frame, kind
 and binary: each size's least step in ms and its ratio to the line's best. How the default
-leaf size was chosen (docs/PERFORMANCE.md, "eighth sitting").
+leaf size was chosen (docs/notes/performance-history.md, section "default leaf size 64").
 """
 
 import argparse
