@@ -1,20 +1,26 @@
 //! The float filter for a minimum distance `delta > 0`: decides whether the two features come
 //! within `delta` during `[0, t_max]`, and when, in interval arithmetic, or says it cannot.
 //!
-//! The step is cut into time pieces, earliest first (depth-first bisection). On each piece the
-//! positions are enclosed by intervals ([`moving`]) and the piece is classified:
-//! - **apart**: the distance is certainly `> delta` at every t of the piece;
-//! - **within**: certainly `<= delta` at every t of the piece;
-//! - **unknown**: the piece is split, down to width `2^-44`.
+//! **Lipschitz pieces.** The distance between the two features changes at most as fast as
+//! their fastest relative motion: a point of either feature is a convex combination of its
+//! corners, so for fixed weights the distance between two such points moves at speed
+//! `|sum l_i a_i' - sum m_j b_j'| <= max_ij |a_i' - b_j'| = L` (each corner moves at the
+//! constant velocity `x1 - x0`), and a minimum of `L`-Lipschitz functions is `L`-Lipschitz.
+//! So a time piece `[lo, hi]` is apart (distance `> delta` at every t of it) when the distance
+//! at one point `m` of it exceeds `delta + L max(m - lo, hi - m)`. That test is evaluated at a
+//! single time, where the interval enclosure of the positions is a few ulps wide, so it stays
+//! sharp however close the piece is to the contact time. Where it fails, the piece is also
+//! tested with every corner enclosed over the whole piece, which is sharper for features
+//! sliding past each other fast at a nearly constant distance (large `L`).
 //!
-//! Pieces are visited in time order and the search stops at the first unknown leaf, so when a
-//! piece `[lo, hi]` is found within, or the first unknown leaf `[lo, hi]` is within at one of
-//! the points `lo + k 2^-44`, `k = 1..16`, every time before `lo` is certified apart: the
-//! earliest contact `t*` lies in `[lo, lo + 2^-40]`, and `lo` is returned (at most `2^-40`
-//! early, the exact path's tolerance). Probing past the leaf is needed because near `t*` the
-//! distance differs from `delta` by less than the float noise of a piece that narrow. Where
-//! no probe is within (the distance touches `delta` without crossing it, or crosses it too
-//! slowly for floats to see within `2^-40`), the query is left to the exact path.
+//! **Search.** First the start: within at t = 0 means a contact at 0. Then pieces of
+//! `[0, t_max]` are visited earliest first (depth-first bisection), skipped when apart and
+//! split otherwise, down to width `2^-46`. At the first leaf `[lo, hi]` that is not apart,
+//! every time before `lo` is apart; if the distance is within `delta` at one of the points
+//! `lo + k 2^-44`, `k = 1..16`, the earliest contact lies in `[lo, lo + 2^-40]` and `lo` is
+//! returned (at most `2^-40` early, the exact path's tolerance). Otherwise (the distance
+//! touches `delta` without crossing it, or crosses it too slowly against `L` for floats to
+//! place within `2^-40`), the query is left to the exact path.
 //!
 //! Every test compares squared distances times a positive squared length with `delta^2`, so no
 //! division or square root is needed, and uses only these facts:
@@ -29,36 +35,49 @@
 //!   endpoint (minimising a convex function over a square): so with the foot certainly outside
 //!   the triangle (a barycentric numerator `< 0`), the three edges all apart certify apart,
 //!   and with the lines' closest points certainly not both on the segments, the four
-//!   endpoint-to-segment distances all apart do.
+//!   endpoint-to-segment distances all apart do;
+//! - for nearly parallel edges, a separating axis: along `n = u x (u x (b0 - a0))`
+//!   (perpendicular to edge a, in the plane of its line and `b0`) all of edge a projects to one
+//!   value, so both ends of edge b beyond delta on the same side separate the edges.
 //!
 //! A foot or a line is only used where its squared length factor is certainly `> 0`
 //! (degenerate triangles and zero-length edges fall back to their corners).
 
-use super::filter::{moving, Verdict, ROOT_WIDTH};
+use super::filter::{moving, Verdict};
 use super::interval::Iv;
 use super::ring::{self, Ring, V3};
 
-/// What a piece of the step certainly is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Piece {
-    Apart,
-    Within,
-    Unknown,
-}
-
-/// Bound on the pieces classified per query: pieces the interval arithmetic over-estimates
-/// are split until they are narrow enough, which a near-tangent pair could repeat at many
-/// places; past this many the query is left to the exact path.
+/// Bound on the pieces visited per query: where the distance stays near `delta` for a long
+/// time the bisection would split many pieces; past this many the query is left to the exact
+/// path (~2 us a piece).
 const MAX_PIECES: u32 = 4096;
 
-/// Width of the narrowest pieces, a sixteenth of the tolerance; [`PROBES`] points after the
-/// first unknown one are probed, up to the tolerance.
-const LEAF_WIDTH: f64 = ROOT_WIDTH / 16.0;
+/// Width of the narrowest pieces.
+const LEAF_WIDTH: f64 = 1.0 / (1u64 << 46) as f64;
+/// Spacing and number of the probes after the first leaf not apart: up to `2^-40`.
+const PROBE_STEP: f64 = 1.0 / (1u64 << 44) as f64;
 const PROBES: u32 = 16;
 
-/// Depth bound of the bisection (a piece of `[0, 1]` narrower than `2^-44` needs 45 halvings;
+/// Depth bound of the bisection (a piece of `[0, 1]` narrower than `2^-46` needs 47 halvings;
 /// the midpoints of float endpoints are exact or rounded between them).
 const MAX_DEPTH: usize = 64;
+
+/// An upper bound on the speed at which the features' distance can change (see the module
+/// docs): the largest `|a_i' - b_j'|` over the corners of the two features.
+fn max_relative_speed(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> f64 {
+    let velocity = |i: usize| -> V3<Iv> { std::array::from_fn(|k| Iv::diff(x1[i][k], x0[i][k])) };
+    let split = if vf { 1 } else { 2 };
+    let mut most = 0.0f64;
+    for i in 0..split {
+        for j in split..4 {
+            let d = ring::sub3(&velocity(i), &velocity(j));
+            most = most.max(ring::dot(&d, &d).hi);
+        }
+    }
+    // sqrt is correctly rounded; a NaN (overflow) makes every margin NaN, which certifies
+    // nothing.
+    most.sqrt().next_up()
+}
 
 /// The verdict for the pair (`vf`: vertex-face, else edge-edge) coming within `delta > 0`
 /// during `[0, t_max]`: `Miss`, `Hit(lo)` with the earliest contact in `[lo, lo + 2^-40]`, or
@@ -70,8 +89,11 @@ pub(crate) fn decide(
     t_max: f64,
     delta: f64,
 ) -> Verdict {
-    let dd = Iv::point(delta).mul(&Iv::point(delta));
-    let classify = |lo: f64, hi: f64| classify(vf, &moving(x0, x1, Iv { lo, hi }), dd, delta);
+    let at = |t: f64| moving(x0, x1, Iv::point(t));
+    if within(vf, &at(0.0), delta) {
+        return Verdict::Hit(0.0);
+    }
+    let speed = max_relative_speed(vf, x0, x1);
     let mut stack = [(0.0f64, 0.0f64); MAX_DEPTH + 1];
     stack[0] = (0.0, t_max);
     let (mut n, mut pieces) = (1usize, 0u32);
@@ -82,20 +104,24 @@ pub(crate) fn decide(
         if pieces > MAX_PIECES {
             return Verdict::Unknown;
         }
-        match classify(lo, hi) {
-            Piece::Apart => continue,
-            Piece::Within => return Verdict::Hit(lo),
-            Piece::Unknown => {}
-        }
         let mid = 0.5 * (lo + hi);
+        // The largest distance from mid to an end, rounded up, times the speed.
+        let reach = (mid - lo).max(hi - mid).next_up();
+        let margin = (speed * reach).next_up();
+        if apart(vf, &at(mid), (delta + margin).next_up()) {
+            continue;
+        }
+        // The features enclosed over the whole piece: sharper where they slide past each
+        // other fast at a nearly constant distance (then L is large and the margin wide).
+        if apart(vf, &moving(x0, x1, Iv { lo, hi }), delta) {
+            continue;
+        }
         if hi - lo <= LEAF_WIDTH || n + 2 > MAX_DEPTH || !(lo < mid && mid < hi) {
-            // Everything before lo is apart. Near the contact the distance differs from
-            // delta by less than the float noise of a piece, so within is looked for at
-            // points after lo, up to the tolerance: within at one puts the contact in
+            // Everything before lo is apart: within at a probe puts the contact in
             // [lo, lo + 2^-40].
             let within = (1..=PROBES).any(|k| {
-                let t = (lo + k as f64 * LEAF_WIDTH).min(t_max);
-                classify(t, t) == Piece::Within
+                let t = (lo + k as f64 * PROBE_STEP).min(t_max);
+                within(vf, &at(t), delta)
             });
             return if within {
                 Verdict::Hit(lo)
@@ -127,15 +153,86 @@ fn boxes_apart(vf: bool, pts: &[V3<Iv>; 4], delta: f64) -> bool {
     })
 }
 
-fn classify(vf: bool, pts: &[V3<Iv>; 4], dd: Iv, delta: f64) -> Piece {
+/// The features at `pts` (enclosures of their corners over a time or a piece) certainly
+/// farther apart than `delta`. Cheapest tests first, each skipped once one succeeds.
+fn apart(vf: bool, pts: &[V3<Iv>; 4], delta: f64) -> bool {
     if boxes_apart(vf, pts, delta) {
-        return Piece::Apart;
+        return true;
     }
+    let dd = square(delta);
     if vf {
-        vertex_face(pts, dd)
+        let [p, a, b, c] = pts;
+        let face = ring::vf_face(p, a, b, c);
+        let n2 = ring::dot(&face.n, &face.n);
+        // f = (a - p) . n: the plane's distance is |f| / |n|.
+        if n2.pos() && excess(face.f, n2, dd).pos() {
+            return true;
+        }
+        // The foot certainly outside, or the triangle degenerate (then it is its edges).
+        let foot_out = face.d.iter().any(|d| d.neg()) || nonpositive(n2);
+        foot_out
+            && segment_apart(p, a, b, dd)
+            && segment_apart(p, b, c, dd)
+            && segment_apart(p, c, a, dd)
     } else {
-        edge_edge(pts, dd)
+        let [a0, a1, b0, b1] = pts;
+        let (u, v) = (ring::sub3(a1, a0), ring::sub3(b1, b0));
+        let w = ring::cross(&u, &v);
+        let w2 = ring::dot(&w, &w);
+        let r = ring::sub3(b0, a0);
+        // The lines' distance is |r . w| / |w|.
+        if w2.pos() && excess(ring::dot(&r, &w), w2, dd).pos() {
+            return true;
+        }
+        // Parallel or nearly parallel edges: the axis across one edge's line towards the
+        // other edge, on which the first edge is one point.
+        if beside(a0, &u, b0, b1, dd) || beside(b0, &v, a0, a1, dd) {
+            return true;
+        }
+        // The lines' closest points a0 + s u, b0 + t v (times |w|^2) not both on the
+        // segments: then the closest pair involves an endpoint.
+        let (s, t) = lines_closest(&r, &u, &v, &w);
+        let off = |x: Iv| x.neg() || w2.sub(&x).neg();
+        w2.pos()
+            && (off(s) || off(t))
+            && segment_apart(a0, b0, b1, dd)
+            && segment_apart(a1, b0, b1, dd)
+            && segment_apart(b0, a0, a1, dd)
+            && segment_apart(b1, a0, a1, dd)
     }
+}
+
+/// The features at `pts` certainly within `delta` of each other: the distance to one point of
+/// the other feature is.
+fn within(vf: bool, pts: &[V3<Iv>; 4], delta: f64) -> bool {
+    let dd = square(delta);
+    if vf {
+        let [p, a, b, c] = pts;
+        let face = ring::vf_face(p, a, b, c);
+        let n2 = ring::dot(&face.n, &face.n);
+        let foot_in = n2.pos() && face.d.iter().all(|&d| nonnegative(d));
+        (foot_in && nonpositive(excess(face.f, n2, dd)))
+            || segment_within(p, a, b, dd)
+            || segment_within(p, b, c, dd)
+            || segment_within(p, c, a, dd)
+    } else {
+        let [a0, a1, b0, b1] = pts;
+        let (u, v) = (ring::sub3(a1, a0), ring::sub3(b1, b0));
+        let w = ring::cross(&u, &v);
+        let w2 = ring::dot(&w, &w);
+        let r = ring::sub3(b0, a0);
+        let (s, t) = lines_closest(&r, &u, &v, &w);
+        let on = |x: Iv| nonnegative(x) && nonnegative(w2.sub(&x));
+        (w2.pos() && on(s) && on(t) && nonpositive(excess(ring::dot(&r, &w), w2, dd)))
+            || segment_within(a0, b0, b1, dd)
+            || segment_within(a1, b0, b1, dd)
+            || segment_within(b0, a0, a1, dd)
+            || segment_within(b1, a0, a1, dd)
+    }
+}
+
+fn square(x: f64) -> Iv {
+    Iv::point(x).mul(&Iv::point(x))
 }
 
 /// `x <= 0` for every value of the interval.
@@ -156,92 +253,59 @@ fn excess(q: Iv, len2: Iv, dd: Iv) -> Iv {
     q.mul(&q).sub(&dd.mul(&len2))
 }
 
-/// A point and a closed segment `[a, b]`.
-struct Seg {
-    apart: bool,
-    within: bool,
+/// The parameters of the closest points `a0 + s u`, `b0 + t v` of two lines (`r = b0 - a0`,
+/// `w = u x v`), times `|w|^2`.
+fn lines_closest(r: &V3<Iv>, u: &V3<Iv>, v: &V3<Iv>, w: &V3<Iv>) -> (Iv, Iv) {
+    (
+        ring::dot(&ring::cross(r, v), w),
+        ring::dot(&ring::cross(r, u), w),
+    )
 }
 
-fn point_segment(p: &V3<Iv>, a: &V3<Iv>, b: &V3<Iv>, dd: Iv) -> Seg {
+/// Point `p` farther than delta from the closed segment `[a, b]`: from its line, or from both
+/// ends with the foot of the perpendicular off the segment.
+fn segment_apart(p: &V3<Iv>, a: &V3<Iv>, b: &V3<Iv>, dd: Iv) -> bool {
     let e = ring::sub3(b, a);
     let w = ring::sub3(p, a);
     let len2 = ring::dot(&e, &e);
-    // The foot's parameter times |e|^2, and the squared distances to the corners.
-    let s = ring::dot(&w, &e);
-    let to_a = ring::dot(&w, &w).sub(&dd);
-    let wb = ring::sub3(p, b);
-    let to_b = ring::dot(&wb, &wb).sub(&dd);
     let c = ring::cross(&w, &e);
     // |w x e|^2 - dd |e|^2: the line's distance against delta, times |e|^2.
-    let line = ring::dot(&c, &c).sub(&dd.mul(&len2));
-    let foot_on = len2.pos() && nonnegative(s) && nonnegative(len2.sub(&s));
+    if len2.pos() && ring::dot(&c, &c).sub(&dd.mul(&len2)).pos() {
+        return true;
+    }
+    let s = ring::dot(&w, &e);
     let foot_off = s.neg() || len2.sub(&s).neg();
-    Seg {
-        apart: (len2.pos() && line.pos()) || (to_a.pos() && to_b.pos() && foot_off),
-        within: nonpositive(to_a) || nonpositive(to_b) || (foot_on && nonpositive(line)),
-    }
+    let wb = ring::sub3(p, b);
+    foot_off && ring::dot(&w, &w).sub(&dd).pos() && ring::dot(&wb, &wb).sub(&dd).pos()
 }
 
-fn vertex_face(pts: &[V3<Iv>; 4], dd: Iv) -> Piece {
-    let [p, a, b, c] = pts;
-    let face = ring::vf_face(p, a, b, c);
-    let n2 = ring::dot(&face.n, &face.n);
-    // f = (a - p) . n: the plane's distance is |f| / |n|.
-    let plane = excess(face.f, n2, dd);
-    if n2.pos() && plane.pos() {
-        return Piece::Apart;
+/// Point `p` within delta of the closed segment `[a, b]`: of an end, or of the foot of the
+/// perpendicular when it certainly lies on the segment.
+fn segment_within(p: &V3<Iv>, a: &V3<Iv>, b: &V3<Iv>, dd: Iv) -> bool {
+    let w = ring::sub3(p, a);
+    let wb = ring::sub3(p, b);
+    if nonpositive(ring::dot(&w, &w).sub(&dd)) || nonpositive(ring::dot(&wb, &wb).sub(&dd)) {
+        return true;
     }
-    let foot_in = n2.pos() && face.d.iter().all(|&d| nonnegative(d));
-    if foot_in && nonpositive(plane) {
-        return Piece::Within;
-    }
-    let edges = [
-        point_segment(p, a, b, dd),
-        point_segment(p, b, c, dd),
-        point_segment(p, c, a, dd),
-    ];
-    if edges.iter().any(|e| e.within) {
-        return Piece::Within;
-    }
-    // The foot certainly outside, or the triangle degenerate (then it is its edges).
-    let foot_out = face.d.iter().any(|d| d.neg()) || nonpositive(n2);
-    if foot_out && edges.iter().all(|e| e.apart) {
-        return Piece::Apart;
-    }
-    Piece::Unknown
+    let e = ring::sub3(b, a);
+    let len2 = ring::dot(&e, &e);
+    let s = ring::dot(&w, &e);
+    let c = ring::cross(&w, &e);
+    len2.pos()
+        && nonnegative(s)
+        && nonnegative(len2.sub(&s))
+        && nonpositive(ring::dot(&c, &c).sub(&dd.mul(&len2)))
 }
 
-fn edge_edge(pts: &[V3<Iv>; 4], dd: Iv) -> Piece {
-    let [a0, a1, b0, b1] = pts;
-    let u = ring::sub3(a1, a0);
-    let v = ring::sub3(b1, b0);
-    let w = ring::cross(&u, &v);
-    let w2 = ring::dot(&w, &w);
-    let r = ring::sub3(b0, a0);
-    // The lines' distance is |r . w| / |w|.
-    let lines = excess(ring::dot(&r, &w), w2, dd);
-    if w2.pos() && lines.pos() {
-        return Piece::Apart;
-    }
-    // The lines' closest points a0 + s u, b0 + t v, times |w|^2.
-    let s = ring::dot(&ring::cross(&r, &v), &w);
-    let t = ring::dot(&ring::cross(&r, &u), &w);
-    let on = |x: Iv| nonnegative(x) && nonnegative(w2.sub(&x));
-    let off = |x: Iv| x.neg() || w2.sub(&x).neg();
-    if w2.pos() && on(s) && on(t) && nonpositive(lines) {
-        return Piece::Within;
-    }
-    let ends = [
-        point_segment(a0, b0, b1, dd),
-        point_segment(a1, b0, b1, dd),
-        point_segment(b0, a0, a1, dd),
-        point_segment(b1, a0, a1, dd),
-    ];
-    if ends.iter().any(|e| e.within) {
-        return Piece::Within;
-    }
-    if w2.pos() && (off(s) || off(t)) && ends.iter().all(|e| e.apart) {
-        return Piece::Apart;
-    }
-    Piece::Unknown
+/// Both `q0` and `q1` farther than delta, on the same side, from the line through `p` along
+/// `u`, measured along `n = u x (u x (q0 - p))`, the direction in the plane of the line and
+/// `q0` perpendicular to the line (the whole line projects onto one value along `n`).
+fn beside(p: &V3<Iv>, u: &V3<Iv>, q0: &V3<Iv>, q1: &V3<Iv>, dd: Iv) -> bool {
+    let r0 = ring::sub3(q0, p);
+    let r1 = ring::sub3(q1, p);
+    let n = ring::cross(u, &ring::cross(u, &r0));
+    let n2 = ring::dot(&n, &n);
+    let (h0, h1) = (ring::dot(&r0, &n), ring::dot(&r1, &n));
+    let same_side = (h0.neg() && h1.neg()) || (h0.pos() && h1.pos());
+    same_side && excess(h0, n2, dd).pos() && excess(h1, n2, dd).pos()
 }
