@@ -273,6 +273,32 @@ typedef struct DhcdSceneProximity {
   struct DhcdCounters counters;
 } DhcdSceneProximity;
 
+/**
+ * Colliding feature pairs over a step in a scene, from `dhcd_scene_ccd` (release with
+ * `dhcd_scene_impacts_free`): every object pair's results (`object_a < object_b`) and every
+ * self-collision object's own (`object_a == object_b`), flattened with object ids, each
+ * list sorted by its rows; times of impact as in `DhcdImpacts`:
+ * - `vertex_face`: `[object_a, vertex, object_b, triangle]` at `vertex_face[4k..4k+4]`;
+ * - `face_vertex`: `[object_a, triangle, object_b, vertex]` (between two objects only);
+ * - `edge_edge`: `[object_a, a0, a1, object_b, b0, b1]` at `edge_edge[6k..6k+6]`.
+ *
+ * `toi` is the earliest time of impact over the scene (`+inf`: nothing collides);
+ * `counters` are the totals over the object pairs.
+ */
+typedef struct DhcdSceneImpacts {
+  uint64_t *vertex_face;
+  double *vf_toi;
+  size_t vf_count;
+  uint64_t *face_vertex;
+  double *fv_toi;
+  size_t fv_count;
+  uint64_t *edge_edge;
+  double *ee_toi;
+  size_t ee_count;
+  double toi;
+  struct DhcdCounters counters;
+} DhcdSceneImpacts;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -732,6 +758,47 @@ int dhcd_scene_proximity(struct DhcdScene *s,
  * `p` null or a `DhcdSceneProximity` filled by this library and not modified since.
  */
 void dhcd_scene_proximity_free(struct DhcdSceneProximity *p);
+
+/**
+ * Continuous collision detection of the whole scene over one step: entry `k` moves object
+ * `ids[k]` from `x0[k]` (t = 0) to `x1[k]` (t = 1), `3 * vertex_counts[k]` doubles each (as
+ * in `dhcd_ccd`; the object's stored pose is not read and the scene does not change); every
+ * object not listed stays at its stored pose. Every object pair whose boxes over the step
+ * come within `min_distance`, and every object with self-collision on, is queried as by
+ * `dhcd_ccd` / `dhcd_self_ccd`, into `*out` (see `DhcdSceneImpacts`; release with
+ * `dhcd_scene_impacts_free`). `earliest` non-zero: only the earliest time of impact over
+ * the scene and the pairs reaching it. Everything is checked before any work: an unknown
+ * id (`DHCD_ERR_UNKNOWN_OBJECT`), an id given twice (`DHCD_ERR_REPEATED_OBJECT`), a bad
+ * `t_max` or `min_distance` (`DHCD_ERR_INVALID_ARGUMENT`), a wrong vertex count
+ * (`DHCD_ERR_LENGTH_MISMATCH`), a non-finite coordinate (`DHCD_ERR_INVALID_MESH`). The
+ * result does not depend on `threads` (the work counters of earliest mode may). With
+ * `count == 0` the arrays may be NULL (every object still).
+ *
+ * # Safety
+ * `s` null or a live handle; `ids`, `x0`, `x1` and `vertex_counts` hold `count` elements
+ * each, and each non-null `x0[k]`, `x1[k]` holds `3 * vertex_counts[k]` doubles; `out`
+ * null or valid for a write.
+ */
+int dhcd_scene_ccd(struct DhcdScene *s,
+                   const uint64_t *ids,
+                   const double *const *x0,
+                   const double *const *x1,
+                   const size_t *vertex_counts,
+                   size_t count,
+                   double t_max,
+                   double min_distance,
+                   int earliest,
+                   uint32_t threads,
+                   struct DhcdSceneImpacts *out);
+
+/**
+ * Releases the arrays of a `DhcdSceneImpacts` and resets it to empty (`toi` `+inf`). Null,
+ * or an already released or empty result, is a no-op.
+ *
+ * # Safety
+ * `p` null or a `DhcdSceneImpacts` filled by this library and not modified since.
+ */
+void dhcd_scene_impacts_free(struct DhcdSceneImpacts *p);
 
 #ifdef __cplusplus
 }  // extern "C"

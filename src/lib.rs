@@ -60,7 +60,9 @@ pub use error::{Error, Result};
 pub use hierarchy::{CentralVertex, Hierarchy, InvariantError, Options, Refit};
 pub use mesh::{Mesh, Precision};
 pub use par::Par;
-pub use scene::{ObjectId, PairProximity, Scene, SceneContacts, SceneProximity};
+pub use scene::{
+    ObjectId, PairImpacts, PairProximity, Scene, SceneContacts, SceneImpacts, SceneProximity,
+};
 
 pub use query::{
     broad_phase, ccd_pair, ccd_pair_with, collide, collide_with, narrow_phase, proximity,

@@ -19,8 +19,11 @@
 //! job in job order, so every pair's `bv_updates`, and their sum, are the same for every
 //! `Par`.
 
+use std::borrow::Cow;
+
 use rayon::prelude::*;
 
+use crate::bv::swept::{box_over_step, f32_up, Step};
 use crate::bv::{BvKind, Method};
 use crate::counters::Counters;
 use crate::detail::{segment, OriginalCorners, Segment};
@@ -29,9 +32,10 @@ use crate::hierarchy::{Hierarchy, Options};
 use crate::kinds::{kinds, match_kind, with_kind};
 use crate::mesh::{check_positions, Mesh, Precision};
 use crate::par::Par;
+use crate::query::ccd::{self, checked_step, earliest_bound, keep_earliest, Swept};
 use crate::query::contacts::contacts;
 use crate::query::proximity::{self, check_distance};
-use crate::query::{Contacts, Overlap, Posed, Proximity, Within};
+use crate::query::{CcdQuery, Contacts, Impacts, Motion, Overlap, Posed, Proximity, Within};
 use crate::walk::Workspace;
 
 /// Identifies an object of a [`Scene`]. Ids are handed out in increasing order from 0 and
@@ -90,6 +94,33 @@ pub struct SceneProximity {
     /// Sum of the pairs' counters.
     pub counters: Counters,
     /// Object pairs whose root boxes were compared in the broad phase.
+    pub broad_phase_tests: u64,
+}
+
+/// The impacts of one object pair that passed the broad phase over the step (`a < b`:
+/// vertices, triangles and edges of `a` first, as in [`crate::ccd_pair`]), or of one object
+/// with itself (`a == b`, as in [`crate::self_ccd`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairImpacts {
+    pub a: ObjectId,
+    pub b: ObjectId,
+    /// Each object's original vertex, triangle and edge indices.
+    pub impacts: Impacts,
+}
+
+/// Result of [`Scene::ccd`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneImpacts {
+    /// Every object pair whose boxes over the step came within the minimum distance (and
+    /// every object with self-collision on), sorted by `(a, b)`, each with its impacts and
+    /// counters. In earliest mode only the pairs reaching `toi` keep their impacts; the
+    /// others are listed with none.
+    pub per_pair: Vec<PairImpacts>,
+    /// The earliest time of impact over every pair (`None`: nothing collides).
+    pub toi: Option<f64>,
+    /// Sum of the pairs' counters.
+    pub counters: Counters,
+    /// Object pairs whose boxes over the step were compared in the broad phase.
     pub broad_phase_tests: u64,
 }
 
@@ -263,7 +294,7 @@ impl Scene {
     /// non-finite position) nothing changes. The result is the same as one
     /// [`Scene::update_positions`] per object, for every `par`.
     pub fn update_many(&mut self, updates: &[(ObjectId, &[[f32; 3]])], par: Par) -> Result<()> {
-        let slot = self.update_slots(updates)?;
+        let slot = self.slots(updates)?;
         // One trip to the pool for the checks and the gathers (each trip wakes its threads).
         each!(&mut self.objects, v => par.install(|| update_objects(v, &slot, par.is_parallel())))
     }
@@ -272,7 +303,7 @@ impl Scene {
     /// the thread pool (on two threads of a small scene, each trip costs about a tenth of the
     /// step: `docs/PERFORMANCE.md`). On error nothing changes and there are no contacts.
     pub fn step(&mut self, updates: &[(ObjectId, &[[f32; 3]])], par: Par) -> Result<SceneContacts> {
-        let slot = self.update_slots(updates)?;
+        let slot = self.slots(updates)?;
         let parallel = par.is_parallel();
         each!(&mut self.objects, v => par.install(|| {
             update_objects(v, &slot, parallel)?;
@@ -280,15 +311,13 @@ impl Scene {
         }))
     }
 
-    /// Each object's new positions (by scene index), or an unknown or repeated id.
-    fn update_slots<'p>(
-        &self,
-        updates: &[(ObjectId, &'p [[f32; 3]])],
-    ) -> Result<Vec<Option<&'p [[f32; 3]]>>> {
+    /// Each object's item (new positions, a motion) by scene index, or an unknown or
+    /// repeated id.
+    fn slots<T: Copy>(&self, items: &[(ObjectId, T)]) -> Result<Vec<Option<T>>> {
         let mut slot = vec![None; self.len()];
-        for &(id, positions) in updates {
+        for &(id, item) in items {
             let i = self.index(id)?;
-            if slot[i].replace(positions).is_some() {
+            if slot[i].replace(item).is_some() {
                 return Err(Error::RepeatedObject(id.0));
             }
         }
@@ -336,6 +365,80 @@ impl Scene {
         Ok(each!(&mut self.objects, v => par.install(|| proximity_of(v, d, parallel))))
     }
 
+    /// Continuous collision detection over one step of the whole scene: every
+    /// vertex-triangle and edge-edge pair that collides during the step between two objects,
+    /// and inside every object with self-collision on, with its time of impact (or, with
+    /// [`CcdMode::Earliest`](crate::CcdMode::Earliest), only the earliest), as
+    /// [`crate::ccd_pair`] and [`crate::self_ccd`] find them.
+    ///
+    /// Each object in `motions` (at most once) moves from its `x0` to its `x1`; as in
+    /// [`crate::ccd_pair`], its stored pose is **not read** (it need not equal `x0`), and the
+    /// scene is not changed (a simulator updates the poses once it has chosen the step).
+    /// Every other object stays still at its stored pose for the whole step (`f32` positions
+    /// converted exactly, `f64` ones as stored).
+    ///
+    /// Broad phase: each object's box over the step (of its vertices at t0 and t1, rounded
+    /// outward to `f32`; the stored root box for a still object), grown by the query's
+    /// minimum distance, goes through the sweep-and-prune of [`Scene::contacts`]. Each
+    /// object's bounds over the step are fitted once and shared by all its jobs; refits are
+    /// credited to each object's first job, as in [`Scene::contacts`] (eager refits of
+    /// updates wait for the next query of the current pose).
+    ///
+    /// In earliest mode every job prunes with one shared bound (the earliest time found so
+    /// far by any job), and `toi` is the least over all jobs; only the jobs reaching it keep
+    /// their pairs. The impacts and `toi` do not depend on `par` (in all mode neither do the
+    /// counters; in earliest mode the work counters do, as for [`crate::ccd_pair`]).
+    ///
+    /// Everything is checked before any work; on error nothing is computed:
+    /// [`Error::UnknownObject`], [`Error::RepeatedObject`], the query's options
+    /// ([`Error::InvalidTimeLimit`], [`Error::InvalidMinDistance`]), then each listed
+    /// object's positions in scene order ([`Error::WrongVertexCount`],
+    /// [`Error::NonFinite`], [`Error::OutOfRange`]).
+    ///
+    /// ```
+    /// use dhcd::{scene::Scene, shapes, CcdQuery, Method, Motion, Options, Par};
+    /// let mut scene = Scene::new(Method::Dh, Options::default());
+    /// let ball = shapes::icosphere(2, 0.5, [0.0; 3]);
+    /// let wall = scene.add(&ball)?;
+    /// let bullet = scene.add(&shapes::icosphere(1, 0.1, [-3.0, 0.0, 0.0]))?;
+    /// let far = scene.add(&shapes::icosphere(1, 0.5, [50.0, 0.0, 0.0]))?;
+    /// // The bullet crosses the ball within the step: it is apart from it at t0 and t1.
+    /// let x0: Vec<[f64; 3]> = scene.positions_f64(bullet)?;
+    /// let x1: Vec<[f64; 3]> = x0.iter().map(|p| [p[0] + 6.0, p[1], p[2]]).collect();
+    /// let hits = scene.ccd(&[(bullet, Motion::new(&x0, &x1))], &CcdQuery::all(), Par::Seq)?;
+    /// // Only (wall, bullet) passed the broad phase; the far ball was culled.
+    /// assert_eq!(hits.per_pair.len(), 1);
+    /// assert_eq!((hits.per_pair[0].a, hits.per_pair[0].b), (wall, bullet));
+    /// let toi = hits.toi.unwrap();
+    /// assert!(toi > 0.3 && toi < 0.5); // the bullet meets the ball at x = -0.5 - 0.1
+    /// let first = scene.ccd(&[(bullet, Motion::new(&x0, &x1))], &CcdQuery::earliest(), Par::Rayon(2))?;
+    /// assert_eq!(first.toi, hits.toi);
+    /// # let _ = far;
+    /// # Ok::<(), dhcd::Error>(())
+    /// ```
+    pub fn ccd(
+        &self,
+        motions: &[(ObjectId, Motion<'_>)],
+        query: &CcdQuery,
+        par: Par,
+    ) -> Result<SceneImpacts> {
+        let slot = self.slots(motions)?;
+        query.options.validate()?;
+        let parallel = par.is_parallel();
+        each!(&self.objects, v => par.install(|| ccd_of(v, &slot, query, parallel)))
+    }
+
+    /// The object's current positions in its mesh's vertex order, as `f64` (the `f32`
+    /// positions converted exactly, or the `f64` ones as stored): the `x0` of a step that
+    /// starts from the stored pose.
+    pub fn positions_f64(&self, id: ObjectId) -> Result<Vec<[f64; 3]>> {
+        let i = self.index(id)?;
+        Ok(each!(&self.objects, v => {
+            let h = &v[i].h;
+            h.tree().vert_slot().iter().map(|&s| h.position_f64(s as usize)).collect()
+        }))
+    }
+
     /// Intersection segments of `contacts` (from [`Scene::contacts`] in the current poses),
     /// in the order of `contacts.pairs`. Errors if an object is gone, an index is out of
     /// range, or a pair no longer intersects.
@@ -376,7 +479,8 @@ impl Scene {
 
 fn proximity_of<K: BvKind>(objects: &mut [Object<K>], d: f64, parallel: bool) -> SceneProximity {
     let within = Within::distance(d);
-    let (jobs, broad_phase_tests) = jobs_of(objects, within.margin);
+    let boxes = objects.iter().map(|o| o.bounds);
+    let (jobs, broad_phase_tests) = jobs_of(objects, boxes, within.margin);
     let results = run_jobs(
         objects,
         &jobs,
@@ -446,17 +550,9 @@ fn update_objects<K: BvKind>(
         Some(p) => check_positions(p, o.h.tree().vertex_total()),
         None => Ok(()),
     };
-    let checks: Vec<Result<()>> = if parallel {
-        objects
-            .par_iter()
-            .zip(slot)
-            .with_max_len(1)
-            .map(check)
-            .collect()
-    } else {
-        objects.iter().zip(slot).map(check).collect()
-    };
-    checks.into_iter().collect::<Result<()>>()?;
+    map_objects(objects.len(), parallel, |i| check((&objects[i], &slot[i])))
+        .into_iter()
+        .collect::<Result<()>>()?;
     let apply = |(o, p): (&mut Object<K>, &Option<&[[f32; 3]]>)| {
         if let Some(p) = p {
             o.refitted += o.h.apply_positions(p);
@@ -475,18 +571,32 @@ fn update_objects<K: BvKind>(
     Ok(())
 }
 
-/// The jobs of a query: the object pairs whose root boxes, grown by `margin`, overlap, and
-/// the objects with self-collision on (`(a, a)`), sorted; and the broad phase's box tests.
-fn jobs_of<K: BvKind>(objects: &[Object<K>], margin: f32) -> (Vec<(usize, usize)>, u64) {
-    let bounds: Vec<_> = objects
-        .iter()
-        .map(|o| {
+/// `f(i)` for each object index `i < n`, one object per task in the ambient pool if
+/// `parallel`: results in object order.
+fn map_objects<R: Send>(n: usize, parallel: bool, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
+    if parallel {
+        (0..n).into_par_iter().with_max_len(1).map(f).collect()
+    } else {
+        (0..n).map(f).collect()
+    }
+}
+
+/// The jobs of a query: the object pairs whose boxes (`boxes`, one per object: the root
+/// boxes of the pose, or the boxes over a step), grown by `margin`, overlap, and the objects
+/// with self-collision on (`(a, a)`), sorted; and the broad phase's box tests.
+fn jobs_of<K: BvKind>(
+    objects: &[Object<K>],
+    boxes: impl Iterator<Item = [[f32; 3]; 2]>,
+    margin: f32,
+) -> (Vec<(usize, usize)>, u64) {
+    let bounds: Vec<_> = boxes
+        .map(|b| {
             if margin == 0.0 {
-                o.bounds
+                b
             } else {
                 [
-                    o.bounds[0].map(|x| (x - margin).next_down()),
-                    o.bounds[1].map(|x| (x + margin).next_up()),
+                    b[0].map(|x| (x - margin).next_down()),
+                    b[1].map(|x| (x + margin).next_up()),
                 ]
             }
         })
@@ -514,13 +624,29 @@ fn run_jobs<K: BvKind, R: Send>(
     query: impl Fn(&mut Workspace, &Hierarchy<K>, Option<&Hierarchy<K>>, Par) -> (R, [u64; 2]) + Sync,
     counters: impl Fn(&mut R) -> &mut Counters,
 ) -> Vec<R> {
+    let results = run_walks(objects, jobs, parallel, |ws, a, b, par| {
+        query(ws, &a.h, b.map(|b| &b.h), par)
+    });
+    credit_refits(results, jobs, objects.len(), counters, |i| {
+        std::mem::take(&mut objects[i].refitted)
+    })
+}
+
+/// Runs `query` on every job at once, each on its objects' `sides` (`None` as the second
+/// for a self job), in the ambient pool if `parallel` (each query may also split its own
+/// walk on the same pool): results in job order, with the nodes fitted on each side.
+fn run_walks<T: Sync, R: Send>(
+    sides: &[T],
+    jobs: &[(usize, usize)],
+    parallel: bool,
+    query: impl Fn(&mut Workspace, &T, Option<&T>, Par) -> (R, [u64; 2]) + Sync,
+) -> Vec<(R, [u64; 2])> {
     let inner = if parallel { Par::Rayon(0) } else { Par::Seq };
-    let shared: &[Object<K>] = objects;
     let run = |ws: &mut Workspace, (a, b): (usize, usize)| {
-        let other = (a != b).then(|| &shared[b].h);
-        query(ws, &shared[a].h, other, inner)
+        let other = (a != b).then(|| &sides[b]);
+        query(ws, &sides[a], other, inner)
     };
-    let mut results: Vec<(R, [u64; 2])> = if parallel && jobs.len() > 1 {
+    if parallel && jobs.len() > 1 {
         // One workspace per worker thread, reused across jobs.
         jobs.par_iter()
             .map_init(Workspace::default, |ws, &job| run(ws, job))
@@ -528,16 +654,26 @@ fn run_jobs<K: BvKind, R: Send>(
     } else {
         let mut ws = Workspace::default();
         jobs.iter().map(|&job| run(&mut ws, job)).collect()
-    };
-    // Each object's refits (the sum over jobs of the nodes fitted on it, whichever job
-    // fitted them, plus its eager refits) to its first job. Objects in no job were not
-    // touched: their eager refits wait for their next job.
-    let mut refitted = vec![0u64; objects.len()];
+    }
+}
+
+/// Credits each object's refits to its first job in job order: the sum over jobs of the
+/// nodes fitted on it (whichever job fitted them), plus `eager(i)`, its refits outside the
+/// walks. Objects in no job were not touched (`eager` is not called for them: their eager
+/// refits wait for their next job). The results in job order.
+fn credit_refits<R>(
+    mut results: Vec<(R, [u64; 2])>,
+    jobs: &[(usize, usize)],
+    objects: usize,
+    counters: impl Fn(&mut R) -> &mut Counters,
+    mut eager: impl FnMut(usize) -> u64,
+) -> Vec<R> {
+    let mut refitted = vec![0u64; objects];
     for (&(a, b), (_, fitted)) in jobs.iter().zip(&results) {
         refitted[a] += fitted[0];
         refitted[b] += fitted[1];
     }
-    let mut first_job = vec![None; objects.len()];
+    let mut first_job = vec![None; objects];
     for (k, &(a, b)) in jobs.iter().enumerate().rev() {
         first_job[a] = Some(k);
         first_job[b] = Some(k);
@@ -545,16 +681,16 @@ fn run_jobs<K: BvKind, R: Send>(
     for (r, _) in &mut results {
         counters(r).bv_updates = 0;
     }
-    for ((o, first), lazy) in objects.iter_mut().zip(first_job).zip(refitted) {
+    for (i, (first, lazy)) in first_job.into_iter().zip(refitted).enumerate() {
         if let Some(k) = first {
-            counters(&mut results[k].0).bv_updates += lazy + std::mem::take(&mut o.refitted);
+            counters(&mut results[k].0).bv_updates += lazy + eager(i);
         }
     }
     results.into_iter().map(|(r, _)| r).collect()
 }
 
 fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
-    let (jobs, broad_phase_tests) = jobs_of(objects, 0.0);
+    let (jobs, broad_phase_tests) = jobs_of(objects, objects.iter().map(|o| o.bounds), 0.0);
     let results = run_jobs(
         objects,
         &jobs,
@@ -588,4 +724,90 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
     }
     out.pairs.sort_unstable();
     out
+}
+
+/// [`Scene::ccd`] once the ids and options are checked: `motions[i]` is object `i`'s motion
+/// (`None`: still).
+fn ccd_of<K: BvKind>(
+    objects: &[Object<K>],
+    motions: &[Option<Motion<'_>>],
+    query: &CcdQuery,
+    parallel: bool,
+) -> Result<SceneImpacts> {
+    // Each moving object's step (checked, in internal order) and box over the step; the first
+    // error in scene order.
+    let steps: Vec<(Option<Step>, [[f32; 3]; 2])> = map_objects(objects.len(), parallel, |i| {
+        let o = &objects[i];
+        let Some(motion) = motions[i] else {
+            return Ok((None, o.bounds));
+        };
+        let step = checked_step(o.h.tree(), motion)?;
+        let b = box_over_step(o.h.tree(), &step, 0);
+        Ok((Some(step), [[b[0], b[1], b[2]], [b[3], b[4], b[5]]]))
+    })
+    .into_iter()
+    .collect::<Result<_>>()?;
+    let margin = f32_up(query.options.min_distance);
+    let (jobs, broad_phase_tests) = jobs_of(objects, steps.iter().map(|s| s.1), margin);
+    let mut in_job = vec![false; objects.len()];
+    for &(a, b) in &jobs {
+        in_job[a] = true;
+        in_job[b] = true;
+    }
+    // Each object's bounds over the step, shared by its jobs; a still object's step is its
+    // stored pose at both ends.
+    let sweeps: Vec<Option<Swept<'_, K>>> = map_objects(objects.len(), parallel, |i| {
+        in_job[i].then(|| {
+            let h = &objects[i].h;
+            let step = match &steps[i].0 {
+                Some(step) => Cow::Borrowed(step),
+                None => Cow::Owned(Step::still(
+                    (0..h.tree().vertex_total())
+                        .map(|v| h.position_f64(v))
+                        .collect(),
+                )),
+            };
+            Swept::of_step(h, step)
+        })
+    });
+    let best = earliest_bound(query);
+    let results = run_walks(&sweeps, &jobs, parallel, |ws, a, b, par| {
+        let a = a
+            .as_ref()
+            .expect("an object in a job has its bounds over the step");
+        match b {
+            None => ccd::run(a, a, true, query, best.as_ref(), ws, par),
+            Some(b) => {
+                let b = b
+                    .as_ref()
+                    .expect("an object in a job has its bounds over the step");
+                ccd::run(a, b, false, query, best.as_ref(), ws, par)
+            }
+        }
+    });
+    let mut impacts = credit_refits(
+        results,
+        &jobs,
+        objects.len(),
+        |i: &mut Impacts| &mut i.counters,
+        |_| 0,
+    );
+    let toi = match best {
+        Some(_) => keep_earliest(&mut impacts),
+        None => impacts.iter().filter_map(|i| i.toi).reduce(f64::min),
+    };
+    let mut out = SceneImpacts {
+        toi,
+        broad_phase_tests,
+        ..SceneImpacts::default()
+    };
+    for (&(a, b), i) in jobs.iter().zip(impacts) {
+        out.counters += i.counters;
+        out.per_pair.push(PairImpacts {
+            a: ObjectId(objects[a].id),
+            b: ObjectId(objects[b].id),
+            impacts: i,
+        });
+    }
+    Ok(out)
 }

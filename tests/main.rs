@@ -20,6 +20,7 @@ mod precision;
 mod proximity;
 mod real_frames;
 mod scene;
+mod scene_ccd;
 mod self_collision;
 mod shared_pairs;
 mod support;

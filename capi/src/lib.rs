@@ -42,7 +42,10 @@ use dhcd::hierarchy::Options;
 use dhcd::mesh::{Mesh, Precision};
 use dhcd::par::Par;
 use dhcd::scene::{ObjectId, Scene};
-use dhcd::{CcdMode, CcdQuery, Contacts, Impacts, Motion, Proximity, SceneProximity, Workspace};
+use dhcd::{
+    CcdMode, CcdQuery, Contacts, Impacts, Motion, Proximity, SceneImpacts, SceneProximity,
+    Workspace,
+};
 
 /// Success.
 pub const DHCD_OK: c_int = 0;
@@ -218,6 +221,32 @@ pub struct DhcdImpacts {
     pub fv_toi: *mut f64,
     pub fv_count: usize,
     pub edge_edge: *mut u32,
+    pub ee_toi: *mut f64,
+    pub ee_count: usize,
+    pub toi: f64,
+    pub counters: DhcdCounters,
+}
+
+/// Colliding feature pairs over a step in a scene, from `dhcd_scene_ccd` (release with
+/// `dhcd_scene_impacts_free`): every object pair's results (`object_a < object_b`) and every
+/// self-collision object's own (`object_a == object_b`), flattened with object ids, each
+/// list sorted by its rows; times of impact as in `DhcdImpacts`:
+/// - `vertex_face`: `[object_a, vertex, object_b, triangle]` at `vertex_face[4k..4k+4]`;
+/// - `face_vertex`: `[object_a, triangle, object_b, vertex]` (between two objects only);
+/// - `edge_edge`: `[object_a, a0, a1, object_b, b0, b1]` at `edge_edge[6k..6k+6]`.
+///
+/// `toi` is the earliest time of impact over the scene (`+inf`: nothing collides);
+/// `counters` are the totals over the object pairs.
+#[repr(C)]
+#[derive(Debug)]
+pub struct DhcdSceneImpacts {
+    pub vertex_face: *mut u64,
+    pub vf_toi: *mut f64,
+    pub vf_count: usize,
+    pub face_vertex: *mut u64,
+    pub fv_toi: *mut f64,
+    pub fv_count: usize,
+    pub edge_edge: *mut u64,
     pub ee_toi: *mut f64,
     pub ee_count: usize,
     pub toi: f64,
@@ -504,6 +533,58 @@ fn impacts_out(p: Impacts) -> DhcdImpacts {
     }
 }
 
+/// Rows of `N` indices with their times of impact, sorted by the rows: the index array
+/// (flattened), the times and the count.
+fn toi_rows<const N: usize>(mut rows: Vec<([u64; N], f64)>) -> (*mut u64, *mut f64, usize) {
+    // Rows are unique (one per feature pair of one object pair): the order is total.
+    rows.sort_unstable_by_key(|r| r.0);
+    let n = rows.len();
+    (
+        c_pairs(rows.iter().map(|r| r.0).collect()),
+        c_array(rows.iter().map(|r| r.1).collect()),
+        n,
+    )
+}
+
+/// The C result of a scene's CCD: every pair's rows with their object ids.
+fn scene_impacts_out(p: SceneImpacts) -> DhcdSceneImpacts {
+    let (mut vf, mut fv, mut ee) = (Vec::new(), Vec::new(), Vec::new());
+    let i = u64::from;
+    for pair in &p.per_pair {
+        let (a, b, q) = (pair.a.0, pair.b.0, &pair.impacts);
+        vf.extend(
+            q.vertex_face
+                .iter()
+                .map(|x| ([a, i(x.vertex), b, i(x.triangle)], x.toi)),
+        );
+        fv.extend(
+            q.face_vertex
+                .iter()
+                .map(|x| ([a, i(x.triangle), b, i(x.vertex)], x.toi)),
+        );
+        ee.extend(q.edge_edge.iter().map(|x| {
+            let row = [a, i(x.a[0]), i(x.a[1]), b, i(x.b[0]), i(x.b[1])];
+            (row, x.toi)
+        }));
+    }
+    let (vertex_face, vf_toi, vf_count) = toi_rows(vf);
+    let (face_vertex, fv_toi, fv_count) = toi_rows(fv);
+    let (edge_edge, ee_toi, ee_count) = toi_rows(ee);
+    DhcdSceneImpacts {
+        vertex_face,
+        vf_toi,
+        vf_count,
+        face_vertex,
+        fv_toi,
+        fv_count,
+        edge_edge,
+        ee_toi,
+        ee_count,
+        toi: p.toi.unwrap_or(f64::INFINITY),
+        counters: p.counters.into(),
+    }
+}
+
 /// The C result of a proximity query.
 fn proximity_out(p: Proximity) -> DhcdProximity {
     let vf = &p.vertex_face;
@@ -647,6 +728,20 @@ const NO_SCENE_PROXIMITY: DhcdSceneProximity = DhcdSceneProximity {
     ee_distance_sq: std::ptr::null_mut(),
     ee_type: std::ptr::null_mut(),
     ee_count: 0,
+    counters: NO_CONTACTS.counters,
+};
+
+const NO_SCENE_IMPACTS: DhcdSceneImpacts = DhcdSceneImpacts {
+    vertex_face: std::ptr::null_mut(),
+    vf_toi: std::ptr::null_mut(),
+    vf_count: 0,
+    face_vertex: std::ptr::null_mut(),
+    fv_toi: std::ptr::null_mut(),
+    fv_count: 0,
+    edge_edge: std::ptr::null_mut(),
+    ee_toi: std::ptr::null_mut(),
+    ee_count: 0,
+    toi: f64::INFINITY,
     counters: NO_CONTACTS.counters,
 };
 
@@ -1708,6 +1803,97 @@ pub unsafe extern "C" fn dhcd_scene_proximity_free(p: *mut DhcdSceneProximity) {
                 free_array(p.ee_type, p.ee_count);
             }
             *p = NO_SCENE_PROXIMITY;
+        }
+        Ok(())
+    });
+}
+
+/// Continuous collision detection of the whole scene over one step: entry `k` moves object
+/// `ids[k]` from `x0[k]` (t = 0) to `x1[k]` (t = 1), `3 * vertex_counts[k]` doubles each (as
+/// in `dhcd_ccd`; the object's stored pose is not read and the scene does not change); every
+/// object not listed stays at its stored pose. Every object pair whose boxes over the step
+/// come within `min_distance`, and every object with self-collision on, is queried as by
+/// `dhcd_ccd` / `dhcd_self_ccd`, into `*out` (see `DhcdSceneImpacts`; release with
+/// `dhcd_scene_impacts_free`). `earliest` non-zero: only the earliest time of impact over
+/// the scene and the pairs reaching it. Everything is checked before any work: an unknown
+/// id (`DHCD_ERR_UNKNOWN_OBJECT`), an id given twice (`DHCD_ERR_REPEATED_OBJECT`), a bad
+/// `t_max` or `min_distance` (`DHCD_ERR_INVALID_ARGUMENT`), a wrong vertex count
+/// (`DHCD_ERR_LENGTH_MISMATCH`), a non-finite coordinate (`DHCD_ERR_INVALID_MESH`). The
+/// result does not depend on `threads` (the work counters of earliest mode may). With
+/// `count == 0` the arrays may be NULL (every object still).
+///
+/// # Safety
+/// `s` null or a live handle; `ids`, `x0`, `x1` and `vertex_counts` hold `count` elements
+/// each, and each non-null `x0[k]`, `x1[k]` holds `3 * vertex_counts[k]` doubles; `out`
+/// null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_ccd(
+    s: *mut DhcdScene,
+    ids: *const u64,
+    x0: *const *const f64,
+    x1: *const *const f64,
+    vertex_counts: *const usize,
+    count: usize,
+    t_max: f64,
+    min_distance: f64,
+    earliest: c_int,
+    threads: u32,
+    out: *mut DhcdSceneImpacts,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on `out`: empty until there is a result.
+        unsafe { write(out, NO_SCENE_IMPACTS, "out")? };
+        // SAFETY: caller's contract.
+        let s = unsafe { handle(s, "scene")? };
+        let par = par(threads)?;
+        let motions: Vec<(ObjectId, Motion<'_>)> = if count == 0 {
+            Vec::new()
+        } else {
+            // SAFETY: the four arrays hold `count` elements (caller's contract).
+            let (ids, p0, p1, counts) = unsafe {
+                (
+                    slice(ids, count, "ids")?,
+                    slice(x0, count, "x0")?,
+                    slice(x1, count, "x1")?,
+                    slice(vertex_counts, count, "vertex_counts")?,
+                )
+            };
+            (0..count)
+                .map(|k| {
+                    // SAFETY: `x0[k]`, `x1[k]` hold `3 * vertex_counts[k]` doubles (caller's
+                    // contract).
+                    let m = unsafe { motion(p0[k], p1[k], counts[k], &format!("motion {k}"))? };
+                    Ok((ObjectId(ids[k]), m))
+                })
+                .collect::<Result<_, Fail>>()?
+        };
+        let q = ccd_query(t_max, min_distance, earliest);
+        let p = s.scene.ccd(&motions, &q, par)?;
+        // SAFETY: caller's contract on `out` (written above).
+        unsafe { write(out, scene_impacts_out(p), "out") }
+    })
+}
+
+/// Releases the arrays of a `DhcdSceneImpacts` and resets it to empty (`toi` `+inf`). Null,
+/// or an already released or empty result, is a no-op.
+///
+/// # Safety
+/// `p` null or a `DhcdSceneImpacts` filled by this library and not modified since.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_impacts_free(p: *mut DhcdSceneImpacts) {
+    let _ = guard(|| {
+        // SAFETY: caller's contract.
+        if let Some(p) = unsafe { p.as_mut() } {
+            // SAFETY: each array came from `c_array` with the lengths below, or is null.
+            unsafe {
+                free_array(p.vertex_face, 4 * p.vf_count);
+                free_array(p.vf_toi, p.vf_count);
+                free_array(p.face_vertex, 4 * p.fv_count);
+                free_array(p.fv_toi, p.fv_count);
+                free_array(p.edge_edge, 6 * p.ee_count);
+                free_array(p.ee_toi, p.ee_count);
+            }
+            *p = NO_SCENE_IMPACTS;
         }
         Ok(())
     });

@@ -809,6 +809,13 @@ fn struct_layouts() {
     ] {
         assert_eq!(size, 12 * std::mem::size_of::<usize>() + 32);
     }
+    // Six pointers and three counts, the earliest time, then the counters.
+    for size in [
+        std::mem::size_of::<DhcdImpacts>(),
+        std::mem::size_of::<DhcdSceneImpacts>(),
+    ] {
+        assert_eq!(size, 9 * std::mem::size_of::<usize>() + 8 + 32);
+    }
 }
 
 /// A pointer no valid handle or array has: what a C caller's uninitialised variable holds.
@@ -2695,5 +2702,185 @@ fn empty_impacts_free() {
         dhcd_impacts_free(&mut out);
         dhcd_hierarchy_free(a);
         dhcd_hierarchy_free(b);
+    }
+}
+
+/// `dhcd_scene_ccd` equals the Rust scene's `ccd` flattened with object ids (a small ball
+/// tunnelling through a still one, a far ball culled), in both modes and for 1 and 2
+/// threads; bad input is the documented error code with `out` left empty.
+#[test]
+fn scene_ccd_equals_the_rust_scene() {
+    let wall = icosphere(2, 1.0, [0.0; 3]);
+    let bullet = icosphere(1, 0.3, [-3.0, 0.0, 0.0]);
+    let far = icosphere(1, 0.5, [50.0, 0.0, 0.0]);
+    let b0: Vec<f64> = bullet
+        .positions()
+        .iter()
+        .flatten()
+        .map(|&c| f64::from(c))
+        .collect();
+    let b1: Vec<f64> = b0
+        .chunks(3)
+        .flat_map(|p| [p[0] + 6.0, p[1], p[2]])
+        .collect();
+    let nv = bullet.vertex_count();
+    type Rows<const N: usize> = Vec<([u64; N], f64)>;
+    /// A filled `DhcdSceneImpacts` as rows and its time; the C result is released.
+    unsafe fn taken(p: &mut DhcdSceneImpacts) -> (Rows<4>, Rows<4>, Rows<6>, f64) {
+        fn rows<const N: usize>(idx: &[u64], t: &[f64]) -> Rows<N> {
+            (0..t.len())
+                .map(|k| (std::array::from_fn(|i| idx[N * k + i]), t[k]))
+                .collect()
+        }
+        // SAFETY: the library wrote the stated number of elements at each array.
+        let out = unsafe {
+            (
+                rows(
+                    part(p.vertex_face, 4 * p.vf_count),
+                    part(p.vf_toi, p.vf_count),
+                ),
+                rows(
+                    part(p.face_vertex, 4 * p.fv_count),
+                    part(p.fv_toi, p.fv_count),
+                ),
+                rows(
+                    part(p.edge_edge, 6 * p.ee_count),
+                    part(p.ee_toi, p.ee_count),
+                ),
+                p.toi,
+            )
+        };
+        // SAFETY: filled by the library, released once (the second call is a no-op).
+        unsafe {
+            dhcd_scene_impacts_free(p);
+            assert!(p.vertex_face.is_null() && p.vf_count == 0 && p.toi == f64::INFINITY);
+            dhcd_scene_impacts_free(p);
+        }
+        out
+    }
+    for method in METHODS {
+        let mut rust = dhcd::Scene::new(method_of(method), options4());
+        let mut s = null_mut();
+        // SAFETY: live handles, arrays of the stated lengths, writable outputs.
+        unsafe {
+            assert_eq!(dhcd_scene_new(method, 4, &mut s), DHCD_OK);
+            for m in [&wall, &bullet, &far] {
+                let p: Vec<f32> = m.positions().iter().flatten().copied().collect();
+                let t: Vec<u32> = m.triangles().iter().flatten().copied().collect();
+                let mut id = u64::MAX;
+                let rc = dhcd_scene_add(
+                    s,
+                    p.as_ptr(),
+                    m.vertex_count(),
+                    t.as_ptr(),
+                    m.triangle_count(),
+                    0,
+                    &mut id,
+                );
+                assert_eq!(rc, DHCD_OK, "{}", last_error());
+                assert_eq!(id, rust.add(m).unwrap().0);
+            }
+            let rows =
+                |f: &[f64]| -> Vec<[f64; 3]> { f.chunks(3).map(|p| [p[0], p[1], p[2]]).collect() };
+            let (x0, x1) = (rows(&b0), rows(&b1));
+            for earliest in [0, 1] {
+                let q = CcdQuery {
+                    mode: if earliest == 1 {
+                        CcdMode::Earliest
+                    } else {
+                        CcdMode::All
+                    },
+                    ..CcdQuery::all()
+                };
+                let want = rust
+                    .ccd(&[(dhcd::ObjectId(1), Motion::new(&x0, &x1))], &q, Par::Seq)
+                    .unwrap();
+                for threads in [1u32, 2] {
+                    let mut p = std::mem::zeroed::<DhcdSceneImpacts>();
+                    let rc = dhcd_scene_ccd(
+                        s,
+                        &1,
+                        &b0.as_ptr(),
+                        &b1.as_ptr(),
+                        &nv,
+                        1,
+                        1.0,
+                        0.0,
+                        earliest,
+                        threads,
+                        &mut p,
+                    );
+                    assert_eq!(rc, DHCD_OK, "{}", last_error());
+                    let (vf, fv, ee, toi) = taken(&mut p);
+                    assert_eq!(Some(toi), want.toi);
+                    assert!(toi > 0.28 && toi < 0.30);
+                    let pair = &want.per_pair[0].impacts;
+                    assert_eq!(want.per_pair.len(), 1, "the far ball is culled");
+                    let wvf: Rows<4> = pair
+                        .vertex_face
+                        .iter()
+                        .map(|x| ([0, x.vertex.into(), 1, x.triangle.into()], x.toi))
+                        .collect();
+                    let wfv: Rows<4> = pair
+                        .face_vertex
+                        .iter()
+                        .map(|x| ([0, x.triangle.into(), 1, x.vertex.into()], x.toi))
+                        .collect();
+                    let wee: Rows<6> = pair
+                        .edge_edge
+                        .iter()
+                        .map(|x| {
+                            let [a0, a1] = x.a.map(u64::from);
+                            let [c0, c1] = x.b.map(u64::from);
+                            ([0, a0, a1, 1, c0, c1], x.toi)
+                        })
+                        .collect();
+                    assert_eq!(
+                        (vf, fv, ee),
+                        (wvf, wfv, wee),
+                        "{method} {earliest} {threads}"
+                    );
+                }
+            }
+            // Errors: the documented codes, `out` empty.
+            let (p0, p1) = (b0.as_ptr(), b1.as_ptr());
+            let short = nv - 1;
+            let cases: [(&[u64], &[usize], f64, i32); 4] = [
+                (&[7], &[nv], 0.0, DHCD_ERR_UNKNOWN_OBJECT),
+                (&[1, 1], &[nv, nv], 0.0, DHCD_ERR_REPEATED_OBJECT),
+                (&[1], &[short], 0.0, DHCD_ERR_LENGTH_MISMATCH),
+                (&[1], &[nv], -1.0, DHCD_ERR_INVALID_ARGUMENT),
+            ];
+            for (ids, counts, d, code) in cases {
+                let (x0s, x1s) = (vec![p0; ids.len()], vec![p1; ids.len()]);
+                let mut p = DhcdSceneImpacts {
+                    vertex_face: garbage(),
+                    vf_count: 3,
+                    ..std::mem::zeroed()
+                };
+                let rc = dhcd_scene_ccd(
+                    s,
+                    ids.as_ptr(),
+                    x0s.as_ptr(),
+                    x1s.as_ptr(),
+                    counts.as_ptr(),
+                    ids.len(),
+                    1.0,
+                    d,
+                    0,
+                    1,
+                    &mut p,
+                );
+                assert_eq!(rc, code, "{}", last_error());
+                assert!(p.vertex_face.is_null() && p.vf_count == 0 && p.toi == f64::INFINITY);
+            }
+            // No motion: nothing moves, nothing collides.
+            let mut p = std::mem::zeroed::<DhcdSceneImpacts>();
+            let rc = dhcd_scene_ccd(s, null(), null(), null(), null(), 0, 1.0, 0.0, 0, 1, &mut p);
+            assert_eq!(rc, DHCD_OK, "{}", last_error());
+            assert_eq!((p.vf_count, p.fv_count, p.ee_count), (0, 0, 0));
+            assert_eq!(p.toi, f64::INFINITY);
+            dhcd_scene_free(s);
+        }
     }
 }

@@ -94,6 +94,11 @@ Queries64 = npt.ArrayLike
 """Single-pair CCD queries: an ``(N, 4, 3)`` float64 array, four points per query."""
 # `Scene.update_many` and `Scene.step`: `{id or name: vertices}` or `[(id or name, vertices)]`.
 Updates = Union[Mapping[Union[int, str], Vertices], Iterable[Tuple[Union[int, str], Vertices]]]
+# `Scene.ccd`: `{id or name: (x0, x1)}` or `[(id or name, (x0, x1))]`.
+Motions = Union[
+    Mapping[Union[int, str], Tuple[Positions64, Positions64]],
+    Iterable[Tuple[Union[int, str], Tuple[Positions64, Positions64]]],
+]
 
 class Contacts:
     """The result of a query."""
@@ -175,6 +180,13 @@ class Impacts:
         face_vertex  (K, 2) [face of a, vertex of b]
         edge_edge    (K, 4) [a0, a1, b0, b1]             (a0 < a1, b0 < b1; self:
                                                           (a0, a1) < (b0, b1), no shared vertex)
+
+    From ``Scene.ccd(motions)``, rows with object ids (``object_a < object_b``, or ``==``
+    inside an object with self-collision on)::
+
+        vertex_face  (K, 4) [object_a, vertex, object_b, face]
+        face_vertex  (K, 4) [object_a, face, object_b, vertex]
+        edge_edge    (K, 6) [object_a, a0, a1, object_b, b0, b1]
 
     With ``earliest=True`` the lists hold only the pairs whose time of impact is ``toi``.
     """
@@ -372,6 +384,26 @@ class Scene:
         """Every vertex-face, face-vertex and edge-edge pair within distance ``d`` between
         two objects, and inside each object with self-collision on: rows with object ids
         (see ``Proximity``), sorted. Objects farther apart than ``d`` cost one box test."""
+    def ccd(
+        self,
+        motions: Motions,
+        *,
+        min_distance: float = 0.0,
+        earliest: bool = False,
+        t_max: float = 1.0,
+        threads: int = 1,
+    ) -> Impacts:
+        """Continuous collision detection of the whole scene over one step (as ``ccd`` for
+        each object pair and each object with self-collision on): each object in
+        ``motions`` (``{id: (x0, x1)}`` or ``[(id, (x0, x1))]``, ids or names, each at most
+        once; float64 ``(n, 3)`` arrays) moves from ``x0`` to ``x1`` (its stored pose is not
+        read, and nothing in the scene changes); every other object stays at its stored
+        pose. Objects whose boxes over the step do not come within ``min_distance`` cost one
+        box test. Rows with object ids (see ``Impacts``); ``earliest=True``: the earliest
+        time over the whole scene and the pairs reaching it. Bad input (an unknown or
+        repeated id, a wrong shape, dtype or vertex count, a non-finite coordinate, a
+        negative ``min_distance``) raises ``ValueError`` before any work. The result does not
+        depend on ``threads`` (the work counters of earliest mode may)."""
     def __len__(self) -> int: ...
 
 MeshLike = Union[Any, Tuple[Vertices, Faces]]

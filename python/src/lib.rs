@@ -874,42 +874,80 @@ struct Impacts {
 /// `(K, N)` int64 index rows and `(K,)` float64 times of impact.
 type TimeColumns = (Py<PyArray2<i64>>, Py<PyArray1<f64>>);
 
+/// Rows of `N` indices, each with its time of impact.
+type TimeRows<const N: usize> = Vec<([u64; N], f64)>;
+
 /// One list of a CCD result as numpy arrays.
-fn toi_columns<const N: usize>(
-    py: Python<'_>,
-    rows: Vec<([u32; N], f64)>,
-) -> PyResult<TimeColumns> {
+fn toi_columns<const N: usize>(py: Python<'_>, rows: TimeRows<N>) -> PyResult<TimeColumns> {
     let k = rows.len();
-    let flat: Vec<i64> = rows.iter().flat_map(|r| r.0).map(i64::from).collect();
+    let flat: Vec<i64> = rows.iter().flat_map(|r| r.0).map(|v| v as i64).collect();
     let idx = Array2::from_shape_vec((k, N), flat)
         .map_err(|e| value_error(format!("internal error: {e}")))?;
     let toi: Vec<f64> = rows.iter().map(|r| r.1).collect();
     Ok((idx.into_pyarray(py).unbind(), toi.into_pyarray(py).unbind()))
 }
 
+/// The rows of one walk's impacts with object ids `[a, b]` in front of each side's indices
+/// (`None`: a single mesh's query, no ids): vertex-face, face-vertex, edge-edge.
+fn impact_rows<const V: usize, const E: usize>(
+    r: &dhcd::Impacts,
+    ids: Option<[u64; 2]>,
+    (vf, fv, ee): &mut (TimeRows<V>, TimeRows<V>, TimeRows<E>),
+) {
+    let i = u64::from;
+    let ids: Vec<u64> = ids.map(|x| x.to_vec()).unwrap_or_default();
+    // `[a?, x, b?, y]`: the object ids (if any) before each side's indices.
+    let row = |x: &[u64], y: &[u64]| -> Vec<u64> {
+        let (a, b) = (ids.first(), ids.get(1));
+        a.into_iter().chain(x).chain(b).chain(y).copied().collect()
+    };
+    let fixed = |r: Vec<u64>| -> [u64; V] { r.try_into().expect("row width") };
+    vf.extend(
+        r.vertex_face
+            .iter()
+            .map(|x| (fixed(row(&[i(x.vertex)], &[i(x.triangle)])), x.toi)),
+    );
+    fv.extend(
+        r.face_vertex
+            .iter()
+            .map(|x| (fixed(row(&[i(x.triangle)], &[i(x.vertex)])), x.toi)),
+    );
+    ee.extend(r.edge_edge.iter().map(|x| {
+        let r = row(&x.a.map(i), &x.b.map(i));
+        (r.try_into().expect("row width"), x.toi)
+    }));
+}
+
 impl Impacts {
     fn new(py: Python<'_>, r: dhcd::Impacts) -> PyResult<Self> {
-        let (vertex_face, vf_toi) = toi_columns(
-            py,
-            r.vertex_face
-                .iter()
-                .map(|x| ([x.vertex, x.triangle], x.toi))
-                .collect(),
-        )?;
-        let (face_vertex, fv_toi) = toi_columns(
-            py,
-            r.face_vertex
-                .iter()
-                .map(|x| ([x.triangle, x.vertex], x.toi))
-                .collect(),
-        )?;
-        let (edge_edge, ee_toi) = toi_columns(
-            py,
-            r.edge_edge
-                .iter()
-                .map(|x| ([x.a[0], x.a[1], x.b[0], x.b[1]], x.toi))
-                .collect(),
-        )?;
+        let mut rows: (TimeRows<2>, TimeRows<2>, TimeRows<4>) = Default::default();
+        impact_rows(&r, None, &mut rows);
+        Self::of_rows(py, rows, r.toi, r.counters)
+    }
+
+    /// A scene's result flattened with object ids (as [`scene_proximity_rows`]), each list
+    /// sorted by its rows.
+    fn of_scene(py: Python<'_>, r: dhcd::SceneImpacts) -> PyResult<Self> {
+        let mut rows: (TimeRows<4>, TimeRows<4>, TimeRows<6>) = Default::default();
+        for p in &r.per_pair {
+            impact_rows(&p.impacts, Some([p.a.0, p.b.0]), &mut rows);
+        }
+        // Rows are unique (one per feature pair of one object pair): the order is total.
+        rows.0.sort_unstable_by_key(|r| r.0);
+        rows.1.sort_unstable_by_key(|r| r.0);
+        rows.2.sort_unstable_by_key(|r| r.0);
+        Self::of_rows(py, rows, r.toi, r.counters)
+    }
+
+    fn of_rows<const V: usize, const E: usize>(
+        py: Python<'_>,
+        (vf, fv, ee): (TimeRows<V>, TimeRows<V>, TimeRows<E>),
+        toi: Option<f64>,
+        c: Counters,
+    ) -> PyResult<Self> {
+        let (vertex_face, vf_toi) = toi_columns(py, vf)?;
+        let (face_vertex, fv_toi) = toi_columns(py, fv)?;
+        let (edge_edge, ee_toi) = toi_columns(py, ee)?;
         Ok(Self {
             vertex_face,
             vf_toi,
@@ -917,8 +955,8 @@ impl Impacts {
             fv_toi,
             edge_edge,
             ee_toi,
-            toi: r.toi.unwrap_or(f64::INFINITY),
-            counters: counters(py, r.counters)?,
+            toi: toi.unwrap_or(f64::INFINITY),
+            counters: counters(py, c)?,
         })
     }
 
@@ -1190,21 +1228,24 @@ fn update_pair<'py>(
     entry: &Bound<'py, PyAny>,
     k: usize,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    two_items(entry, &format!("update {k} must be an (id, vertices) pair"))
+}
+
+/// The two items of a tuple or list (`must`: what it must be, for the errors).
+fn two_items<'py>(
+    entry: &Bound<'py, PyAny>,
+    must: &str,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let items = if let Ok(t) = entry.cast::<PyTuple>() {
         t.as_sequence().clone()
     } else if let Ok(l) = entry.cast::<PyList>() {
         l.as_sequence().clone()
     } else {
         let kind = entry.get_type().name()?;
-        return Err(PyTypeError::new_err(format!(
-            "update {k} must be an (id, vertices) pair, got {kind}"
-        )));
+        return Err(PyTypeError::new_err(format!("{must}, got {kind}")));
     };
     if items.len()? != 2 {
-        return Err(value_error(format!(
-            "update {k} must be an (id, vertices) pair, got {} items",
-            items.len()?
-        )));
+        return Err(value_error(format!("{must}, got {} items", items.len()?)));
     }
     Ok((items.get_item(0)?, items.get_item(1)?))
 }
@@ -1369,6 +1410,46 @@ impl Scene {
             .detach(|| Ok(scene_proximity_rows(scene.proximity(d, par)?)))
             .map_err(to_py)?;
         Proximity::new(py, rows)
+    }
+
+    /// Continuous collision detection of the whole scene over one step: `motions` maps
+    /// objects to `(x0, x1)` (float64 `(n, 3)` each); the other objects stay still.
+    #[pyo3(
+        signature = (motions, *, min_distance = None, earliest = false, t_max = None, threads = None),
+        text_signature = "(self, motions, *, min_distance=0.0, earliest=False, t_max=1.0, threads=1)"
+    )]
+    fn ccd(
+        &self,
+        py: Python<'_>,
+        motions: &Bound<'_, PyAny>,
+        min_distance: Option<&Bound<'_, PyAny>>,
+        earliest: bool,
+        t_max: Option<&Bound<'_, PyAny>>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Impacts> {
+        let q = ccd_query(min_distance, t_max, earliest)?;
+        let par = par(threads)?;
+        let entries = match motions.cast::<PyMapping>() {
+            Ok(m) => m.items()?.into_any(),
+            Err(_) => motions.clone(),
+        };
+        let mut arrays = Vec::new();
+        for (k, entry) in entries.try_iter()?.enumerate() {
+            let (id, m) = two_items(
+                &entry?,
+                &format!("motion {k} must be an (id, (x0, x1)) pair"),
+            )?;
+            let (x0, x1) = two_items(&m, &format!("motion {k} must be an (x0, x1) pair"))?;
+            let id = self.object(&id)?;
+            arrays.push((id, ccd_positions(&x0, "x0")?, ccd_positions(&x1, "x1")?));
+        }
+        let motions: Vec<(ObjectId, Motion<'_>)> = arrays
+            .iter()
+            .map(|(id, x0, x1)| Ok((*id, Motion::new(rows_of(x0, "x0")?, rows_of(x1, "x1")?))))
+            .collect::<PyResult<_>>()?;
+        let scene = &self.scene;
+        let r = py.detach(|| scene.ccd(&motions, &q, par)).map_err(to_py)?;
+        Impacts::of_scene(py, r)
     }
 
     fn __len__(&self) -> usize {

@@ -41,6 +41,14 @@ pub struct Step {
 }
 
 impl Step {
+    /// A step without motion: `x` (internal order) at t0 and at t1.
+    pub(crate) fn still(x: Vec<[f64; 3]>) -> Self {
+        Self {
+            x0: x.clone(),
+            x1: x,
+        }
+    }
+
     /// The positions `x0`, `x1` (caller's order, checked) gathered into internal order.
     pub(crate) fn gather(tree: &RegionTree, x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Self {
         let order = tree.vert_order();

@@ -26,6 +26,7 @@
 //! count. `prim_tests` counts the feature pairs given to the exact test, `contacts` the
 //! pairs reported, `bv_updates` the bounds fitted over the step.
 
+use std::borrow::Cow;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use pulp::Simd;
@@ -190,7 +191,8 @@ pub fn ccd_pair_with<K: BvKind>(
     query.options.validate()?;
     let sa = Swept::new(a, a_motion)?;
     let sb = Swept::new(b, b_motion)?;
-    Ok(run(&sa, &sb, false, query, ws, par))
+    let best = earliest_bound(query);
+    Ok(run(&sa, &sb, false, query, best.as_ref(), ws, par).0)
 }
 
 /// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
@@ -213,7 +215,8 @@ pub fn self_ccd_with<K: BvKind>(
 ) -> Result<Impacts> {
     query.options.validate()?;
     let s = Swept::new(h, motion)?;
-    Ok(run(&s, &s, true, query, ws, par))
+    let best = earliest_bound(query);
+    Ok(run(&s, &s, true, query, best.as_ref(), ws, par).0)
 }
 
 /// One hierarchy over a step: its positions at t0 and t1 (internal order), its node bounds
@@ -221,10 +224,18 @@ pub fn self_ccd_with<K: BvKind>(
 /// (internal order) and own edges (leaf-edge order), as six rows each.
 pub(crate) struct Swept<'h, K: BvKind> {
     h: &'h Hierarchy<K>,
-    step: Step,
+    step: Cow<'h, Step>,
     bounds: K::Swept,
     tri_rows: [Vec<f32>; 6],
     edge_rows: [Vec<f32>; 6],
+}
+
+/// `motion`'s positions (checked: the mesh's vertex count, finite, in range) in `tree`'s
+/// internal vertex order.
+pub(crate) fn checked_step(tree: &RegionTree, motion: Motion<'_>) -> Result<Step> {
+    check_positions_f64(motion.x0, tree.vertex_total())?;
+    check_positions_f64(motion.x1, tree.vertex_total())?;
+    Ok(Step::gather(tree, motion.x0, motion.x1))
 }
 
 /// Six rows of boxes, one per point set.
@@ -254,10 +265,15 @@ fn box_rows<const N: usize>(
 
 impl<'h, K: BvKind> Swept<'h, K> {
     pub(crate) fn new(h: &'h Hierarchy<K>, motion: Motion<'_>) -> Result<Self> {
+        Ok(Self::of_step(
+            h,
+            Cow::Owned(checked_step(h.tree(), motion)?),
+        ))
+    }
+
+    /// `h` over `step` (its positions in `h`'s internal order, checked).
+    pub(crate) fn of_step(h: &'h Hierarchy<K>, step: Cow<'h, Step>) -> Self {
         let tree = h.tree();
-        check_positions_f64(motion.x0, tree.vertex_total())?;
-        check_positions_f64(motion.x1, tree.vertex_total())?;
-        let step = Step::gather(tree, motion.x0, motion.x1);
         let tri_rows = box_rows(
             tree.triangles().iter().map(|t| t.map(|v| v as usize)),
             &step,
@@ -269,13 +285,13 @@ impl<'h, K: BvKind> Swept<'h, K> {
                 .map(|e| e.map(|v| v as usize)),
             &step,
         );
-        Ok(Self {
+        Self {
             h,
             bounds: K::swept(tree),
             step,
             tri_rows,
             edge_rows,
-        })
+        }
     }
 
     fn tree(&self) -> &'h RegionTree {
@@ -313,9 +329,9 @@ struct SweptQuery<'s, 'h, K: BvKind> {
     options: CcdOptions,
     /// The minimum distance as an `f32` not below it: the feature boxes' growth.
     margin: f32,
-    /// Earliest mode: the least time of impact found so far (`f64` bits; all are `>= 0`,
-    /// so their order is the integers').
-    best: Option<AtomicU64>,
+    /// Earliest mode: the least time of impact found so far, by this walk or any other
+    /// sharing the bound ([`earliest_bound`]).
+    best: Option<&'s AtomicU64>,
 }
 
 #[derive(Default)]
@@ -337,21 +353,32 @@ impl ImpactOut {
     }
 }
 
-fn run<K: BvKind>(
+/// Earliest mode's bound on the time of impact (`None` in all mode): the least time found so
+/// far, as `f64` bits (all times are `>= 0`, so their order is the integers'). Walks that
+/// share one bound prune each other's tests; each still settles its own answer
+/// ([`SweptQuery::settle_earliest`]), and [`keep_earliest`] settles several walks' answers.
+pub(crate) fn earliest_bound(query: &CcdQuery) -> Option<AtomicU64> {
+    (query.mode == CcdMode::Earliest).then(|| AtomicU64::new(f64::INFINITY.to_bits()))
+}
+
+/// The CCD walk of `a` against `b` (options checked), pruned by `best` in earliest mode; also
+/// the bounds fitted on each side.
+pub(crate) fn run<K: BvKind>(
     a: &Swept<'_, K>,
     b: &Swept<'_, K>,
     self_query: bool,
     query: &CcdQuery,
+    best: Option<&AtomicU64>,
     ws: &mut Workspace,
     par: Par,
-) -> Impacts {
+) -> (Impacts, [u64; 2]) {
     let q = SweptQuery {
         a,
         b,
         self_query,
         options: query.options,
         margin: f32_up(query.options.min_distance),
-        best: (query.mode == CcdMode::Earliest).then(|| AtomicU64::new(f64::INFINITY.to_bits())),
+        best,
     };
     let w = walk::walk(&q, ws, par);
     let mut out = w.out;
@@ -367,13 +394,32 @@ fn run<K: BvKind>(
     let mut counters = w.counters;
     counters.contacts =
         (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
-    Impacts {
+    let impacts = Impacts {
         vertex_face: out.vertex_face,
         face_vertex: out.face_vertex,
         edge_edge: out.edge_edge,
         toi,
         counters,
+    };
+    (impacts, w.fitted)
+}
+
+/// Earliest mode over several walks that shared one bound: the least of their times, and
+/// each walk's pairs only if they reach it (the others are emptied, with `toi` `None`). A
+/// walk whose own answer is later may have been cut short by another's bound, so only the
+/// walks reaching the least time have an answer that does not depend on the order; theirs
+/// is the same as without the sharing (every pair within the tolerance of the least time is
+/// found whatever the bound, see [`PRUNE_SLACK`]).
+pub(crate) fn keep_earliest(walks: &mut [Impacts]) -> Option<f64> {
+    let least = walks.iter().filter_map(|w| w.toi).reduce(f64::min);
+    for w in walks.iter_mut().filter(|w| w.toi != least) {
+        w.vertex_face.clear();
+        w.face_vertex.clear();
+        w.edge_edge.clear();
+        w.toi = None;
+        w.counters.contacts = 0;
     }
+    least
 }
 
 impl<K: BvKind> SweptQuery<'_, '_, K> {
