@@ -495,21 +495,21 @@ int main(void) {
    * one (object 1) moving; a far grid (object 2) is culled. Rows carry object ids; they are
    * the pair query's. */
   DhcdScene *ccd_scene = NULL;
-  uint64_t lower = 0, upper = 0, far = 0;
+  uint64_t id_lower = 0, id_upper = 0, id_far = 0;
   float *far_grid = malloc(3 * nv * sizeof(float));
   for (size_t k = 0; k < 3 * nv; k++) far_grid[k] = g[k] + (k % 3 == 0 ? 100.0f : 0.0f);
   OK(dhcd_scene_new(DHCD_METHOD_DH, 0, &ccd_scene));
-  OK(dhcd_scene_add(ccd_scene, g, nv, gt, nt, 0, &lower));
-  OK(dhcd_scene_add(ccd_scene, g, nv, gt, nt, 0, &upper));
-  OK(dhcd_scene_add(ccd_scene, far_grid, nv, gt, nt, 0, &far));
+  OK(dhcd_scene_add(ccd_scene, g, nv, gt, nt, 0, &id_lower));
+  OK(dhcd_scene_add(ccd_scene, g, nv, gt, nt, 0, &id_upper));
+  OK(dhcd_scene_add(ccd_scene, far_grid, nv, gt, nt, 0, &id_far));
   const double *up0[1] = {c0 + 3 * nv}, *up1[1] = {c1 + 3 * nv};
   const size_t up_count[1] = {nv};
   DhcdSceneImpacts si = {0};
-  OK(dhcd_scene_ccd(ccd_scene, &upper, up0, up1, up_count, 1, 1.0, 0.0, 0, 2, &si));
+  OK(dhcd_scene_ccd(ccd_scene, &id_upper, up0, up1, up_count, 1, 1.0, 0.0, 0, 2, &si));
   CHECK(si.vf_count == pair_ccd.vf_count && si.fv_count == pair_ccd.fv_count);
   CHECK(si.ee_count == pair_ccd.ee_count && si.toi == pair_ccd.toi);
   for (size_t k = 0; k < si.vf_count && k < pair_ccd.vf_count; k++) {
-    CHECK(si.vertex_face[4 * k] == lower && si.vertex_face[4 * k + 2] == upper);
+    CHECK(si.vertex_face[4 * k] == id_lower && si.vertex_face[4 * k + 2] == id_upper);
     CHECK(si.vertex_face[4 * k + 1] == pair_ccd.vertex_face[2 * k]);
     CHECK(si.vertex_face[4 * k + 3] == pair_ccd.vertex_face[2 * k + 1]);
     CHECK(si.vf_toi[k] == pair_ccd.vf_toi[k]);
@@ -518,7 +518,7 @@ int main(void) {
          si.vf_count, si.fv_count, si.ee_count, si.toi);
   dhcd_scene_impacts_free(&si);
   /* The same object twice: an error, the result empty. */
-  const uint64_t twice_up[2] = {upper, upper};
+  const uint64_t twice_up[2] = {id_upper, id_upper};
   const double *up0s[2] = {up0[0], up0[0]}, *up1s[2] = {up1[0], up1[0]};
   const size_t up_counts[2] = {nv, nv};
   CHECK(dhcd_scene_ccd(ccd_scene, twice_up, up0s, up1s, up_counts, 2, 1.0, 0.0, 0, 1, &si) ==
