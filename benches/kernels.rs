@@ -11,7 +11,8 @@
 //!   vertices, separating planes, then the certified canonical form on the candidates) on
 //!   1,024 pairs of leaves of 8 nearby triangles, throughput in triangle pairs. (Before the
 //!   canonical form moved into the kernel this was `leaf_candidates`, the filter alone.)
-//! - `kernels/<refit reduction>/{scalar,dispatched}/<n>`: refit reductions over `n` points.
+//! - `kernels/<refit reduction>/{scalar,dispatched}/<n>`: refit reductions over `n` points;
+//!   `dispatched` is the `*_with` body in a dispatch of its own per call.
 //!
 //! Inputs come from a seeded RNG and are generated once.
 //!
@@ -21,7 +22,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use dhcd_kernels::narrow::{self, Pairing, TriSoa};
 use dhcd_kernels::overlap::{self, AabbSoa, SphereSoa};
 use dhcd_kernels::pulp::{Simd, WithSimd};
-use dhcd_kernels::refit;
+use dhcd_kernels::{reference, refit};
 use dhcd_kernels::{Soa3, Tile};
 use std::hint::black_box;
 
@@ -147,12 +148,12 @@ fn block_benches(c: &mut Criterion) {
                     let mut hits = 0;
                     if aabb {
                         for (k, &(lo, hi)) in blocks.box_probes.iter().enumerate() {
-                            hits += overlap::aabb_block_scalar(lo, hi, blocks.aabb(k), BLOCK)
+                            hits += reference::aabb_block_scalar(lo, hi, blocks.aabb(k), BLOCK)
                                 .count_ones();
                         }
                     } else {
                         for (k, &(c, r)) in blocks.probes.iter().enumerate() {
-                            hits += overlap::sphere_block_scalar(c, r, blocks.sphere(k), BLOCK)
+                            hits += reference::sphere_block_scalar(c, r, blocks.sphere(k), BLOCK)
                                 .count_ones();
                         }
                     }
@@ -246,7 +247,7 @@ fn leaf_benches(c: &mut Criterion) {
                 let mut n = 0;
                 for p in 0..LEAF_PAIRS {
                     let (a, b) = (leaves.leaf(2 * p), leaves.leaf(2 * p + 1));
-                    narrow::leaf_contacts_scalar(a, LEAF, b, LEAF, pairing, &mut rows);
+                    reference::leaf_contacts_scalar(a, LEAF, b, LEAF, pairing, &mut rows);
                     n += rows
                         .iter()
                         .map(|r| r.candidates().count_ones() as u64)
@@ -296,40 +297,83 @@ fn s3(s: [f32; 3]) -> [f32; 6] {
     [s[0], s[1], s[2], 0.0, 0.0, 0.0]
 }
 
+/// A refit reduction for [`Dispatched`].
+#[derive(Clone, Copy)]
+enum Reduction {
+    MaxDistSq,
+    MaxDistSqIndexed,
+    Sum,
+    SumIndexed,
+    Bounds,
+    BoundsIndexed,
+}
+
+/// One refit reduction (`*_with`) in a dispatch of its own.
+struct Dispatched<'a> {
+    r: Reduction,
+    p: Soa3<'a>,
+    idx: &'a [u32],
+    c: [f32; 3],
+}
+
+impl WithSimd for Dispatched<'_> {
+    type Output = [f32; 6];
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> [f32; 6] {
+        let (p, idx, c) = (self.p, self.idx, self.c);
+        match self.r {
+            Reduction::MaxDistSq => [refit::max_dist_sq_with(simd, p, c); 6],
+            Reduction::MaxDistSqIndexed => [refit::max_dist_sq_indexed_with(simd, p, idx, c); 6],
+            Reduction::Sum => s3(refit::sum_with(simd, p)),
+            Reduction::SumIndexed => s3(refit::sum_indexed_with(simd, p, idx)),
+            Reduction::Bounds => flat(refit::bounds_with(simd, p)),
+            Reduction::BoundsIndexed => flat(refit::bounds_indexed_with(simd, p, idx)),
+        }
+    }
+}
+
+/// `r` around the centre `c`, dispatched per call.
+fn dispatched(r: Reduction, c: [f32; 3]) -> impl Fn(Soa3, &[u32]) -> [f32; 6] {
+    move |p, idx| dhcd_kernels::arch().dispatch(Dispatched { r, p, idx, c })
+}
+
 fn refit_benches(c: &mut Criterion) {
     let ctr = [0.1, -0.05, 0.2];
     bench_refit(
         c,
         "max_dist_sq",
-        &|p, _| [refit::max_dist_sq_scalar(p, ctr); 6],
-        &|p, _| [refit::max_dist_sq(p, ctr); 6],
+        &|p, _| [reference::max_dist_sq_scalar(p, ctr); 6],
+        &dispatched(Reduction::MaxDistSq, ctr),
     );
     bench_refit(
         c,
         "max_dist_sq_indexed",
-        &|p, i| [refit::max_dist_sq_indexed_scalar(p, i, ctr); 6],
-        &|p, i| [refit::max_dist_sq_indexed(p, i, ctr); 6],
+        &|p, i| [reference::max_dist_sq_indexed_scalar(p, i, ctr); 6],
+        &dispatched(Reduction::MaxDistSqIndexed, ctr),
     );
-    bench_refit(c, "sum", &|p, _| s3(refit::sum_scalar(p)), &|p, _| {
-        s3(refit::sum(p))
-    });
+    bench_refit(
+        c,
+        "sum",
+        &|p, _| s3(reference::sum_scalar(p)),
+        &dispatched(Reduction::Sum, ctr),
+    );
     bench_refit(
         c,
         "sum_indexed",
-        &|p, i| s3(refit::sum_indexed_scalar(p, i)),
-        &|p, i| s3(refit::sum_indexed(p, i)),
+        &|p, i| s3(reference::sum_indexed_scalar(p, i)),
+        &dispatched(Reduction::SumIndexed, ctr),
     );
     bench_refit(
         c,
         "bounds",
-        &|p, _| flat(refit::bounds_scalar(p)),
-        &|p, _| flat(refit::bounds(p)),
+        &|p, _| flat(reference::bounds_scalar(p)),
+        &dispatched(Reduction::Bounds, ctr),
     );
     bench_refit(
         c,
         "bounds_indexed",
-        &|p, i| flat(refit::bounds_indexed_scalar(p, i)),
-        &|p, i| flat(refit::bounds_indexed(p, i)),
+        &|p, i| flat(reference::bounds_indexed_scalar(p, i)),
+        &dispatched(Reduction::BoundsIndexed, ctr),
     );
 }
 

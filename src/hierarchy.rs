@@ -12,6 +12,7 @@ use dhcd_kernels::lazy::LazyTiles;
 use dhcd_kernels::narrow::TriSoa;
 use dhcd_kernels::overlap::BoxRows;
 use dhcd_kernels::{refit, Soa3, Tile};
+use pulp::Simd;
 
 /// When bounding volumes follow a deformation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -241,8 +242,9 @@ impl TriCache {
 
     /// Leaf `leaf`'s triangles in the current pose, gathered first if stale.
     #[inline]
-    pub(crate) fn leaf<'a>(
+    pub(crate) fn leaf<'a, S: Simd>(
         &'a self,
+        simd: S,
         tree: &'a RegionTree,
         p: &Points,
         leaf: usize,
@@ -251,9 +253,9 @@ impl TriCache {
         let len = tree.tri_range(leaf).len();
         let stride = tree.leaf_slots(r).len();
         let vertices = tree.leaf_vertex_tile(r);
-        let (group, _) = self
-            .tiles
-            .get_or_fill(r, |group| fill_leaf_tile(group, stride, len, vertices, p));
+        let (group, _) = self.tiles.get_or_fill(r, |group| {
+            fill_leaf_tile(simd, group, stride, len, vertices, p)
+        });
         let (tile, union) = group.split_at(TRI_FIELDS * stride);
         let union = (
             [union[0], union[1], union[2]],
@@ -262,6 +264,34 @@ impl TriCache {
         LeafTris {
             len,
             soa: TriSoa::new(Tile::new(tile, stride), vertices).with_bounds(union),
+        }
+    }
+}
+
+/// [`Hierarchy::refit_nodes`]'s fits of the stale `groups` on one dispatched backend.
+struct RefitGroups<'a, K: BvKind> {
+    h: &'a Hierarchy<K>,
+    groups: &'a [usize],
+    par: crate::par::Par,
+}
+
+impl<K: BvKind> pulp::WithSimd for RefitGroups<'_, K> {
+    type Output = u64;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> u64 {
+        let h = self.h;
+        let fit = |g: &usize| {
+            if h.group(simd, *g).1 {
+                h.tree.group_nodes(*g).len() as u64
+            } else {
+                0
+            }
+        };
+        if self.par.is_parallel() {
+            use rayon::prelude::*;
+            self.par.install(|| self.groups.par_iter().map(fit).sum())
+        } else {
+            self.groups.iter().map(fit).sum()
         }
     }
 }
@@ -275,7 +305,14 @@ impl TriCache {
 /// PERF: one gather loop per corner and axis, then the box rows from the corner rows. The
 /// per-triangle form (gather three points, write fifteen scattered entries) took ~190
 /// instructions a triangle and 10-13% of an n-body step.
-fn fill_leaf_tile(group: &mut [f32], stride: usize, n: usize, vertices: &[u32], p: &Points) {
+fn fill_leaf_tile<S: Simd>(
+    simd: S,
+    group: &mut [f32],
+    stride: usize,
+    n: usize,
+    vertices: &[u32],
+    p: &Points,
+) {
     let (tile, union) = group.split_at_mut(TRI_FIELDS * stride);
     let (corners, boxes) = tile.split_at_mut(9 * stride);
     let axes = [&p.x[..], &p.y[..], &p.z[..]];
@@ -310,8 +347,8 @@ fn fill_leaf_tile(group: &mut [f32], stride: usize, n: usize, vertices: &[u32], 
     }
     // The union of the boxes: the minima's least, the maxima's greatest (the SIMD bounds
     // reduction; a single `min` chain per axis waits on each one's latency).
-    union[..3].copy_from_slice(&refit::bounds(three_rows(lo, stride, n)).0);
-    union[3..].copy_from_slice(&refit::bounds(three_rows(hi, stride, n)).1);
+    union[..3].copy_from_slice(&refit::bounds_with(simd, three_rows(lo, stride, n)).0);
+    union[3..].copy_from_slice(&refit::bounds_with(simd, three_rows(hi, stride, n)).1);
 }
 
 /// The first `n` entries of three consecutive rows of `stride` slots, as x, y and z.
@@ -451,20 +488,11 @@ impl<K: BvKind> Hierarchy<K> {
             .collect();
         groups.sort_unstable();
         groups.dedup();
-        let (nodes, tree, points) = (&self.nodes, &*self.tree, &self.points);
-        let fit = |g: &usize| {
-            if K::group(nodes, tree, points, *g).1 {
-                tree.group_nodes(*g).len() as u64
-            } else {
-                0
-            }
-        };
-        Ok(if par.is_parallel() {
-            use rayon::prelude::*;
-            par.install(|| groups.par_iter().map(fit).sum())
-        } else {
-            groups.iter().map(fit).sum()
-        })
+        Ok(dhcd_kernels::arch().dispatch(RefitGroups {
+            h: self,
+            groups: &groups,
+            par,
+        }))
     }
 
     /// The nodes fitted to the current positions (after a lazy query: the sibling groups it
@@ -477,25 +505,26 @@ impl<K: BvKind> Hierarchy<K> {
 
     /// Refits every stale node exactly; returns the number of nodes fitted.
     pub fn refit_all(&mut self) -> u64 {
-        K::refit_all(&mut self.nodes, &self.tree, &self.points, false)
+        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, false)
     }
 
     /// Refits every stale node bottom-up: leaves exactly, internal nodes from their children.
     /// Returns the number of nodes fitted.
     pub fn refit_bottom_up(&mut self) -> u64 {
-        K::refit_all(&mut self.nodes, &self.tree, &self.points, true)
+        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, true)
     }
 
-    /// Sibling group `g`'s volumes, fitted first if stale; whether this call fitted them.
+    /// Sibling group `g`'s volumes, fitted first if stale (the refit kernels on `simd`);
+    /// whether this call fitted them.
     #[inline]
-    pub(crate) fn group(&self, g: usize) -> (K::Block<'_>, bool) {
-        K::group(&self.nodes, &self.tree, &self.points, g)
+    pub(crate) fn group<S: Simd>(&self, simd: S, g: usize) -> (K::Block<'_>, bool) {
+        K::group(simd, &self.nodes, &self.tree, &self.points, g)
     }
 
     /// Leaf `leaf`'s triangles in the current pose, gathered first if stale.
     #[inline]
-    pub(crate) fn leaf_tris(&self, leaf: usize) -> LeafTris<'_> {
-        self.tris.leaf(&self.tree, &self.points, leaf)
+    pub(crate) fn leaf_tris<S: Simd>(&self, simd: S, leaf: usize) -> LeafTris<'_> {
+        self.tris.leaf(simd, &self.tree, &self.points, leaf)
     }
 
     /// The closed boxes of leaf `leaf`'s own edges in the current pose (rounded outward for

@@ -6,7 +6,7 @@ use dhcd::narrow::{
     brute_force_pairs, brute_force_self_pairs, intersection_segment, triangles_intersect,
 };
 use dhcd::Mesh;
-use dhcd_kernels::narrow::{pair_verdict, Verdict};
+use dhcd_kernels::reference::{pair_verdict, Verdict};
 use proptest::prelude::*;
 
 type Tri = [[f32; 3]; 3];

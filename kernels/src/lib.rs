@@ -3,20 +3,21 @@
 //! [`narrow`]) and refit reductions ([`refit`]) over structure-of-arrays slices. No tree
 //! knowledge lives here: slices in, bit masks and values out.
 //!
-//! Every kernel has a scalar reference beside it (`*_scalar`) with the same operation order.
+//! Every kernel has a scalar reference (`*_scalar`) with the same operation order, in
+//! [`mod@reference`]: the oracles of the tests and the baselines of the benchmarks.
 //!
-//! Each public entry is a SIMD kernel with runtime dispatch (pulp): a generic body, a small
-//! `pulp::WithSimd` struct, and the entry that dispatches it on the cached [`arch`]. The
-//! bodies are public as `*_with(simd, ..)` and `#[inline(always)]`, so a caller that runs a
-//! whole traversal inside one `WithSimd` (dispatching once, never per node) inlines them
-//! under its target features; tests run them on `pulp::Scalar`, `Scalar128b`, `Scalar256b`,
-//! `Scalar512b` and the native backends against the references.
+//! The kernels are SIMD bodies generic over a pulp backend, public as `*_with(simd, ..)`
+//! and `#[inline(always)]`: a caller runs a whole traversal inside one `pulp::WithSimd`
+//! dispatched on the cached [`arch`] (dispatching once, never per node) and the kernels
+//! inline under its target features. The one dispatching entry is [`refit::bounds`], for
+//! callers outside such a body. Tests run the bodies on `pulp::Scalar`, `Scalar128b`,
+//! `Scalar256b`, `Scalar512b` and the native backends against the references.
 //!
 //! Exactness: the SIMD bodies use no fused multiply-add. pulp's `mul_add_e_f32s` is fused on
 //! the vector backends but unfused on `pulp::Scalar`, so fusing would make results depend on
 //! the backend. Overlap and filter kernels therefore give bit-identical masks on every
-//! backend; reductions ([`refit`]) are exact against `*_scalar_lanes(.., lanes)` for the
-//! backend's lane count ([`f32_lanes`]).
+//! backend; reductions ([`refit`]) are exact against `reference::*_scalar_lanes(.., lanes)`
+//! for the backend's lane count.
 //!
 //! NaN policy: overlap tests use ordered comparisons only, so a NaN anywhere in a pair makes
 //! the pair *not* overlap, on every backend. Reductions skip NaN values (see [`refit`]).
@@ -30,38 +31,23 @@
 pub mod lazy;
 pub mod narrow;
 pub mod overlap;
+pub mod reference;
 pub mod refit;
 
 pub use pulp;
 
-use pulp::Simd;
 use std::sync::OnceLock;
 
 /// The widest lane count of any pulp backend for `f32` (AVX-512: 16). Staging buffers for
 /// gathers have this size.
 pub(crate) const MAX_LANES: usize = 16;
 
-/// The cached runtime-detected backend every public kernel entry dispatches on.
+/// The cached runtime-detected backend: the one to dispatch a traversal (and so its
+/// `*_with` kernels) on.
 #[inline]
 pub fn arch() -> pulp::Arch {
     static ARCH: OnceLock<pulp::Arch> = OnceLock::new();
     *ARCH.get_or_init(pulp::Arch::new)
-}
-
-struct F32Lanes;
-
-impl pulp::WithSimd for F32Lanes {
-    type Output = usize;
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, _simd: S) -> usize {
-        S::F32_LANES
-    }
-}
-
-/// The `f32` lane count of the dispatched backend ([`arch`]): the `lanes` argument for which
-/// the `refit::*_scalar_lanes` references reproduce the dispatched reductions exactly.
-pub fn f32_lanes() -> usize {
-    arch().dispatch(F32Lanes)
 }
 
 /// Lane-width helpers shared by the kernels. pulp's vector types are `Pod` with the alignment

@@ -77,13 +77,14 @@
 //! verdicts would need the same slack); every candidate is left *undecided*, for the caller's
 //! exact test on the `f64` corners.
 //!
-//! Results are bit-identical to [`leaf_contacts_scalar`] (and [`leaf_candidates_rounded_scalar`])
-//! on every backend (same operation order, no fused multiply-add; the canonical form's vertex
-//! choices are selects).
+//! Results are bit-identical to [`crate::reference::leaf_contacts_scalar`] (and
+//! [`crate::reference::leaf_candidates_rounded_scalar`]) on every backend (same operation
+//! order, no fused multiply-add; the canonical form's vertex choices are selects).
 
 use crate::lanes::{load_prefix, load_prefix_u32, mask_bits};
+use crate::reference::Verdict;
 use crate::Tile;
-use pulp::{Simd, WithSimd};
+use pulp::Simd;
 
 /// Lane counts for which the filter culls rows per lane vector of the second block (see
 /// [`leaf_contacts_with`]).
@@ -104,10 +105,10 @@ const IOTA: [f32; 64] = {
 pub const MAX_ROW: usize = 64;
 
 /// The relative factor of the plane filter's certification bound: `8 eps`, `eps = 2^-24`.
-pub const PLANE_ERR: f32 = 8.0 * (f32::EPSILON / 2.0);
+pub(crate) const PLANE_ERR: f32 = 8.0 * (f32::EPSILON / 2.0);
 /// The absolute factor for gradual underflow: `2^-126`, the smallest normal `f32` (a
 /// subnormal factor would make every bound an FP assist; see the module doc).
-pub const PLANE_TINY: f32 = f32::MIN_POSITIVE;
+pub(crate) const PLANE_TINY: f32 = f32::MIN_POSITIVE;
 
 /// The factor of the rounded-corner slack `13 delta sigma_2(E)` (module doc, "Rounded
 /// corners").
@@ -124,14 +125,14 @@ fn coordinate_error(m: f32) -> f32 {
 /// coordinate error at the union box's largest magnitude `m`, in the operation order the
 /// SIMD body repeats.
 #[inline(always)]
-fn rounding_slack(ext: &[f32; 3], m: f32) -> f32 {
+pub(crate) fn rounding_slack(ext: &[f32; 3], m: f32) -> f32 {
     let s2 = (ext[0] * ext[1] + ext[1] * ext[2]) + ext[2] * ext[0];
     (SLACK_FACTOR * coordinate_error(m)) * s2
 }
 
 /// The largest magnitude of the union of two boxes.
 #[inline(always)]
-fn union_magnitude(a: &([f32; 3], [f32; 3]), b: &([f32; 3], [f32; 3])) -> f32 {
+pub(crate) fn union_magnitude(a: &([f32; 3], [f32; 3]), b: &([f32; 3], [f32; 3])) -> f32 {
     let mut m = 0.0f32;
     for k in 0..3 {
         m = m
@@ -330,7 +331,7 @@ fn side(a: &[f32; 3], n: &[f32; 3], m: &[f32; 3], d: &[f32; 3]) -> i32 {
 
 /// A triangle's closed box, as the callers' leaf tiles store it.
 #[inline(always)]
-fn corner_box(t: &[[f32; 3]; 3]) -> ([f32; 3], [f32; 3]) {
+pub(crate) fn corner_box(t: &[[f32; 3]; 3]) -> ([f32; 3], [f32; 3]) {
     let lo = std::array::from_fn(|k| t[0][k].min(t[1][k]).min(t[2][k]));
     let hi = std::array::from_fn(|k| t[0][k].max(t[1][k]).max(t[2][k]));
     (lo, hi)
@@ -338,7 +339,7 @@ fn corner_box(t: &[[f32; 3]; 3]) -> ([f32; 3], [f32; 3]) {
 
 /// The extents `E` of the union of two closed boxes (module doc).
 #[inline(always)]
-fn union_extents(a: &([f32; 3], [f32; 3]), b: &([f32; 3], [f32; 3])) -> [f32; 3] {
+pub(crate) fn union_extents(a: &([f32; 3], [f32; 3]), b: &([f32; 3], [f32; 3])) -> [f32; 3] {
     std::array::from_fn(|k| a.1[k].max(b.1[k]) - a.0[k].min(b.0[k]))
 }
 
@@ -373,7 +374,7 @@ fn det(a: &[f32; 3], n: &[f32; 3], d: &[f32; 3]) -> ([f32; 3], f32) {
 /// The filter's signs of a pair: `a`'s corners against `b`'s plane, `b`'s against `a`'s,
 /// `ext` the union extents of their boxes.
 #[inline(always)]
-fn filter_signs(
+pub(crate) fn filter_signs(
     a: &[[f32; 3]; 3],
     b: &[[f32; 3]; 3],
     ext: &[f32; 3],
@@ -389,7 +390,7 @@ fn filter_signs(
 
 /// All three signs certain and equal.
 #[inline(always)]
-fn one_side(s: [i32; 3]) -> bool {
+pub(crate) fn one_side(s: [i32; 3]) -> bool {
     s[0] != 0 && s[0] == s[1] && s[0] == s[2]
 }
 
@@ -443,13 +444,6 @@ fn projected_apart(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], n_a: &[f32; 3]) -> bool
     edge_separates(&a, &b) || edge_separates(&b, &a)
 }
 
-/// Whether a separating plane of `a` or `b` is certified (the plane filter on one pair,
-/// boxes from the corners).
-pub fn plane_separated(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
-    let (sa, sb) = filter_signs(a, b, &union_extents(&corner_box(a), &corner_box(b)), 0.0);
-    one_side(sa) || one_side(sb)
-}
-
 /// One row of verdicts: triangle `i` of the first block against the second block, bit `j`
 /// for triangle `j`. The two rows are disjoint; a pair in neither certainly does not
 /// intersect (or is not allowed by the pairing).
@@ -469,26 +463,9 @@ impl Row {
     }
 }
 
-/// The verdict on one pair (the scalar reference's unit).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Verdict {
-    /// Certainly disjoint.
-    Apart,
-    /// Certainly intersecting.
-    Contact,
-    /// Not certified either way.
-    Undecided,
-}
-
-/// The verdict of the plane filter and the certified canonical form on one pair (module
-/// doc), in the kernel's arithmetic, boxes from the corners.
-pub fn pair_verdict(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> Verdict {
-    verdict_within(a, b, &union_extents(&corner_box(a), &corner_box(b)))
-}
-
 /// [`pair_verdict`] with the union extents of the pair's boxes: the plane filter and the
 /// canonical form, then the projection for the pairs they leave undecided.
-fn verdict_within(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], ext: &[f32; 3]) -> Verdict {
+pub(crate) fn verdict_within(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3], ext: &[f32; 3]) -> Verdict {
     match planes_and_canonical(a, b, ext) {
         Verdict::Undecided if projected_apart(a, b, &plane(a).0) => Verdict::Apart,
         v => v,
@@ -548,7 +525,7 @@ fn oriented_side(t: &[[f32; 3]; 3], d: &[f32; 3]) -> i32 {
     side(&t[0], &n, &m, d)
 }
 
-fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[Row]) {
+pub(crate) fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[Row]) {
     assert!(
         nb <= MAX_ROW,
         "the second block holds at most {MAX_ROW} triangles"
@@ -561,130 +538,6 @@ fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[Row]) {
         out.len() >= na,
         "one output row per triangle of the first block"
     );
-}
-
-/// Scalar reference of [`leaf_contacts`] (one pair at a time).
-pub fn leaf_contacts_scalar(
-    a: TriSoa,
-    na: usize,
-    b: TriSoa,
-    nb: usize,
-    pairing: Pairing,
-    out: &mut [Row],
-) {
-    rows_scalar::<false>(a, na, b, nb, pairing, out)
-}
-
-/// Scalar reference of [`leaf_candidates_rounded_with`] (one pair at a time).
-pub fn leaf_candidates_rounded_scalar(
-    a: TriSoa,
-    na: usize,
-    b: TriSoa,
-    nb: usize,
-    pairing: Pairing,
-    out: &mut [Row],
-) {
-    rows_scalar::<true>(a, na, b, nb, pairing, out)
-}
-
-fn rows_scalar<const ROUNDED: bool>(
-    a: TriSoa,
-    na: usize,
-    b: TriSoa,
-    nb: usize,
-    pairing: Pairing,
-    out: &mut [Row],
-) {
-    check(&a, na, &b, nb, out);
-    for i in 0..na {
-        let ta = a.corners(i);
-        let va = [a.vertex(0)[i], a.vertex(1)[i], a.vertex(2)[i]];
-        let mut row = Row::default();
-        for j in 0..nb {
-            if pairing == Pairing::NoSharedVertexUpper && j <= i {
-                continue;
-            }
-            if pairing != Pairing::All && (0..3).any(|c| va.contains(&b.vertex(c)[j])) {
-                continue;
-            }
-            let boxes = (0..3).all(|k| a.lo(k)[i] <= b.hi(k)[j] && b.lo(k)[j] <= a.hi(k)[i]);
-            if !boxes {
-                continue;
-            }
-            let stored = |t: &TriSoa, i: usize| {
-                (
-                    [t.lo(0)[i], t.lo(1)[i], t.lo(2)[i]],
-                    [t.hi(0)[i], t.hi(1)[i], t.hi(2)[i]],
-                )
-            };
-            let (sa, sb) = (stored(&a, i), stored(&b, j));
-            let ext = union_extents(&sa, &sb);
-            if ROUNDED {
-                let slack = rounding_slack(&ext, union_magnitude(&sa, &sb));
-                let (s1, s2) = filter_signs(&ta, &b.corners(j), &ext, slack);
-                if !(one_side(s1) || one_side(s2)) {
-                    row.undecided |= 1 << j;
-                }
-                continue;
-            }
-            match verdict_within(&ta, &b.corners(j), &ext) {
-                Verdict::Apart => {}
-                Verdict::Contact => row.contact |= 1 << j,
-                Verdict::Undecided => row.undecided |= 1 << j,
-            }
-        }
-        out[i] = row;
-    }
-}
-
-/// The verdicts on the first `na` triangles of `a` against the first `nb <= MAX_ROW` of `b`:
-/// `out[i]` gets bit `j` in `contact` iff `(i, j)` is allowed by `pairing`, the closed boxes
-/// overlap and the pair certainly intersects, in `undecided` iff it is allowed, the boxes
-/// overlap and neither a separating plane nor the canonical form is certified (module doc).
-/// Panics if `nb > MAX_ROW`, a block is shorter than its count, or `out` is shorter than
-/// `na`. (It does not count the allowed pairs, `N_P`: that is a fact of the mesh's topology,
-/// which the caller tabulates once.)
-pub fn leaf_contacts(
-    a: TriSoa,
-    na: usize,
-    b: TriSoa,
-    nb: usize,
-    pairing: Pairing,
-    out: &mut [Row],
-) {
-    crate::arch().dispatch(LeafContacts {
-        a,
-        na,
-        b,
-        nb,
-        pairing,
-        out,
-    })
-}
-
-struct LeafContacts<'a> {
-    a: TriSoa<'a>,
-    na: usize,
-    b: TriSoa<'a>,
-    nb: usize,
-    pairing: Pairing,
-    out: &'a mut [Row],
-}
-
-impl WithSimd for LeafContacts<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) {
-        leaf_contacts_with(
-            simd,
-            self.a,
-            self.na,
-            self.b,
-            self.nb,
-            self.pairing,
-            self.out,
-        )
-    }
 }
 
 /// The low `n` bits set (`n <= 64`).
@@ -731,7 +584,15 @@ impl<S: Simd> Consts<S> {
     }
 }
 
-/// [`leaf_contacts`] on the backend `simd` (inlined into the caller's dispatched body).
+/// The verdicts on the first `na` triangles of `a` against the first `nb <= MAX_ROW` of `b`,
+/// on the backend `simd` (inlined into the caller's dispatched body): `out[i]` gets bit `j`
+/// in `contact` iff `(i, j)` is allowed by `pairing`, the closed boxes overlap and the pair
+/// certainly intersects, in `undecided` iff it is allowed, the boxes overlap and neither a
+/// separating plane nor the canonical form is certified (module doc). Panics if
+/// `nb > MAX_ROW`, a block is shorter than its count, or `out` is shorter than `na`. (It
+/// does not count the allowed pairs, `N_P`: that is a fact of the mesh's topology, which the
+/// caller tabulates once.)
+///
 ///
 /// Two passes: the filter (boxes, shared vertices, separating planes) leaves the candidates
 /// in `undecided`, then the canonical form decides the candidates it can certify.

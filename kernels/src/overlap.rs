@@ -11,12 +11,12 @@
 //! the lane count is read with a partial load, so nothing outside the slices is ever read.
 //!
 //! Exactness: comparisons and a fixed operation order without fused multiply-add, so masks
-//! are bit-identical to the `*_scalar` references on every backend. NaN policy: a NaN in the
-//! probe or an entry makes the pair not overlap, on every backend.
+//! are bit-identical to the `*_scalar` references ([`crate::reference`]) on every backend.
+//! NaN policy: a NaN in the probe or an entry makes the pair not overlap, on every backend.
 
 use crate::lanes::{load_prefix, mask_bits, mask_bits_f64};
 use crate::Tile;
-use pulp::{Simd, WithSimd};
+use pulp::Simd;
 
 /// Largest block: the bits of the mask.
 pub const MAX_BLOCK: usize = 32;
@@ -117,33 +117,9 @@ impl<'a> AabbSoa<'a> {
     }
 }
 
-/// Closed sphere test in the kernels' operation order:
-/// `(dx*dx + dy*dy) + dz*dz <= (ra + rb)*(ra + rb)`. Symmetric: swapping the spheres gives
-/// the same bits (negated differences square alike; addition commutes).
-#[inline(always)]
-pub fn spheres_overlap(a: [f32; 3], ra: f32, b: [f32; 3], rb: f32) -> bool {
-    let dx = a[0] - b[0];
-    let dy = a[1] - b[1];
-    let dz = a[2] - b[2];
-    let d2 = dx * dx + dy * dy + dz * dz;
-    let rs = ra + rb;
-    d2 <= rs * rs
-}
-
-/// Closed box test (comparisons only).
-#[inline(always)]
-pub fn aabbs_overlap(a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])) -> bool {
-    a.0[0] <= b.1[0]
-        && b.0[0] <= a.1[0]
-        && a.0[1] <= b.1[1]
-        && b.0[1] <= a.1[1]
-        && a.0[2] <= b.1[2]
-        && b.0[2] <= a.1[2]
-}
-
 /// The block's slice length, checking `n <= len <= MAX_BLOCK`.
 #[inline(always)]
-fn block_len(len: usize, n: usize) -> usize {
+pub(crate) fn block_len(len: usize, n: usize) -> usize {
     assert!(
         len <= MAX_BLOCK,
         "a block holds at most {MAX_BLOCK} entries"
@@ -155,40 +131,10 @@ fn block_len(len: usize, n: usize) -> usize {
 // ---------------------------------------------------------------------------------------
 // sphere_block
 
-/// Scalar reference of [`sphere_block`] (one pair at a time).
-pub fn sphere_block_scalar(c: [f32; 3], r: f32, b: SphereSoa, n: usize) -> u32 {
-    block_len(b.len(), n);
-    let mut bits = 0;
-    for k in 0..n {
-        let (bc, br) = b.get(k);
-        bits |= (spheres_overlap(c, r, bc, br) as u32) << k;
-    }
-    bits
-}
-
 /// Sphere `(c, r)` against the first `n` entries of the block `b` (four slices of equal
-/// length, at most [`MAX_BLOCK`], at least `n`): bit `k` set iff they overlap.
-pub fn sphere_block(c: [f32; 3], r: f32, b: SphereSoa, n: usize) -> u32 {
-    crate::arch().dispatch(SphereBlock { c, r, b, n })
-}
-
-struct SphereBlock<'a> {
-    c: [f32; 3],
-    r: f32,
-    b: SphereSoa<'a>,
-    n: usize,
-}
-
-impl WithSimd for SphereBlock<'_> {
-    type Output = u32;
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> u32 {
-        sphere_block_with(simd, self.c, self.r, self.b, self.n)
-    }
-}
-
-/// [`sphere_block`] on the backend `simd` (inlined into the caller's dispatched body: call
-/// it from inside a `pulp::WithSimd` so a whole traversal dispatches once).
+/// length, at most [`MAX_BLOCK`], at least `n`): bit `k` set iff they overlap. On the backend
+/// `simd`, inlined into the caller's dispatched body: call it from inside a `pulp::WithSimd`
+/// so a whole traversal dispatches once.
 #[inline(always)]
 pub fn sphere_block_with<S: Simd>(simd: S, c: [f32; 3], r: f32, b: SphereSoa, n: usize) -> u32 {
     let len = block_len(b.len(), n);
@@ -225,38 +171,9 @@ pub fn sphere_block_with<S: Simd>(simd: S, c: [f32; 3], r: f32, b: SphereSoa, n:
 // ---------------------------------------------------------------------------------------
 // aabb_block
 
-/// Scalar reference of [`aabb_block`] (one pair at a time, early exit per axis).
-pub fn aabb_block_scalar(lo: [f32; 3], hi: [f32; 3], b: AabbSoa, n: usize) -> u32 {
-    block_len(b.len(), n);
-    let mut bits = 0;
-    for k in 0..n {
-        bits |= (aabbs_overlap((lo, hi), b.get(k)) as u32) << k;
-    }
-    bits
-}
-
 /// Box `(lo, hi)` against the first `n` entries of the block `b` (six slices of equal
-/// length, at most [`MAX_BLOCK`], at least `n`): bit `k` set iff they overlap.
-pub fn aabb_block(lo: [f32; 3], hi: [f32; 3], b: AabbSoa, n: usize) -> u32 {
-    crate::arch().dispatch(AabbBlock { lo, hi, b, n })
-}
-
-struct AabbBlock<'a> {
-    lo: [f32; 3],
-    hi: [f32; 3],
-    b: AabbSoa<'a>,
-    n: usize,
-}
-
-impl WithSimd for AabbBlock<'_> {
-    type Output = u32;
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, simd: S) -> u32 {
-        aabb_block_with(simd, self.lo, self.hi, self.b, self.n)
-    }
-}
-
-/// [`aabb_block`] on the backend `simd` (see [`sphere_block_with`]).
+/// length, at most [`MAX_BLOCK`], at least `n`): bit `k` set iff they overlap. On the backend
+/// `simd` (see [`sphere_block_with`]).
 #[inline(always)]
 pub fn aabb_block_with<S: Simd>(simd: S, lo: [f32; 3], hi: [f32; 3], b: AabbSoa, n: usize) -> u32 {
     let len = block_len(b.len(), n);
@@ -336,21 +253,7 @@ pub type BoxRows<'a> = [&'a [f32]; 6];
 /// The longest block [`boxes_meet_with`] tests: the bits of a `u64`.
 pub const MAX_BOX_ROW: usize = 64;
 
-/// Scalar reference of [`boxes_meet_with`].
-pub fn boxes_meet_scalar(lo: [f32; 3], hi: [f32; 3], rows: BoxRows, n: usize) -> u64 {
-    box_rows_len(&rows, n);
-    let mut bits = 0;
-    for k in 0..n {
-        let b = (
-            [rows[0][k], rows[1][k], rows[2][k]],
-            [rows[3][k], rows[4][k], rows[5][k]],
-        );
-        bits |= u64::from(aabbs_overlap((lo, hi), b)) << k;
-    }
-    bits
-}
-
-fn box_rows_len(rows: &BoxRows, n: usize) -> usize {
+pub(crate) fn box_rows_len(rows: &BoxRows, n: usize) -> usize {
     assert!(n <= MAX_BOX_ROW, "at most {MAX_BOX_ROW} boxes a call");
     let len = rows[0].len();
     assert!(
@@ -362,7 +265,7 @@ fn box_rows_len(rows: &BoxRows, n: usize) -> usize {
 
 /// The box `(lo, hi)` against the first `n <= 64` boxes of `rows`: bit `k` set iff they
 /// meet (closed boxes; a NaN bound never meets). Comparisons only, so the mask is the
-/// same on every backend as [`boxes_meet_scalar`].
+/// same on every backend as [`crate::reference::boxes_meet_scalar`].
 #[inline(always)]
 pub fn boxes_meet_with<S: Simd>(
     simd: S,
@@ -482,65 +385,16 @@ impl<'a> MovingSphereSoa<'a> {
 
 /// The relative error bound of the quadratic's coefficients: `2^-44 M^2` (their rounding is
 /// below `2^-46 M^2`, `M` the largest magnitude of the centre differences and radius sums).
-const MOVING_K2: f64 = 1.0 / (1u64 << 44) as f64;
+pub(crate) const MOVING_K2: f64 = 1.0 / (1u64 << 44) as f64;
 /// The error bound of `A C - B^2`: `2^-36 M^4` (below `2^-39 M^4`).
-const MOVING_K4: f64 = 1.0 / (1u64 << 36) as f64;
+pub(crate) const MOVING_K4: f64 = 1.0 / (1u64 << 36) as f64;
 /// An absolute term for underflow: far above any underflowing rounding (`2^-1075` each,
 /// times magnitudes below `2^130`).
-const MOVING_TINY: f64 = f64::from_bits((1023 - 900) << 52);
-
-/// Whether two moving spheres meet at some `t` in `[0, 1]`, conservatively: always when they
-/// do, and when they come within rounding of doing so. With `D(t) = D0 + t E` the centres'
-/// difference and `R(t) = R0 + t F` the radii's sum, they meet iff `h(t) = |D|^2 - R^2 <= 0`
-/// somewhere: `h(0) = C <= 0`, `h(1) <= 0`, or the minimum of the quadratic
-/// `h = A t^2 + 2 B t + C` is interior (`A > 0`, `-A < B < 0`) and `A C - B^2 <= 0`
-/// (`C - |B| <= 0` is implied, and tested too: it stops near-still pairs that are apart).
-/// Evaluated in `f64` (centres and radii are `f32` values, exact in `f64`), every comparison
-/// widened by its rounding bound (`MOVING_K2`, `MOVING_K4`). A NaN makes the pair not meet.
-/// In the operation order of [`moving_sphere_block_with`].
-#[inline(always)]
-pub fn moving_spheres_meet(a: &MovingSphere, b: &MovingSphere) -> bool {
-    let d0 = [a.c0[0] - b.c0[0], a.c0[1] - b.c0[1], a.c0[2] - b.c0[2]];
-    let d1 = [a.c1[0] - b.c1[0], a.c1[1] - b.c1[1], a.c1[2] - b.c1[2]];
-    let e = [d1[0] - d0[0], d1[1] - d0[1], d1[2] - d0[2]];
-    let (r0, r1) = (a.r0 + b.r0, a.r1 + b.r1);
-    let f = r1 - r0;
-    let dot = |x: [f64; 3], y: [f64; 3]| (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2];
-    let c = dot(d0, d0) - r0 * r0;
-    let h1 = dot(d1, d1) - r1 * r1;
-    let aa = dot(e, e) - f * f;
-    let bb = dot(d0, e) - r0 * f;
-    let abs = |x: f64| if x < 0.0 { 0.0 - x } else { x };
-    let mut m = r0;
-    for x in [d0[0], d0[1], d0[2], d1[0], d1[1], d1[2], r1] {
-        let x = abs(x);
-        m = if x > m { x } else { m };
-    }
-    let m2 = m * m;
-    let s2 = MOVING_K2 * m2 + MOVING_TINY;
-    let s4 = MOVING_K4 * (m2 * m2) + MOVING_TINY;
-    let two_s2 = s2 + s2;
-    let interior = aa > 0.0 - s2
-        && bb < s2
-        && bb > (0.0 - aa) - two_s2
-        && c - abs(bb) <= two_s2
-        && aa * c - bb * bb <= s4;
-    c <= s2 || h1 <= s2 || interior
-}
-
-/// Scalar reference of [`moving_sphere_block_with`].
-pub fn moving_sphere_block_scalar(p: &MovingSphere, b: MovingSphereSoa, n: usize) -> u32 {
-    block_len(b.len(), n);
-    let mut bits = 0;
-    for k in 0..n {
-        bits |= u32::from(moving_spheres_meet(p, &b.get(k))) << k;
-    }
-    bits
-}
+pub(crate) const MOVING_TINY: f64 = f64::from_bits((1023 - 900) << 52);
 
 /// The moving sphere `p` against the first `n` entries of the block `b` (at most
-/// [`MAX_BLOCK`]): bit `k` set iff they meet during the step ([`moving_spheres_meet`], the
-/// same bits on every backend).
+/// [`MAX_BLOCK`]): bit `k` set iff they meet during the step
+/// ([`crate::reference::moving_spheres_meet`], the same bits on every backend).
 #[inline(always)]
 pub fn moving_sphere_block_with<S: Simd>(
     simd: S,

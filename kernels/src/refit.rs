@@ -4,95 +4,25 @@
 //!
 //! SIMD and exactness: the SIMD bodies keep one accumulator per lane; point `k` of the run
 //! (or of the index list) goes to lane `k % lanes`, and the lanes are folded in order at the
-//! end. The references `*_scalar_lanes(.., lanes)` do exactly that, so for the dispatched
-//! entries `x(..) == x_scalar_lanes(.., crate::f32_lanes())` bit for bit, and `x_with(simd, ..)`
-//! equals `x_scalar_lanes(.., S::F32_LANES)`. `*_scalar` is the sequential (1-lane) version.
-//! For max/min only ties between `+0` and `-0` can tell orders apart; for sums rounding can.
+//! end. The references in [`crate::reference`], `*_scalar_lanes(.., lanes)`, do exactly
+//! that, so `x_with(simd, ..)` equals `x_scalar_lanes(.., S::F32_LANES)` bit for bit, and the
+//! one dispatching entry, [`bounds`] (for callers outside a dispatched body), equals
+//! `bounds_scalar_lanes(.., reference::f32_lanes())`. `*_scalar` is the sequential (1-lane)
+//! version. For max/min only ties between `+0` and `-0` can tell orders apart; for sums
+//! rounding can.
 //!
 //! Max/min policy: a value replaces the accumulator only if it is strictly greater (max) or
 //! strictly smaller (min). So NaN values are skipped (a point with a NaN coordinate does not
 //! widen the box on that axis; a NaN squared distance is ignored), and among `+0`/`-0` ties the
-//! first in lane order stays. Squared distances are never `-0`, so [`max_dist_sq`] has no
+//! first in lane order stays. Squared distances are never `-0`, so [`max_dist_sq_with`] has no
 //! sign ambiguity. `±inf` coordinates are ordinary values (`inf - inf` is NaN and skipped).
 //! Sums follow IEEE addition: NaN propagates, `inf + -inf` is NaN (NaN payloads and signs
 //! are unspecified and may differ between backends). Sums start at `+0`; tail lanes are
 //! padded with `-0`, which leaves any sum unchanged bit for bit.
 
-use crate::lanes::{f32_array, fold_max, fold_max_simd, fold_min, fold_min_simd, fold_sum, load};
+use crate::lanes::{f32_array, fold_max_simd, fold_min_simd, fold_sum, load};
 use crate::{Soa3, MAX_LANES};
 use pulp::{Simd, WithSimd};
-
-/// The largest `lanes` the `*_scalar_lanes` references accept.
-pub const MAX_REFERENCE_LANES: usize = 64;
-
-fn check_ref_lanes(lanes: usize) {
-    assert!(
-        (1..=MAX_REFERENCE_LANES).contains(&lanes),
-        "lanes must be in 1..={MAX_REFERENCE_LANES}"
-    );
-}
-
-#[inline(always)]
-fn dist_sq(q: [f32; 3], c: [f32; 3]) -> f32 {
-    let dx = q[0] - c[0];
-    let dy = q[1] - c[1];
-    let dz = q[2] - c[2];
-    dx * dx + dy * dy + dz * dz
-}
-
-fn max_dist_sq_ref(points: impl Iterator<Item = [f32; 3]>, c: [f32; 3], lanes: usize) -> f32 {
-    check_ref_lanes(lanes);
-    let mut acc = [0.0f32; MAX_REFERENCE_LANES];
-    for (k, q) in points.enumerate() {
-        let d2 = dist_sq(q, c);
-        let l = k % lanes;
-        if d2 > acc[l] {
-            acc[l] = d2;
-        }
-    }
-    fold_max(&acc[..lanes])
-}
-
-fn sum_ref(points: impl Iterator<Item = [f32; 3]>, lanes: usize) -> [f32; 3] {
-    check_ref_lanes(lanes);
-    let mut acc = [[0.0f32; MAX_REFERENCE_LANES]; 3];
-    for (k, q) in points.enumerate() {
-        let l = k % lanes;
-        for a in 0..3 {
-            acc[a][l] += q[a];
-        }
-    }
-    core::array::from_fn(|a| fold_sum(&acc[a][..lanes]))
-}
-
-fn bounds_ref(points: impl Iterator<Item = [f32; 3]>, lanes: usize) -> ([f32; 3], [f32; 3]) {
-    check_ref_lanes(lanes);
-    let mut lo = [[f32::INFINITY; MAX_REFERENCE_LANES]; 3];
-    let mut hi = [[f32::NEG_INFINITY; MAX_REFERENCE_LANES]; 3];
-    for (k, q) in points.enumerate() {
-        let l = k % lanes;
-        for a in 0..3 {
-            if q[a] < lo[a][l] {
-                lo[a][l] = q[a];
-            }
-            if q[a] > hi[a][l] {
-                hi[a][l] = q[a];
-            }
-        }
-    }
-    (
-        core::array::from_fn(|a| fold_min(&lo[a][..lanes])),
-        core::array::from_fn(|a| fold_max(&hi[a][..lanes])),
-    )
-}
-
-fn run(p: Soa3<'_>) -> impl Iterator<Item = [f32; 3]> + '_ {
-    (0..p.len()).map(move |i| p.get(i))
-}
-
-fn indexed<'a>(p: Soa3<'a>, idx: &'a [u32]) -> impl Iterator<Item = [f32; 3]> + 'a {
-    idx.iter().map(move |&i| p.get(i as usize))
-}
 
 /// Gathers `p[idx[l]]` for the `idx.len() <= S::F32_LANES` indices into lane-width vectors;
 /// lanes past `idx.len()` hold `pad`.
@@ -214,47 +144,14 @@ impl WithSimd for MaxDistSq<'_> {
         max_dist_sq_simd(simd, self.p, self.idx, self.c)
     }
 }
-/// Scalar reference of [`max_dist_sq`] (sequential: [`max_dist_sq_scalar_lanes`] with 1 lane).
-pub fn max_dist_sq_scalar(p: Soa3, c: [f32; 3]) -> f32 {
-    max_dist_sq_scalar_lanes(p, c, 1)
-}
-
-/// Reference of [`max_dist_sq`] in the order of a `lanes`-wide SIMD body (see the module doc).
-pub fn max_dist_sq_scalar_lanes(p: Soa3, c: [f32; 3], lanes: usize) -> f32 {
-    max_dist_sq_ref(run(p), c, lanes)
-}
-
-/// Largest squared distance `(dx*dx + dy*dy) + dz*dz` from `c` to the points of `p`
-/// (0 for no points; NaN distances are skipped).
-pub fn max_dist_sq(p: Soa3, c: [f32; 3]) -> f32 {
-    crate::arch().dispatch(MaxDistSq { p, idx: None, c })
-}
-
-/// [`max_dist_sq`] on the backend `simd`.
+/// Largest squared distance `(dx*dx + dy*dy) + dz*dz` from `c` to the points of `p` (0 for
+/// no points; NaN distances are skipped), on the backend `simd`.
 pub fn max_dist_sq_with<S: Simd>(simd: S, p: Soa3, c: [f32; 3]) -> f32 {
     simd.vectorize(MaxDistSq { p, idx: None, c })
 }
 
-/// Scalar reference of [`max_dist_sq_indexed`] (sequential).
-pub fn max_dist_sq_indexed_scalar(p: Soa3, idx: &[u32], c: [f32; 3]) -> f32 {
-    max_dist_sq_indexed_scalar_lanes(p, idx, c, 1)
-}
-
-/// Reference of [`max_dist_sq_indexed`] in the order of a `lanes`-wide SIMD body.
-pub fn max_dist_sq_indexed_scalar_lanes(p: Soa3, idx: &[u32], c: [f32; 3], lanes: usize) -> f32 {
-    max_dist_sq_ref(indexed(p, idx), c, lanes)
-}
-
-/// Largest squared distance from `c` to the points `p[idx[k]]` (0 for no points).
-pub fn max_dist_sq_indexed(p: Soa3, idx: &[u32], c: [f32; 3]) -> f32 {
-    crate::arch().dispatch(MaxDistSq {
-        p,
-        idx: Some(idx),
-        c,
-    })
-}
-
-/// [`max_dist_sq_indexed`] on the backend `simd`.
+/// Largest squared distance from `c` to the points `p[idx[k]]` (0 for no points), on the
+/// backend `simd`.
 pub fn max_dist_sq_indexed_with<S: Simd>(simd: S, p: Soa3, idx: &[u32], c: [f32; 3]) -> f32 {
     simd.vectorize(MaxDistSq {
         p,
@@ -310,44 +207,14 @@ impl WithSimd for Sum<'_> {
     }
 }
 
-/// Scalar reference of [`sum`] (sequential).
-pub fn sum_scalar(p: Soa3) -> [f32; 3] {
-    sum_scalar_lanes(p, 1)
-}
-
-/// Reference of [`sum`] in the order of a `lanes`-wide SIMD body.
-pub fn sum_scalar_lanes(p: Soa3, lanes: usize) -> [f32; 3] {
-    sum_ref(run(p), lanes)
-}
-
-/// Component-wise sum of the points (for the sphere centre, the mean). The dispatched sum
-/// adds in [`crate::f32_lanes`] interleaved partial sums, so it may differ from the
-/// sequential [`sum_scalar`] by rounding.
-pub fn sum(p: Soa3) -> [f32; 3] {
-    crate::arch().dispatch(Sum { p, idx: None })
-}
-
-/// [`sum`] on the backend `simd`.
+/// Component-wise sum of the points (for the sphere centre, the mean), on the backend
+/// `simd`: `S::F32_LANES` interleaved partial sums, so it may differ from the sequential
+/// [`crate::reference::sum_scalar`] by rounding.
 pub fn sum_with<S: Simd>(simd: S, p: Soa3) -> [f32; 3] {
     simd.vectorize(Sum { p, idx: None })
 }
 
-/// Scalar reference of [`sum_indexed`] (sequential).
-pub fn sum_indexed_scalar(p: Soa3, idx: &[u32]) -> [f32; 3] {
-    sum_indexed_scalar_lanes(p, idx, 1)
-}
-
-/// Reference of [`sum_indexed`] in the order of a `lanes`-wide SIMD body.
-pub fn sum_indexed_scalar_lanes(p: Soa3, idx: &[u32], lanes: usize) -> [f32; 3] {
-    sum_ref(indexed(p, idx), lanes)
-}
-
-/// Component-wise sum of the points `p[idx[k]]`.
-pub fn sum_indexed(p: Soa3, idx: &[u32]) -> [f32; 3] {
-    crate::arch().dispatch(Sum { p, idx: Some(idx) })
-}
-
-/// [`sum_indexed`] on the backend `simd`.
+/// Component-wise sum of the points `p[idx[k]]`, on the backend `simd`.
 pub fn sum_indexed_with<S: Simd>(simd: S, p: Soa3, idx: &[u32]) -> [f32; 3] {
     simd.vectorize(Sum { p, idx: Some(idx) })
 }
@@ -421,43 +288,18 @@ impl WithSimd for Bounds<'_> {
     }
 }
 
-/// Scalar reference of [`bounds`] (sequential).
-pub fn bounds_scalar(p: Soa3) -> ([f32; 3], [f32; 3]) {
-    bounds_scalar_lanes(p, 1)
-}
-
-/// Reference of [`bounds`] in the order of a `lanes`-wide SIMD body.
-pub fn bounds_scalar_lanes(p: Soa3, lanes: usize) -> ([f32; 3], [f32; 3]) {
-    bounds_ref(run(p), lanes)
-}
-
 /// Axis-aligned bounds `(min, max)` of the points ([`EMPTY_BOUNDS`] for no points; NaN
 /// coordinates are skipped, so an axis with only NaN stays empty).
 pub fn bounds(p: Soa3) -> ([f32; 3], [f32; 3]) {
     crate::arch().dispatch(Bounds { p, idx: None })
 }
 
-/// [`bounds`] on the backend `simd`.
+/// [`bounds`] on the backend `simd`: the form to call inside a dispatched body.
 pub fn bounds_with<S: Simd>(simd: S, p: Soa3) -> ([f32; 3], [f32; 3]) {
     simd.vectorize(Bounds { p, idx: None })
 }
 
-/// Scalar reference of [`bounds_indexed`] (sequential).
-pub fn bounds_indexed_scalar(p: Soa3, idx: &[u32]) -> ([f32; 3], [f32; 3]) {
-    bounds_indexed_scalar_lanes(p, idx, 1)
-}
-
-/// Reference of [`bounds_indexed`] in the order of a `lanes`-wide SIMD body.
-pub fn bounds_indexed_scalar_lanes(p: Soa3, idx: &[u32], lanes: usize) -> ([f32; 3], [f32; 3]) {
-    bounds_ref(indexed(p, idx), lanes)
-}
-
-/// Axis-aligned bounds of the points `p[idx[k]]`.
-pub fn bounds_indexed(p: Soa3, idx: &[u32]) -> ([f32; 3], [f32; 3]) {
-    crate::arch().dispatch(Bounds { p, idx: Some(idx) })
-}
-
-/// [`bounds_indexed`] on the backend `simd`.
+/// Axis-aligned bounds of the points `p[idx[k]]`, on the backend `simd`.
 pub fn bounds_indexed_with<S: Simd>(simd: S, p: Soa3, idx: &[u32]) -> ([f32; 3], [f32; 3]) {
     simd.vectorize(Bounds { p, idx: Some(idx) })
 }

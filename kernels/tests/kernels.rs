@@ -1,13 +1,14 @@
 //! Every kernel against its scalar reference, bit for bit, on `pulp::Scalar`, `Scalar128b`,
 //! `Scalar256b`, `Scalar512b`, the native x86 backends present on this machine, and the
-//! dispatched backend (both through `*_with` and through the public entry).
+//! dispatched backend (through `*_with`, and through `refit::bounds`, the one dispatching
+//! entry).
 
 #![allow(clippy::needless_range_loop)]
 
 use dhcd_kernels::narrow;
 use dhcd_kernels::overlap::{self, AabbSoa, SphereSoa};
 use dhcd_kernels::pulp::{self, Simd, WithSimd};
-use dhcd_kernels::refit;
+use dhcd_kernels::{reference, refit};
 use dhcd_kernels::{Soa3, Tile};
 
 /// xorshift64*: small, deterministic, good enough for test data.
@@ -211,7 +212,7 @@ fn check_blocks<S: Simd>(simd: S) {
                 let s = spheres(&mut rng, len, every);
                 let probe = spheres(&mut rng, 1, every);
                 let (c, r) = tile(&probe).sphere().get(0);
-                let want = overlap::sphere_block_scalar(c, r, tile(&s).sphere(), n);
+                let want = reference::sphere_block_scalar(c, r, tile(&s).sphere(), n);
                 let got = overlap::sphere_block_with(simd, c, r, tile(&s).sphere(), n);
                 assert_eq!(got, want, "{simd:?} sphere n={n} len={len} every={every}");
                 assert_eq!(u64::from(got) >> n, 0, "bits past n");
@@ -219,7 +220,7 @@ fn check_blocks<S: Simd>(simd: S) {
                 let b = boxes(&mut rng, len, every);
                 let p = boxes(&mut rng, 1, every);
                 let (lo, hi) = tile(&p).aabb().get(0);
-                let want = overlap::aabb_block_scalar(lo, hi, tile(&b).aabb(), n);
+                let want = reference::aabb_block_scalar(lo, hi, tile(&b).aabb(), n);
                 let got = overlap::aabb_block_with(simd, lo, hi, tile(&b).aabb(), n);
                 assert_eq!(got, want, "{simd:?} aabb n={n} len={len} every={every}");
                 assert_eq!(u64::from(got) >> n, 0, "bits past n");
@@ -244,7 +245,7 @@ fn check_box_rows<S: Simd>(simd: S) {
                 let p = boxes(&mut rng, 1, every);
                 let rows = [&b[0][..], &b[1], &b[2], &b[3], &b[4], &b[5]];
                 let (lo, hi) = ([p[0][0], p[1][0], p[2][0]], [p[3][0], p[4][0], p[5][0]]);
-                let want = overlap::boxes_meet_scalar(lo, hi, rows, n);
+                let want = reference::boxes_meet_scalar(lo, hi, rows, n);
                 let got = overlap::boxes_meet_with(simd, lo, hi, rows, n);
                 assert_eq!(got, want, "{simd:?} n={n} len={len} every={every}");
                 if n < 64 {
@@ -255,7 +256,7 @@ fn check_box_rows<S: Simd>(simd: S) {
                     let k = rng.below(n);
                     let (lo, hi) = ([b[0][k], b[1][k], b[2][k]], [b[0][k], b[1][k], b[2][k]]);
                     let bits = overlap::boxes_meet_with(simd, lo, hi, rows, n);
-                    assert_eq!(bits, overlap::boxes_meet_scalar(lo, hi, rows, n));
+                    assert_eq!(bits, reference::boxes_meet_scalar(lo, hi, rows, n));
                     let finite = (0..6).all(|f| b[f][k].is_finite());
                     assert!(!finite || bits >> k & 1 == 1, "a touching box meets");
                 }
@@ -269,6 +270,30 @@ fn box_rows_match_reference_on_all_backends() {
     on_all_backends!(check_box_rows);
 }
 
+/// [`overlap::sphere_block_with`] on the dispatched backend.
+fn sphere_block_dispatched(c: [f32; 3], r: f32, b: SphereSoa, n: usize) -> u32 {
+    struct Op<'a>([f32; 3], f32, SphereSoa<'a>, usize);
+    impl WithSimd for Op<'_> {
+        type Output = u32;
+        fn with_simd<S: Simd>(self, simd: S) -> u32 {
+            overlap::sphere_block_with(simd, self.0, self.1, self.2, self.3)
+        }
+    }
+    dhcd_kernels::arch().dispatch(Op(c, r, b, n))
+}
+
+/// [`overlap::aabb_block_with`] on the dispatched backend.
+fn aabb_block_dispatched(lo: [f32; 3], hi: [f32; 3], b: AabbSoa, n: usize) -> u32 {
+    struct Op<'a>([f32; 3], [f32; 3], AabbSoa<'a>, usize);
+    impl WithSimd for Op<'_> {
+        type Output = u32;
+        fn with_simd<S: Simd>(self, simd: S) -> u32 {
+            overlap::aabb_block_with(simd, self.0, self.1, self.2, self.3)
+        }
+    }
+    dhcd_kernels::arch().dispatch(Op(lo, hi, b, n))
+}
+
 #[test]
 fn dispatched_blocks_match_reference() {
     let mut rng = Rng::new(2);
@@ -279,14 +304,14 @@ fn dispatched_blocks_match_reference() {
             let probe = spheres(&mut rng, 1, 0);
             let (c, r) = tile(&probe).sphere().get(0);
             assert_eq!(
-                overlap::sphere_block(c, r, tile(&s).sphere(), n),
-                overlap::sphere_block_scalar(c, r, tile(&s).sphere(), n)
+                sphere_block_dispatched(c, r, tile(&s).sphere(), n),
+                reference::sphere_block_scalar(c, r, tile(&s).sphere(), n)
             );
             let p = boxes(&mut rng, 1, 0);
             let (lo, hi) = tile(&p).aabb().get(0);
             assert_eq!(
-                overlap::aabb_block(lo, hi, tile(&b).aabb(), n),
-                overlap::aabb_block_scalar(lo, hi, tile(&b).aabb(), n)
+                aabb_block_dispatched(lo, hi, tile(&b).aabb(), n),
+                reference::aabb_block_scalar(lo, hi, tile(&b).aabb(), n)
             );
         }
     }
@@ -428,7 +453,7 @@ fn block_special_values_on_all_backends() {
 #[should_panic(expected = "at most 32")]
 fn oversized_block_is_refused() {
     let v = vec![0.0; 4 * 33];
-    overlap::sphere_block([0.0; 3], 1.0, SphereSoa::new(Tile::new(&v, 33)), 33);
+    sphere_block_dispatched([0.0; 3], 1.0, SphereSoa::new(Tile::new(&v, 33)), 33);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -561,7 +586,7 @@ fn check_leaf_contacts<S: Simd>(simd: S) {
                     };
                     let mut want = vec![row(7); na + 1];
                     let mut got = vec![row(9); na + 1];
-                    narrow::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
+                    reference::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
                     narrow::leaf_contacts_with(simd, a.soa(), na, b.soa(), nb, pairing, &mut got);
                     assert_eq!(
                         &got[..na],
@@ -588,7 +613,7 @@ fn check_leaf_contacts<S: Simd>(simd: S) {
                     // slack only keeps more pairs).
                     let mut want_r = vec![row(7); na + 1];
                     let mut got_r = vec![row(9); na + 1];
-                    narrow::leaf_candidates_rounded_scalar(
+                    reference::leaf_candidates_rounded_scalar(
                         a.soa(),
                         na,
                         b.soa(),
@@ -674,7 +699,7 @@ fn check_coplanar_blocks<S: Simd>(simd: S) {
             ] {
                 let mut want = vec![narrow::Row::default(); na];
                 let mut got = vec![narrow::Row::default(); na];
-                narrow::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
+                reference::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
                 narrow::leaf_contacts_with(simd, a.soa(), na, b.soa(), nb, pairing, &mut got);
                 assert_eq!(got, want, "{simd:?} na={na} nb={nb} {pairing:?}");
                 assert!(
@@ -691,6 +716,47 @@ fn coplanar_blocks_match_reference_on_all_backends() {
     on_all_backends!(check_coplanar_blocks);
 }
 
+/// [`narrow::leaf_contacts_with`] on the dispatched backend.
+fn leaf_contacts(
+    a: narrow::TriSoa,
+    na: usize,
+    b: narrow::TriSoa,
+    nb: usize,
+    pairing: narrow::Pairing,
+    out: &mut [narrow::Row],
+) {
+    struct Op<'a> {
+        a: narrow::TriSoa<'a>,
+        na: usize,
+        b: narrow::TriSoa<'a>,
+        nb: usize,
+        pairing: narrow::Pairing,
+        out: &'a mut [narrow::Row],
+    }
+    impl WithSimd for Op<'_> {
+        type Output = ();
+        fn with_simd<S: Simd>(self, simd: S) {
+            narrow::leaf_contacts_with(
+                simd,
+                self.a,
+                self.na,
+                self.b,
+                self.nb,
+                self.pairing,
+                self.out,
+            )
+        }
+    }
+    dhcd_kernels::arch().dispatch(Op {
+        a,
+        na,
+        b,
+        nb,
+        pairing,
+        out,
+    })
+}
+
 #[test]
 fn dispatched_leaf_contacts_match_reference() {
     let mut rng = Rng::new(9);
@@ -701,8 +767,8 @@ fn dispatched_leaf_contacts_match_reference() {
         for pairing in PAIRINGS {
             let mut want = vec![narrow::Row::default(); na];
             let mut got = want.clone();
-            narrow::leaf_contacts(a.soa(), na, b.soa(), nb, pairing, &mut got);
-            narrow::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
+            leaf_contacts(a.soa(), na, b.soa(), nb, pairing, &mut got);
+            reference::leaf_contacts_scalar(a.soa(), na, b.soa(), nb, pairing, &mut want);
             assert_eq!(got, want);
         }
     }
@@ -718,7 +784,7 @@ fn leaf_contacts_keep_exactly_the_allowed_pairs() {
     shared.set_vertex(1, 3, 0); // triangle 3 of b shares vertex 0 with triangle 0 of a
     let rows = |b: &Tris, pairing| {
         let mut out = [narrow::Row::default(); 10];
-        narrow::leaf_contacts(a.soa(), 10, b.soa(), 10, pairing, &mut out);
+        leaf_contacts(a.soa(), 10, b.soa(), 10, pairing, &mut out);
         // Coplanar copies certify no sign: every candidate is left to the exact test.
         assert!(out.iter().all(|r| r.contact == 0));
         out.map(|r| r.candidates())
@@ -747,7 +813,7 @@ fn leaf_contacts_filter_a_strip() {
     let a = Tris::new(&tris, 0);
     let mut out = [narrow::Row::default(); 10];
     // Coplanar neighbours in one plane, boxes overlapping: left to the exact test.
-    narrow::leaf_contacts(
+    leaf_contacts(
         a.soa(),
         10,
         a.soa(),
@@ -792,7 +858,7 @@ fn check_union_boxes<S: Simd>(simd: S) {
                     let mut want = got.clone();
                     let pairing = narrow::Pairing::All;
                     narrow::leaf_contacts_with(simd, x.soa(), nx, y.soa(), ny, pairing, &mut got);
-                    narrow::leaf_contacts_scalar(x.soa(), nx, y.soa(), ny, pairing, &mut want);
+                    reference::leaf_contacts_scalar(x.soa(), nx, y.soa(), ny, pairing, &mut want);
                     assert_eq!(got, want, "{simd:?} n={n} odd={odd} field {f}");
                     let hits: u32 = got.iter().map(|r| r.candidates().count_ones()).sum();
                     let lost = u32::from(v.is_nan());
@@ -900,7 +966,7 @@ fn check_vector_culling<S: Simd>(simd: S) {
             for pairing in PAIRINGS {
                 let mut want = vec![narrow::Row::default(); n];
                 let mut got = want.clone();
-                narrow::leaf_contacts_scalar(x.soa(), n, y.soa(), n, pairing, &mut want);
+                reference::leaf_contacts_scalar(x.soa(), n, y.soa(), n, pairing, &mut want);
                 narrow::leaf_contacts_with(simd, x.soa(), n, y.soa(), n, pairing, &mut got);
                 assert_eq!(got, want, "{simd:?} n={n} {pairing:?}");
                 let found: u32 = got.iter().map(|r| r.candidates().count_ones()).sum();
@@ -927,7 +993,7 @@ fn given_bounds_that_miss_a_triangle_panic_in_debug_builds() {
     let (a, b) = (Tris::new(&[base], 0), Tris::new(&[post], 10));
     let short = ([0.0; 3], [1.0; 3]);
     let mut out = [narrow::Row::default(); 1];
-    narrow::leaf_contacts(
+    leaf_contacts(
         a.soa(),
         1,
         b.soa().with_bounds(short),
@@ -941,9 +1007,9 @@ fn given_bounds_that_miss_a_triangle_panic_in_debug_builds() {
 /// on every backend, in every rotation of both triangles (the lone vertices move) and both
 /// orders.
 fn check_canonical_form<S: Simd>(simd: S) {
-    use narrow::Verdict::{Apart, Contact};
+    use reference::Verdict::{Apart, Contact};
     let base = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
-    let cases: [([[f32; 3]; 3], narrow::Verdict); 4] = [
+    let cases: [([[f32; 3]; 3], reference::Verdict); 4] = [
         // Pierces base's interior: intersect.
         (
             [[1.0, 1.0, -1.0], [1.0, 1.0, 1.0], [1.5, 1.2, 1.0]],
@@ -979,10 +1045,14 @@ fn check_canonical_form<S: Simd>(simd: S) {
                 };
                 for (x, y) in [(a, b), (b, a)] {
                     assert!(
-                        !narrow::plane_separated(&x, &y),
+                        !reference::plane_separated(&x, &y),
                         "case {ci}: no plane separates"
                     );
-                    assert_eq!(narrow::pair_verdict(&x, &y), want, "case {ci} r={r} s={s}");
+                    assert_eq!(
+                        reference::pair_verdict(&x, &y),
+                        want,
+                        "case {ci} r={r} s={s}"
+                    );
                     let (tx, ty) = (Tris::new(&[x], 0), Tris::new(&[y], 10));
                     let mut out = [narrow::Row::default(); 1];
                     narrow::leaf_contacts_with(
@@ -1046,7 +1116,7 @@ fn plane_filter_drops_only_certainly_separated_pairs() {
                 // No exact oracle for non-finite input (the library rejects it).
                 continue;
             }
-            let separated = narrow::plane_separated(&probe, &t);
+            let separated = reference::plane_separated(&probe, &t);
             // Local scales whose degree-3 products stay normal f32 (at 1e-20 they underflow,
             // at 1e20 they overflow: the filter then certifies nothing, which is sound).
             if i % 6 == 0 && (scale == 1.0 || scale == 7e-4) {
@@ -1100,13 +1170,13 @@ fn check_refit<S: Simd>(simd: S) {
             let idx: Vec<u32> = (0..n + 5).map(|_| rng.below(n.max(1)) as u32).collect();
             let idx: &[u32] = if n == 0 { &[] } else { &idx };
             for c in [[0.1f32, -0.2, 0.3], [0.0, -0.0, 0.0]] {
-                let want = refit::max_dist_sq_scalar_lanes(p, c, lanes);
+                let want = reference::max_dist_sq_scalar_lanes(p, c, lanes);
                 assert_eq!(
                     refit::max_dist_sq_with(simd, p, c).to_bits(),
                     want.to_bits(),
                     "{simd:?} n={n}"
                 );
-                let want = refit::max_dist_sq_indexed_scalar_lanes(p, idx, c, lanes);
+                let want = reference::max_dist_sq_indexed_scalar_lanes(p, idx, c, lanes);
                 assert_eq!(
                     refit::max_dist_sq_indexed_with(simd, p, idx, c).to_bits(),
                     want.to_bits()
@@ -1114,37 +1184,40 @@ fn check_refit<S: Simd>(simd: S) {
             }
             assert_eq!(
                 bits3(refit::sum_with(simd, p)),
-                bits3(refit::sum_scalar_lanes(p, lanes)),
+                bits3(reference::sum_scalar_lanes(p, lanes)),
                 "{simd:?} n={n} every={every}"
             );
             assert_eq!(
                 bits3(refit::sum_indexed_with(simd, p, idx)),
-                bits3(refit::sum_indexed_scalar_lanes(p, idx, lanes))
+                bits3(reference::sum_indexed_scalar_lanes(p, idx, lanes))
             );
             assert_eq!(
                 bits_box(refit::bounds_with(simd, p)),
-                bits_box(refit::bounds_scalar_lanes(p, lanes)),
+                bits_box(reference::bounds_scalar_lanes(p, lanes)),
                 "{simd:?} n={n}"
             );
             assert_eq!(
                 bits_box(refit::bounds_indexed_with(simd, p, idx)),
-                bits_box(refit::bounds_indexed_scalar_lanes(p, idx, lanes))
+                bits_box(reference::bounds_indexed_scalar_lanes(p, idx, lanes))
             );
             if lanes == 1 {
                 // The sequential references are the 1-lane case.
-                assert_eq!(bits3(refit::sum_with(simd, p)), bits3(refit::sum_scalar(p)));
+                assert_eq!(
+                    bits3(refit::sum_with(simd, p)),
+                    bits3(reference::sum_scalar(p))
+                );
                 assert_eq!(
                     bits_box(refit::bounds_with(simd, p)),
-                    bits_box(refit::bounds_scalar(p))
+                    bits_box(reference::bounds_scalar(p))
                 );
             }
             // Max/min do not depend on the order except for +-0 ties; compare values.
             let (lo, hi) = refit::bounds_with(simd, p);
-            let (slo, shi) = refit::bounds_scalar(p);
+            let (slo, shi) = reference::bounds_scalar(p);
             assert_eq!((lo, hi), (slo, shi));
             assert_eq!(
                 refit::max_dist_sq_with(simd, p, [0.5; 3]),
-                refit::max_dist_sq_scalar(p, [0.5; 3])
+                reference::max_dist_sq_scalar(p, [0.5; 3])
             );
         }
     }
@@ -1155,9 +1228,41 @@ fn refit_matches_lane_reference_on_all_backends() {
     on_all_backends!(check_refit);
 }
 
+/// The refit reductions on the dispatched backend: max distance, indexed max distance, sum,
+/// indexed sum, bounds, indexed bounds.
+struct Refits<'a> {
+    p: Soa3<'a>,
+    idx: &'a [u32],
+    c: [f32; 3],
+}
+
+type RefitValues = (
+    f32,
+    f32,
+    [f32; 3],
+    [f32; 3],
+    ([f32; 3], [f32; 3]),
+    ([f32; 3], [f32; 3]),
+);
+
+impl WithSimd for Refits<'_> {
+    type Output = RefitValues;
+    fn with_simd<S: Simd>(self, simd: S) -> RefitValues {
+        let (p, idx, c) = (self.p, self.idx, self.c);
+        (
+            refit::max_dist_sq_with(simd, p, c),
+            refit::max_dist_sq_indexed_with(simd, p, idx, c),
+            refit::sum_with(simd, p),
+            refit::sum_indexed_with(simd, p, idx),
+            refit::bounds_with(simd, p),
+            refit::bounds_indexed_with(simd, p, idx),
+        )
+    }
+}
+
 #[test]
-fn dispatched_refit_entries_match_lane_reference() {
-    let lanes = dhcd_kernels::f32_lanes();
+fn dispatched_refits_match_lane_reference() {
+    let lanes = reference::f32_lanes();
     let mut rng = Rng::new(7);
     for n in sizes(lanes) {
         let pts = Points::random(&mut rng, n, 9);
@@ -1165,29 +1270,27 @@ fn dispatched_refit_entries_match_lane_reference() {
         let idx: Vec<u32> = (0..2 * n).map(|_| rng.below(n.max(1)) as u32).collect();
         let idx: &[u32] = if n == 0 { &[] } else { &idx };
         let c = [0.25, 0.5, -0.125];
+        let (d, d_idx, s, s_idx, b, b_idx) = dhcd_kernels::arch().dispatch(Refits { p, idx, c });
         assert_eq!(
-            refit::max_dist_sq(p, c).to_bits(),
-            refit::max_dist_sq_scalar_lanes(p, c, lanes).to_bits()
+            d.to_bits(),
+            reference::max_dist_sq_scalar_lanes(p, c, lanes).to_bits()
         );
         assert_eq!(
-            refit::max_dist_sq_indexed(p, idx, c).to_bits(),
-            refit::max_dist_sq_indexed_scalar_lanes(p, idx, c, lanes).to_bits()
+            d_idx.to_bits(),
+            reference::max_dist_sq_indexed_scalar_lanes(p, idx, c, lanes).to_bits()
         );
+        assert_eq!(bits3(s), bits3(reference::sum_scalar_lanes(p, lanes)));
         assert_eq!(
-            bits3(refit::sum(p)),
-            bits3(refit::sum_scalar_lanes(p, lanes))
+            bits3(s_idx),
+            bits3(reference::sum_indexed_scalar_lanes(p, idx, lanes))
         );
+        let want = bits_box(reference::bounds_scalar_lanes(p, lanes));
+        assert_eq!(bits_box(b), want);
+        // The one dispatching entry.
+        assert_eq!(bits_box(refit::bounds(p)), want);
         assert_eq!(
-            bits3(refit::sum_indexed(p, idx)),
-            bits3(refit::sum_indexed_scalar_lanes(p, idx, lanes))
-        );
-        assert_eq!(
-            bits_box(refit::bounds(p)),
-            bits_box(refit::bounds_scalar_lanes(p, lanes))
-        );
-        assert_eq!(
-            bits_box(refit::bounds_indexed(p, idx)),
-            bits_box(refit::bounds_indexed_scalar_lanes(p, idx, lanes))
+            bits_box(b_idx),
+            bits_box(reference::bounds_indexed_scalar_lanes(p, idx, lanes))
         );
     }
 }
@@ -1305,13 +1408,16 @@ fn lane_references_agree_with_sequential_on_exact_data() {
     // Small integers sum exactly in any order, so every lane count gives the same sum.
     let x: Vec<f32> = (0..1000).map(|i| (i % 17) as f32).collect();
     let p = Soa3::new(&x, &x, &x);
-    let want = refit::sum_scalar(p);
+    let want = reference::sum_scalar(p);
     assert_eq!(want[0], (0..1000).map(|i| (i % 17) as f32).sum::<f32>());
     for lanes in [1, 2, 4, 8, 16, 64] {
-        assert_eq!(refit::sum_scalar_lanes(p, lanes), want);
-        assert_eq!(refit::bounds_scalar_lanes(p, lanes), ([0.0; 3], [16.0; 3]));
+        assert_eq!(reference::sum_scalar_lanes(p, lanes), want);
         assert_eq!(
-            refit::max_dist_sq_scalar_lanes(p, [0.0; 3], lanes),
+            reference::bounds_scalar_lanes(p, lanes),
+            ([0.0; 3], [16.0; 3])
+        );
+        assert_eq!(
+            reference::max_dist_sq_scalar_lanes(p, [0.0; 3], lanes),
             3.0 * 256.0
         );
     }
@@ -1351,7 +1457,7 @@ fn check_moving_blocks<S: Simd>(simd: S) {
                 let data = moving_soa(&entries, len);
                 let block = overlap::MovingSphereSoa::new(&data, len);
                 let p = moving(&mut rng, scale);
-                let want = overlap::moving_sphere_block_scalar(&p, block, n);
+                let want = reference::moving_sphere_block_scalar(&p, block, n);
                 let got = overlap::moving_sphere_block_with(simd, &p, block, n);
                 assert_eq!(got, want, "{simd:?} n={n} len={len} scale={scale}");
                 assert_eq!(u64::from(got) >> n, 0, "bits past n");
@@ -1385,7 +1491,7 @@ fn moving_spheres_meet_whenever_they_do() {
         let sampled = (0..=64).any(|i| meet_at(&a, &b, i as f64 / 64.0));
         if sampled {
             met += 1;
-            assert!(overlap::moving_spheres_meet(&a, &b), "{a:?} {b:?}");
+            assert!(reference::moving_spheres_meet(&a, &b), "{a:?} {b:?}");
         }
     }
     assert!(met > 1000);
@@ -1396,11 +1502,11 @@ fn moving_spheres_meet_whenever_they_do() {
         r1: r,
     };
     // Still and apart: culled (the near-still guard); still and touching: kept.
-    assert!(!overlap::moving_spheres_meet(
+    assert!(!reference::moving_spheres_meet(
         &still([0.0; 3], 1.0),
         &still([3.0, 0.0, 0.0], 1.0)
     ));
-    assert!(overlap::moving_spheres_meet(
+    assert!(reference::moving_spheres_meet(
         &still([0.0; 3], 1.0),
         &still([2.0, 0.0, 0.0], 1.0)
     ));
@@ -1411,7 +1517,7 @@ fn moving_spheres_meet_whenever_they_do() {
         c1: [5.0, 0.0, 0.0],
         r1: 1.0,
     };
-    assert!(overlap::moving_spheres_meet(
+    assert!(reference::moving_spheres_meet(
         &across,
         &still([0.0, 0.5, 0.0], 0.5)
     ));
@@ -1428,8 +1534,8 @@ fn moving_spheres_meet_whenever_they_do() {
         c1: [10.0, 0.0, 0.0],
         r1: 0.4,
     };
-    assert!(!overlap::moving_spheres_meet(&fast, &other));
+    assert!(!reference::moving_spheres_meet(&fast, &other));
     // NaN never meets.
     let nan = still([f64::NAN, 0.0, 0.0], 1.0);
-    assert!(!overlap::moving_spheres_meet(&nan, &still([0.0; 3], 1.0)));
+    assert!(!reference::moving_spheres_meet(&nan, &still([0.0; 3], 1.0)));
 }

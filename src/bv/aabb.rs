@@ -6,6 +6,7 @@ use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};
+use pulp::Simd;
 
 /// The box node record: min and max corners — 24 bytes.
 #[repr(C)]
@@ -32,10 +33,10 @@ fn fields(r: AabbNode) -> [f32; 6] {
     [r.min[0], r.min[1], r.min[2], r.max[0], r.max[1], r.max[2]]
 }
 
-fn fit_node(tree: &RegionTree, p: &Points, n: usize) -> AabbNode {
+fn fit_node<S: Simd>(simd: S, tree: &RegionTree, p: &Points, n: usize) -> AabbNode {
     let (min, max) = refit::merge_bounds(
-        refit::bounds(p.soa().slice(tree.vert_run(n))),
-        refit::bounds_indexed(p.soa(), tree.borrowed(n)),
+        refit::bounds_with(simd, p.soa().slice(tree.vert_run(n))),
+        refit::bounds_indexed_with(simd, p.soa(), tree.borrowed(n)),
     );
     if p.is_rounded() {
         // An exact coordinate lies within half an ulp of its nearest f32, so beyond the next
@@ -58,12 +59,13 @@ impl BvKind for Aabb {
         let mut nodes = AabbNodes {
             fitted: Bounds::new(tree),
         };
-        Aabb::refit_all(&mut nodes, tree, rest, false);
+        super::refit_all::<Aabb>(&mut nodes, tree, rest, false);
         nodes
     }
 
     #[inline]
-    fn group<'a>(
+    fn group<'a, S: Simd>(
+        simd: S,
         nodes: &'a AabbNodes,
         tree: &RegionTree,
         p: &Points,
@@ -71,7 +73,7 @@ impl BvKind for Aabb {
     ) -> (overlap::AabbSoa<'a>, bool) {
         let (tile, fitted) = nodes
             .fitted
-            .group(tree, g, |n| fields(fit_node(tree, p, n)));
+            .group(tree, g, |n| fields(fit_node(simd, tree, p, n)));
         (overlap::AabbSoa::new(tile), fitted)
     }
 
@@ -114,8 +116,8 @@ impl BvKind for Aabb {
         (a.max(0)[i] - a.min(0)[i]) + (a.max(1)[i] - a.min(1)[i]) + (a.max(2)[i] - a.min(2)[i])
     }
 
-    fn fit(_: &AabbNodes, tree: &RegionTree, p: &Points, n: usize) -> AabbNode {
-        fit_node(tree, p, n)
+    fn fit<S: Simd>(simd: S, _: &AabbNodes, tree: &RegionTree, p: &Points, n: usize) -> AabbNode {
+        fit_node(simd, tree, p, n)
     }
 
     fn record(nodes: &AabbNodes, tree: &RegionTree, n: usize) -> Option<AabbNode> {
@@ -130,7 +132,13 @@ impl BvKind for Aabb {
         nodes.fitted.invalidate();
     }
 
-    fn refit_all(nodes: &mut AabbNodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64 {
+    fn refit_all<S: Simd>(
+        simd: S,
+        nodes: &mut AabbNodes,
+        tree: &RegionTree,
+        p: &Points,
+        bottom_up: bool,
+    ) -> u64 {
         nodes.fitted.refit_all(tree, |n, child| {
             if bottom_up && !tree.is_leaf(n) {
                 let mut b = refit::EMPTY_BOUNDS;
@@ -140,7 +148,7 @@ impl BvKind for Aabb {
                 }
                 fields(AabbNode { min: b.0, max: b.1 })
             } else {
-                fields(fit_node(tree, p, n))
+                fields(fit_node(simd, tree, p, n))
             }
         })
     }

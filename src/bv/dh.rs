@@ -10,6 +10,7 @@ use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};
+use pulp::Simd;
 
 /// The DH node record: central vertex (internal index) and radius — 8 bytes.
 #[repr(C)]
@@ -40,9 +41,9 @@ pub struct Dh;
 impl sealed::Sealed for Dh {}
 
 /// The exact radius of node `n` around its central vertex `c`.
-fn radius(tree: &RegionTree, p: &Points, n: usize, c: [f32; 3]) -> f32 {
-    let run = refit::max_dist_sq(p.soa().slice(tree.vert_run(n)), c);
-    let borrowed = refit::max_dist_sq_indexed(p.soa(), tree.borrowed(n), c);
+fn radius<S: Simd>(simd: S, tree: &RegionTree, p: &Points, n: usize, c: [f32; 3]) -> f32 {
+    let run = refit::max_dist_sq_with(simd, p.soa().slice(tree.vert_run(n)), c);
+    let borrowed = refit::max_dist_sq_indexed_with(simd, p.soa(), tree.borrowed(n), c);
     exact_radius(p, c, conservative_radius(run.max(borrowed)))
 }
 
@@ -58,12 +59,13 @@ impl BvKind for Dh {
             vertex,
             fitted: Bounds::new(tree),
         };
-        Dh::refit_all(&mut nodes, tree, rest, false);
+        super::refit_all::<Dh>(&mut nodes, tree, rest, false);
         nodes
     }
 
     #[inline]
-    fn group<'a>(
+    fn group<'a, S: Simd>(
+        simd: S,
         nodes: &'a DhNodes,
         tree: &RegionTree,
         p: &Points,
@@ -71,7 +73,7 @@ impl BvKind for Dh {
     ) -> (overlap::SphereSoa<'a>, bool) {
         let (tile, fitted) = nodes.fitted.group(tree, g, |n| {
             let c = p.get(nodes.vertex[n] as usize);
-            [c[0], c[1], c[2], radius(tree, p, n, c)]
+            [c[0], c[1], c[2], radius(simd, tree, p, n, c)]
         });
         (overlap::SphereSoa::new(tile), fitted)
     }
@@ -112,11 +114,11 @@ impl BvKind for Dh {
         a.r()[i]
     }
 
-    fn fit(nodes: &DhNodes, tree: &RegionTree, p: &Points, n: usize) -> DhNode {
+    fn fit<S: Simd>(simd: S, nodes: &DhNodes, tree: &RegionTree, p: &Points, n: usize) -> DhNode {
         let vertex = nodes.vertex[n];
         DhNode {
             vertex,
-            radius: radius(tree, p, n, p.get(vertex as usize)),
+            radius: radius(simd, tree, p, n, p.get(vertex as usize)),
         }
     }
 
@@ -132,7 +134,13 @@ impl BvKind for Dh {
         nodes.fitted.invalidate();
     }
 
-    fn refit_all(nodes: &mut DhNodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64 {
+    fn refit_all<S: Simd>(
+        simd: S,
+        nodes: &mut DhNodes,
+        tree: &RegionTree,
+        p: &Points,
+        bottom_up: bool,
+    ) -> u64 {
         let vertex = &nodes.vertex;
         nodes.fitted.refit_all(tree, |n, child| {
             let c = p.get(vertex[n] as usize);
@@ -147,7 +155,7 @@ impl BvKind for Dh {
                 }
                 r
             } else {
-                radius(tree, p, n, c)
+                radius(simd, tree, p, n, c)
             };
             [c[0], c[1], c[2], r]
         })

@@ -90,9 +90,11 @@ pub trait BvKind:
     /// `options` say how (e.g. [`Options::central`] for DH).
     fn build(tree: &RegionTree, rest: &Points, options: &Options) -> Self::Nodes;
     /// The bounds of sibling group `g`, fitting the group exactly to the current pose `p`
-    /// first if it is stale (once per step, whichever thread asks first). Returns the block
-    /// and whether this call fitted it.
-    fn group<'a>(
+    /// first if it is stale (once per step, whichever thread asks first), with the refit
+    /// kernels on the backend `simd` (the caller's: a walk dispatches once). Returns the
+    /// block and whether this call fitted it.
+    fn group<'a, S: pulp::Simd>(
+        simd: S,
         nodes: &'a Self::Nodes,
         tree: &RegionTree,
         p: &Points,
@@ -122,16 +124,29 @@ pub trait BvKind:
     /// A size of entry `i` of a block, to descend the larger volume of an overlapping pair.
     fn extent(a: Self::Block<'_>, i: usize) -> f32;
     /// The exact bounding volume of node `n` for the current positions `p` (reads the
-    /// node's vertices).
-    fn fit(nodes: &Self::Nodes, tree: &RegionTree, p: &Points, n: usize) -> Self::Record;
+    /// node's vertices), with the refit kernels on the backend `simd`.
+    fn fit<S: pulp::Simd>(
+        simd: S,
+        nodes: &Self::Nodes,
+        tree: &RegionTree,
+        p: &Points,
+        n: usize,
+    ) -> Self::Record;
     /// Node `n`'s record if its group is current.
     fn record(nodes: &Self::Nodes, tree: &RegionTree, n: usize) -> Option<Self::Record>;
     /// Makes every node stale (a new step).
     fn invalidate(nodes: &mut Self::Nodes);
     /// Fits every stale group now: exactly, or bottom-up (leaves exactly, each internal node
     /// as a bound of its children's volumes: for DH `r_p = max_c(|C_p - C_c| + r_c)`).
-    /// Returns the number of nodes fitted.
-    fn refit_all(nodes: &mut Self::Nodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64;
+    /// Returns the number of nodes fitted. The refit kernels run on the backend `simd`
+    /// (the crate dispatches once for the whole refit).
+    fn refit_all<S: pulp::Simd>(
+        simd: S,
+        nodes: &mut Self::Nodes,
+        tree: &RegionTree,
+        p: &Points,
+        bottom_up: bool,
+    ) -> u64;
     /// Whether record `r` (its centres read from `p`) encloses `point` (checked in f64; for
     /// validation).
     fn encloses(r: &Self::Record, p: &Points, point: [f64; 3]) -> bool;
@@ -173,6 +188,35 @@ pub trait BvKind:
         t: f64,
         point: [f64; 3],
     ) -> Option<bool>;
+}
+
+/// [`BvKind::refit_all`] on the runtime-detected backend, dispatched once for the whole
+/// refit.
+pub(crate) fn refit_all<K: BvKind>(
+    nodes: &mut K::Nodes,
+    tree: &RegionTree,
+    p: &Points,
+    bottom_up: bool,
+) -> u64 {
+    struct Op<'a, K: BvKind> {
+        nodes: &'a mut K::Nodes,
+        tree: &'a RegionTree,
+        p: &'a Points,
+        bottom_up: bool,
+    }
+    impl<K: BvKind> pulp::WithSimd for Op<'_, K> {
+        type Output = u64;
+        #[inline(always)]
+        fn with_simd<S: pulp::Simd>(self, simd: S) -> u64 {
+            K::refit_all(simd, self.nodes, self.tree, self.p, self.bottom_up)
+        }
+    }
+    dhcd_kernels::arch().dispatch(Op::<K> {
+        nodes,
+        tree,
+        p,
+        bottom_up,
+    })
 }
 
 #[inline]

@@ -8,6 +8,7 @@ use crate::hierarchy::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};
+use pulp::Simd;
 
 /// The sphere node record: centre and radius — 16 bytes.
 #[repr(C)]
@@ -35,22 +36,28 @@ fn fields(r: SphereNode) -> [f32; 4] {
 }
 
 /// The exact sphere of node `n`.
-fn fit_node(tree: &RegionTree, p: &Points, n: usize) -> SphereNode {
+fn fit_node<S: Simd>(simd: S, tree: &RegionTree, p: &Points, n: usize) -> SphereNode {
     let run = p.soa().slice(tree.vert_run(n));
     let borrowed = tree.borrowed(n);
-    let s1 = refit::sum(run);
-    let s2 = refit::sum_indexed(p.soa(), borrowed);
+    let s1 = refit::sum_with(simd, run);
+    let s2 = refit::sum_indexed_with(simd, p.soa(), borrowed);
     let inv = 1.0 / tree.vertex_count(n) as f32;
     let mut center = [0, 1, 2].map(|k| (s1[k] + s2[k]) * inv);
     if !center.iter().all(|c| c.is_finite()) {
         // The sum overflowed (coordinates near f32::MAX): any centre is correct, the
         // radius below bounds the region from it; take the box midpoint.
-        let (lo, hi) =
-            refit::merge_bounds(refit::bounds(run), refit::bounds_indexed(p.soa(), borrowed));
+        let (lo, hi) = refit::merge_bounds(
+            refit::bounds_with(simd, run),
+            refit::bounds_indexed_with(simd, p.soa(), borrowed),
+        );
         center = [0, 1, 2].map(|k| lo[k] * 0.5 + hi[k] * 0.5);
     }
-    let d2 =
-        refit::max_dist_sq(run, center).max(refit::max_dist_sq_indexed(p.soa(), borrowed, center));
+    let d2 = refit::max_dist_sq_with(simd, run, center).max(refit::max_dist_sq_indexed_with(
+        simd,
+        p.soa(),
+        borrowed,
+        center,
+    ));
     SphereNode {
         center,
         radius: exact_radius(p, center, conservative_radius(d2)),
@@ -67,12 +74,13 @@ impl BvKind for Sphere {
         let mut nodes = SphereNodes {
             fitted: Bounds::new(tree),
         };
-        Sphere::refit_all(&mut nodes, tree, rest, false);
+        super::refit_all::<Sphere>(&mut nodes, tree, rest, false);
         nodes
     }
 
     #[inline]
-    fn group<'a>(
+    fn group<'a, S: Simd>(
+        simd: S,
         nodes: &'a SphereNodes,
         tree: &RegionTree,
         p: &Points,
@@ -80,7 +88,7 @@ impl BvKind for Sphere {
     ) -> (overlap::SphereSoa<'a>, bool) {
         let (tile, fitted) = nodes
             .fitted
-            .group(tree, g, |n| fields(fit_node(tree, p, n)));
+            .group(tree, g, |n| fields(fit_node(simd, tree, p, n)));
         (overlap::SphereSoa::new(tile), fitted)
     }
 
@@ -120,8 +128,14 @@ impl BvKind for Sphere {
         a.r()[i]
     }
 
-    fn fit(_: &SphereNodes, tree: &RegionTree, p: &Points, n: usize) -> SphereNode {
-        fit_node(tree, p, n)
+    fn fit<S: Simd>(
+        simd: S,
+        _: &SphereNodes,
+        tree: &RegionTree,
+        p: &Points,
+        n: usize,
+    ) -> SphereNode {
+        fit_node(simd, tree, p, n)
     }
 
     fn record(nodes: &SphereNodes, tree: &RegionTree, n: usize) -> Option<SphereNode> {
@@ -136,12 +150,18 @@ impl BvKind for Sphere {
         nodes.fitted.invalidate();
     }
 
-    fn refit_all(nodes: &mut SphereNodes, tree: &RegionTree, p: &Points, bottom_up: bool) -> u64 {
+    fn refit_all<S: Simd>(
+        simd: S,
+        nodes: &mut SphereNodes,
+        tree: &RegionTree,
+        p: &Points,
+        bottom_up: bool,
+    ) -> u64 {
         nodes.fitted.refit_all(tree, |n, child| {
             fields(if bottom_up && !tree.is_leaf(n) {
                 merge(tree, n, child)
             } else {
-                fit_node(tree, p, n)
+                fit_node(simd, tree, p, n)
             })
         })
     }

@@ -20,7 +20,7 @@
 //!   Record: two centres and two radii, 32 bytes in `f32`; staged as the DH tile.
 //!
 //! Two moving balls meet during the step iff `|c_a(t) - c_b(t)| <= r_a(t) + r_b(t)` for some
-//! t in `[0, 1]`, a quadratic inequality in t ([`dhcd_kernels::overlap::moving_spheres_meet`],
+//! t in `[0, 1]`, a quadratic inequality in t ([`dhcd_kernels::reference::moving_spheres_meet`],
 //! one SIMD block test per sibling group as for the bounds of a pose).
 //!
 //! Radii are computed in `f64` from the `f64` positions and rounded up by a bound on their

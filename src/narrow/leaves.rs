@@ -1,5 +1,5 @@
 //! The narrow phase of one leaf pair: the verdicts of the kernel on the two leaves' triangles
-//! (`dhcd_kernels::narrow::leaf_contacts`: closed boxes, shared vertices for self-collision,
+//! (`dhcd_kernels::narrow::leaf_contacts_with`: closed boxes, shared vertices for self-collision,
 //! certified separating planes, then the certified canonical form), then the exact test on
 //! the pairs it left undecided.
 //!

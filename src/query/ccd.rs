@@ -577,7 +577,7 @@ impl<'s, 'h, K: BvKind> Query for SweptQuery<'s, 'h, K> {
     }
 
     #[inline(always)]
-    fn group(&self, side: Side, g: usize) -> (K::SweptBlock<'s>, bool) {
+    fn group<S: Simd>(&self, _simd: S, side: Side, g: usize) -> (K::SweptBlock<'s>, bool) {
         let s: &'s Swept<'h, K> = match side {
             Side::A => self.a,
             Side::B => self.b,

@@ -266,7 +266,8 @@ impl<'h, K: BvKind, const ROUNDED: bool> LeafAction<'h, K> for ContactAction<ROU
         counters: &mut Counters,
         out: &mut ContactOut<'h>,
     ) {
-        fn side<'h, K: BvKind>(
+        fn side<'h, K: BvKind, S: Simd>(
+            simd: S,
             h: &'h Hierarchy<K>,
             leaf: usize,
             last: &mut Option<(usize, LeafSide<'h>)>,
@@ -275,7 +276,7 @@ impl<'h, K: BvKind, const ROUNDED: bool> LeafAction<'h, K> for ContactAction<ROU
                 Some((n, s)) if n == leaf => s,
                 _ => {
                     let s = LeafSide {
-                        tris: h.leaf_tris(leaf),
+                        tris: h.leaf_tris(simd, leaf),
                         order: &h.tree().tri_order()[h.tree().tri_range(leaf)],
                         exact: h.exact_points(),
                     };
@@ -286,7 +287,7 @@ impl<'h, K: BvKind, const ROUNDED: bool> LeafAction<'h, K> for ContactAction<ROU
         }
         let (leaves, shared) = leaf_pair_kind(posed, x, y);
         let [la, lb] = &mut out.last;
-        let (sa, sb) = (side(posed.a, x, la), side(posed.b, y, lb));
+        let (sa, sb) = (side(simd, posed.a, x, la), side(simd, posed.b, y, lb));
         counters.prim_tests += leaf_pair::<S, ROUNDED>(
             simd,
             &sa,

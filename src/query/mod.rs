@@ -179,8 +179,8 @@ impl<'h, K: BvKind, T: NodeTest, L: LeafAction<'h, K>> Query for PosedQuery<'h, 
     }
 
     #[inline(always)]
-    fn group(&self, side: Side, g: usize) -> (K::Block<'h>, bool) {
-        self.posed.side(side).group(g)
+    fn group<S: Simd>(&self, simd: S, side: Side, g: usize) -> (K::Block<'h>, bool) {
+        self.posed.side(side).group(simd, g)
     }
 
     #[inline(always)]

@@ -265,7 +265,7 @@ impl Features {
         mut emit: impl FnMut(u32, u32, f64, PointTriangle),
     ) {
         let (tv, tt) = (lv.h.tree(), lt.h.tree());
-        let tris = lt.h.leaf_tris(lt.node);
+        let tris = lt.h.leaf_tris(simd, lt.node);
         let soa = &tris.soa;
         let n = tris.len;
         let rows: BoxRows = [

@@ -28,10 +28,11 @@ impl<'q, Q: Query> Task<'q, Q> {
         }
     }
 
-    /// Sibling group `g` of `side`, fitted first if stale (the fit counted for the side).
+    /// Sibling group `g` of `side`, fitted first if stale on `simd` (the fit counted for the
+    /// side).
     #[inline(always)]
-    fn group(&mut self, side: Side, g: usize) -> Q::Block {
-        let (block, fitted) = self.query.group(side, g);
+    fn group<S: Simd>(&mut self, simd: S, side: Side, g: usize) -> Q::Block {
+        let (block, fitted) = self.query.group(simd, side, g);
         if fitted {
             self.fitted[side as usize] += self.query.tree(side).group_nodes(g).len() as u64;
         }
@@ -44,7 +45,7 @@ impl<'q, Q: Query> Task<'q, Q> {
         if self.query.is_self() {
             return Some([0, 0]);
         }
-        let (a, b) = (self.group(Side::A, 0), self.group(Side::B, 0));
+        let (a, b) = (self.group(simd, Side::A, 0), self.group(simd, Side::B, 0));
         self.counters.bv_tests += 1;
         (self.query.test(simd, a, 0, b, 1) != 0).then_some([0, 0])
     }
@@ -82,7 +83,7 @@ impl<'q, Q: Query> Task<'q, Q> {
             let Some(g) = ta.child_group(x) else {
                 return false;
             };
-            let block = self.group(Side::A, g);
+            let block = self.group(simd, Side::A, g);
             let nodes = ta.group_nodes(g);
             let m = nodes.len();
             for i in 0..m {
@@ -104,7 +105,7 @@ impl<'q, Q: Query> Task<'q, Q> {
             return false;
         }
         let (gx, gy) = (ta.group_of(x), tb.group_of(y));
-        let (bx, by) = (self.group(Side::A, gx), self.group(Side::B, gy));
+        let (bx, by) = (self.group(simd, Side::A, gx), self.group(simd, Side::B, gy));
         let (ix, iy) = (x - ta.group_nodes(gx).start, y - tb.group_nodes(gy).start);
         let descend_x = match (cx, cy) {
             (Some(_), None) => true,
@@ -113,14 +114,14 @@ impl<'q, Q: Query> Task<'q, Q> {
         };
         if descend_x {
             let g = cx.unwrap_or_default();
-            let children = self.group(Side::A, g);
+            let children = self.group(simd, Side::A, g);
             let nodes = ta.group_nodes(g);
             self.counters.bv_tests += nodes.len() as u64;
             let bits = q.test(simd, by, iy, children, nodes.len());
             push_bits(next, bits, y as u32, nodes.start, false);
         } else {
             let g = cy.unwrap_or_default();
-            let children = self.group(Side::B, g);
+            let children = self.group(simd, Side::B, g);
             let nodes = tb.group_nodes(g);
             self.counters.bv_tests += nodes.len() as u64;
             let bits = q.test(simd, bx, ix, children, nodes.len());

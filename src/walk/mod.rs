@@ -64,7 +64,7 @@ pub(crate) trait Query: Sync {
     /// An empty output.
     fn out(&self) -> Self::Out;
     /// Sibling group `g` of `side`, fitted first if stale; whether this call fitted it.
-    fn group(&self, side: Side, g: usize) -> (Self::Block, bool);
+    fn group<S: Simd>(&self, simd: S, side: Side, g: usize) -> (Self::Block, bool);
     /// Overlap bits of entry `i` of block `a` (side A's or B's) against the first `n`
     /// entries of block `b` (the other side's, or the same group in a self pair).
     fn test<S: Simd>(&self, simd: S, a: Self::Block, i: usize, b: Self::Block, n: usize) -> u32;
