@@ -52,6 +52,6 @@ for k in sorted(dh):
     assert t["n"] == d["n"], k
     print(f"| {k} | {d['n']} | {t['fp']} | {t['median_ns']:.0f} | {d['median_ns']:.0f} | "
           f"{t['median_ns'] / d['median_ns']:.1f}x | {t['mean_ns']:.0f} | {d['mean_ns']:.0f} | "
-          f"{t['mean_ns'] / d['mean_ns']:.0f}x |")
+          f"{t['mean_ns'] / d['mean_ns']:.1f}x |")
 EOF
 rm -rf "$out"
