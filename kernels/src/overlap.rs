@@ -224,7 +224,8 @@ pub fn aabb_block_with<S: Simd>(simd: S, lo: [f32; 3], hi: [f32; 3], b: AabbSoa,
 /// children fill half of a 16-lane vector, and Zen 4 runs a 512-bit operation as two
 /// 256-bit halves, so the empty half costs as much as the full one (`kernels/sphere_block`
 /// 2.2x -> 3.4-3.6x its scalar reference, `aabb_block` 1.7x -> 2.7-2.8x; packing two
-/// fields per 16-lane vector gave 2.4x and 2.7x: docs/PERFORMANCE.md, sixteenth sitting).
+/// fields per 16-lane vector gave 2.4x and 2.7x: docs/notes/performance-history.md, section
+/// "wide node tests on 8 lanes").
 /// Every x86-v4 CPU has x86-v3.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
