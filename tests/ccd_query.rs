@@ -118,17 +118,7 @@ fn spheres_tunnelling_through_each_other() {
 fn folding_sheet_self_ccd() {
     let g = grid(8, 8, 0.1, [0.0; 3]);
     let x0 = f64s(&jitter(g.positions(), [0.002; 3], 5));
-    let x1: Vec<[f64; 3]> = x0
-        .iter()
-        .map(|p| {
-            if p[0] > 0.45 {
-                // Folded over x = 0.45 and pushed through the lower half.
-                [0.9 - p[0], p[1] + 0.013, -0.04 + 0.01 * (p[1] * 7.0).sin()]
-            } else {
-                *p
-            }
-        })
-        .collect();
+    let x1 = crate::fixtures::folded_through(&x0, 1.0);
     let all = brute_force_self_ccd(&g, Motion::new(&x0, &x1), &CcdOptions::default());
     assert!(all.counters.contacts > 0);
     for_each_kind!(K => check_self::<K>(&g, &x0, &x1, &[0.0], "folding sheet"));

@@ -198,3 +198,18 @@ pub fn seeds() -> Vec<Vec<u8>> {
         f.binary(true),
     ]
 }
+
+/// A sheet's end pose for the CCD suites: every point beyond x = 0.45 folded over that line
+/// and pushed through the part before it (`fold` = 1 all the way, 0 not at all).
+pub fn folded_through(x0: &[[f64; 3]], fold: f64) -> Vec<[f64; 3]> {
+    x0.iter()
+        .map(|p| {
+            if p[0] > 0.45 {
+                let folded = [0.9 - p[0], p[1] + 0.013, -0.04 + 0.01 * (p[1] * 7.0).sin()];
+                std::array::from_fn(|k| p[k] + fold * (folded[k] - p[k]))
+            } else {
+                *p
+            }
+        })
+        .collect()
+}

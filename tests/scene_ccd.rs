@@ -72,16 +72,7 @@ fn bodies() -> Vec<Body> {
     .unwrap();
     let x0 = f64s(sheet.positions());
     // The right half folded over x = 0.45 and pushed through the left half.
-    let x1 = x0
-        .iter()
-        .map(|p| {
-            if p[0] > 0.45 {
-                [0.9 - p[0], p[1] + 0.013, -0.04 + 0.01 * (p[1] * 7.0).sin()]
-            } else {
-                *p
-            }
-        })
-        .collect();
+    let x1 = crate::fixtures::folded_through(&x0, 1.0);
     let sheet = Body {
         mesh: sheet,
         x0,

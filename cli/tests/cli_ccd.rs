@@ -9,6 +9,7 @@ use dhcd::narrow::brute_force_self_ccd;
 use dhcd::shapes::{grid, jitter};
 use dhcd::{Impacts, Mesh, Motion};
 
+use crate::fixtures;
 use crate::support::{self, dhcd, json};
 
 fn dir() -> &'static Path {
@@ -31,17 +32,7 @@ fn folding_sheet(n: u32, fold: f64) -> (Mesh, Vec<[f64; 3]>, Vec<[f64; 3]>) {
         .iter()
         .map(|p| p.map(f64::from))
         .collect();
-    let x1 = x0
-        .iter()
-        .map(|p| {
-            if p[0] > 0.45 {
-                let folded = [0.9 - p[0], p[1] + 0.013, -0.04 + 0.01 * (p[1] * 7.0).sin()];
-                std::array::from_fn(|k| p[k] + fold * (folded[k] - p[k]))
-            } else {
-                *p
-            }
-        })
-        .collect();
+    let x1 = fixtures::folded_through(&x0, fold);
     (g, x0, x1)
 }
 
