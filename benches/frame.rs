@@ -18,13 +18,13 @@
 //!
 //! The setup asserts that dhcd's contacts (all three kinds) equal the exact brute force on a
 //! few frames, and prints how parry's GJK contacts compare (not exact; not asserted).
+use dhcd::calibration::Calibration;
 use std::collections::BTreeSet;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
-use dhcd::{broad_phase, narrow_phase};
 use dhcd::{collide_with, Counters, Hierarchy, Mesh, Method, ObjectId, Options, Par, Workspace};
 use parry3d::bounding_volume::Aabb as PAabb;
 use parry3d::math::{Pose, Vector};
@@ -188,7 +188,9 @@ impl<K: BvKind> DhcdWorld<K> {
         self.apply(scene, f);
         let mut n = 0;
         for (k, &(i, j)) in scene.pairs.iter().enumerate() {
-            let b = broad_phase(&self.hs[i], &self.hs[j], &mut self.ws, Par::Seq);
+            let b = self.hs[i]
+                .broad_phase(&self.hs[j], &mut self.ws, Par::Seq)
+                .expect("one method");
             n += b.counters.prim_tests;
             self.leaves[k] = b.leaf_pairs;
         }
@@ -433,7 +435,8 @@ fn frame(c: &mut Criterion) {
                     w.hier(scene, f);
                     let start = Instant::now();
                     for (k, &(i, j)) in scene.pairs.iter().enumerate() {
-                        let r = narrow_phase(&w.hs[i], &w.hs[j], &w.leaves[k], Par::Seq)
+                        let r = w.hs[i]
+                            .narrow_phase(&w.hs[j], &w.leaves[k], Par::Seq)
                             .expect("leaf pairs of this frame");
                         black_box(r);
                     }

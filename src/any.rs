@@ -4,15 +4,17 @@
 use std::sync::Arc;
 
 use crate::bv::Method;
+use crate::calibration::{BroadPhase, Calibration};
 use crate::error::Result;
-use crate::hierarchy::{Hierarchy, InvariantError, Options};
+use crate::hierarchy::{Hierarchy, InvariantError};
 use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
-use crate::mesh::{Mesh, Precision};
+use crate::mesh::Mesh;
+use crate::options::Options;
 use crate::par::Par;
+use crate::precision::Precision;
 use crate::query::{
-    broad_phase, ccd_pair_with, collide_with, narrow_phase, proximity_with, self_broad_phase,
-    self_ccd_with, self_collide_with, self_proximity_with, BroadPhase, CcdQuery, Contacts, Impacts,
-    Motion, Proximity,
+    ccd_pair_with, collide_with, proximity_with, self_ccd_with, self_collide_with,
+    self_proximity_with, CcdQuery, Contacts, Impacts, Motion, Proximity,
 };
 use crate::tree::RegionTree;
 use crate::walk::Workspace;
@@ -146,65 +148,47 @@ impl AnyHierarchy {
     }
 
     /// Intersection segments of contacts between `self` and `other` (see
-    /// [`contact_segments`](crate::detail::contact_segments)); an error if the kinds differ.
+    /// [`contact_segments`](crate::segments::contact_segments)); an error if the kinds differ.
     pub fn contact_segments(
         &self,
         other: &AnyHierarchy,
         pairs: &[[u32; 2]],
-    ) -> Result<Vec<crate::detail::Segment>> {
-        use crate::detail::contact_segments;
+    ) -> Result<Vec<crate::segments::Segment>> {
+        use crate::segments::contact_segments;
         pairwise!(self, other, a, b => contact_segments(a, b, pairs)?)
     }
+}
 
-    /// Marks every bounding volume stale (see [`Hierarchy::invalidate`]).
-    pub fn invalidate(&mut self) {
+impl Calibration for AnyHierarchy {
+    fn invalidate(&mut self) {
         each!(self, h => h.invalidate())
     }
 
-    /// Refits the stale nodes among `ids` (see [`Hierarchy::refit_nodes`]).
-    pub fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<u64> {
+    fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<u64> {
         each!(self, h => h.refit_nodes(ids, par))
     }
 
-    /// Refits every stale node exactly now (see [`Hierarchy::refit_all`]).
-    pub fn refit_all(&mut self) -> u64 {
+    fn refit_all(&mut self) -> u64 {
         each!(self, h => h.refit_all())
     }
 
-    /// Refits every stale node bottom-up now (see [`Hierarchy::refit_bottom_up`]).
-    pub fn refit_bottom_up(&mut self) -> u64 {
+    fn refit_bottom_up(&mut self) -> u64 {
         each!(self, h => h.refit_bottom_up())
     }
 
-    /// The nodes fitted to the current positions (see [`Hierarchy::fitted_nodes`]).
-    pub fn fitted_nodes(&self) -> Vec<u32> {
+    fn fitted_nodes(&self) -> Vec<u32> {
         each!(self, h => h.fitted_nodes())
     }
 
-    /// [`broad_phase`] between two hierarchies of the same kind; an error if the kinds differ.
-    pub fn broad_phase(
-        &self,
-        other: &AnyHierarchy,
-        ws: &mut Workspace,
-        par: Par,
-    ) -> Result<BroadPhase> {
-        pairwise!(self, other, a, b => broad_phase(a, b, ws, par))
+    fn broad_phase(&self, other: &Self, ws: &mut Workspace, par: Par) -> Result<BroadPhase> {
+        pairwise!(self, other, a, b => a.broad_phase(b, ws, par)?)
     }
 
-    /// [`self_broad_phase`] of this object: refit and traversal down to the overlapping
-    /// leaf pairs, no triangle tested.
-    pub fn self_broad_phase(&self, ws: &mut Workspace, par: Par) -> BroadPhase {
-        each!(self, h => self_broad_phase(h, ws, par))
+    fn self_broad_phase(&self, ws: &mut Workspace, par: Par) -> BroadPhase {
+        each!(self, h => h.self_broad_phase(ws, par))
     }
 
-    /// [`narrow_phase`] on leaf pairs of two hierarchies of the same kind; an error if the
-    /// kinds differ.
-    pub fn narrow_phase(
-        &self,
-        other: &AnyHierarchy,
-        leaves: &[[u32; 2]],
-        par: Par,
-    ) -> Result<Contacts> {
-        pairwise!(self, other, a, b => narrow_phase(a, b, leaves, par)?)
+    fn narrow_phase(&self, other: &Self, leaves: &[[u32; 2]], par: Par) -> Result<Contacts> {
+        pairwise!(self, other, a, b => a.narrow_phase(b, leaves, par)?)
     }
 }

@@ -4,6 +4,8 @@
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
+use crate::precision::Precision;
+
 /// Everything that can go wrong when building, updating, querying or loading a mesh or
 /// hierarchy. One variant per failure, so callers (the C ABI, the Python module) map
 /// variants, never messages.
@@ -40,27 +42,26 @@ pub enum Error {
     /// Positions of one precision given to a mesh or hierarchy of the other: an `f32`
     /// update of an `f64` hierarchy would silently round it.
     #[error("positions are {got}, but the mesh or hierarchy is {expected}")]
-    PrecisionMismatch {
-        expected: crate::mesh::Precision,
-        got: crate::mesh::Precision,
-    },
+    PrecisionMismatch { expected: Precision, got: Precision },
     #[error("position update has {got} vertices, but the mesh has {expected}")]
     WrongVertexCount { expected: usize, got: usize },
-    #[error("levels must be between 1 and {max}, got {got}", max = crate::tree::MAX_LEVELS)]
-    InvalidLevels { got: usize },
-    #[error("leaf size must be between 1 and {max}, got {got}", max = crate::tree::MAX_LEAF_SIZE)]
-    InvalidLeafSize { got: usize },
+    /// A region tree depth outside `1..=max` ([`tree::MAX_LEVELS`](crate::tree::MAX_LEVELS)).
+    #[error("levels must be between 1 and {max}, got {got}")]
+    InvalidLevels { got: usize, max: usize },
+    /// A leaf size outside `1..=max` ([`tree::MAX_LEAF_SIZE`](crate::tree::MAX_LEAF_SIZE)).
+    #[error("leaf size must be between 1 and {max}, got {got}")]
+    InvalidLeafSize { got: usize, max: usize },
+    /// Two hierarchies of different methods, by name ([`Method::name`](crate::Method::name)).
     #[error("cannot collide a {a} hierarchy with a {b} hierarchy")]
-    MethodMismatch {
-        a: crate::bv::Method,
-        b: crate::bv::Method,
-    },
+    MethodMismatch { a: &'static str, b: &'static str },
     #[error("no object with id {0} in the scene")]
     UnknownObject(u64),
     #[error("object {0} is given more than once in one update")]
     RepeatedObject(u64),
-    #[error("unknown method {0:?} (expected one of {names})", names = crate::kinds::Method::names())]
-    UnknownMethod(String),
+    /// A method name that is none of `expected` (the names of
+    /// [`Method::ALL`](crate::Method::ALL), comma-separated).
+    #[error("unknown method {got:?} (expected one of {expected})")]
+    UnknownMethod { got: String, expected: String },
     #[error("unknown refit mode {0:?} (expected lazy, eager or bottom-up)")]
     UnknownRefit(String),
     #[error("unknown central vertex {0:?} (expected rest-centroid or min-radius)")]
@@ -92,17 +93,21 @@ pub enum Error {
         triangle: u64,
         triangle_count: usize,
     },
-    /// A contact whose triangles do not intersect in the current pose (contact detail asked
+    /// A contact whose triangles do not intersect in the current pose (contact segments asked
     /// for contacts of an earlier pose).
     #[error("triangles {pair:?} do not intersect in the current pose (stale contacts?)")]
     StaleContact { pair: [u32; 2] },
+    /// A thread count above `max` ([`Par::MAX_THREADS`](crate::Par::MAX_THREADS)); `cores`
+    /// is [`Par::max_threads`](crate::Par::max_threads).
     #[error(
         "thread count {got} is out of range: threads must be 0 (all cores), 1 (the calling \
-         thread) or up to {max} (at most {cores} are used on this machine)",
-        max = crate::par::MAX_THREADS,
-        cores = crate::par::max_threads()
+         thread) or up to {max} (at most {cores} are used on this machine)"
     )]
-    InvalidThreads { got: usize },
+    InvalidThreads {
+        got: usize,
+        max: usize,
+        cores: usize,
+    },
     /// A CCD time limit outside [0, 1] (or NaN).
     #[error("CCD t_max must be in [0, 1], got {0}")]
     InvalidTimeLimit(f64),
@@ -134,6 +139,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 /// `text` with every control character (newlines and NUL included) and line separator
 /// written as an escape (`\n`, `\0`, `\u{1b}`), so that a message that echoes a path or a
 /// token from a file is always one line of printable text.
+#[doc(hidden)]
 pub fn escaped(text: &str) -> Cow<'_, str> {
     let special = |c: char| c.is_control() || matches!(c, '\u{2028}' | '\u{2029}');
     if !text.contains(special) {
@@ -151,6 +157,7 @@ pub fn escaped(text: &str) -> Cow<'_, str> {
 }
 
 /// A path as [`escaped`] text (bytes that are not UTF-8 shown as U+FFFD).
+#[doc(hidden)]
 pub fn escaped_path(path: &Path) -> String {
     escaped(&path.to_string_lossy()).into_owned()
 }

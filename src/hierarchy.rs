@@ -4,148 +4,21 @@
 use std::sync::Arc;
 
 use crate::bv::{BvKind, Method};
+use crate::calibration::{BroadPhase, Calibration};
 use crate::error::{Error, Result};
-use crate::mesh::{check_positions, check_positions_f64, Mesh, Precision};
+use crate::mesh::{check_positions, check_positions_f64, Mesh};
+use crate::options::{Options, Refit};
+use crate::par::Par;
 use crate::points::Points;
-use crate::tree::{RegionTree, TreeShape, DEFAULT_LEAF_SIZE, PAPER_LEVELS};
+use crate::precision::Precision;
+use crate::query::{contacts, Contacts};
+use crate::tree::RegionTree;
+use crate::walk::Workspace;
 use dhcd_kernels::lazy::LazyTiles;
 use dhcd_kernels::narrow::TriSoa;
 use dhcd_kernels::overlap::BoxRows;
 use dhcd_kernels::{refit, Soa3, Tile};
 use pulp::Simd;
-
-/// When bounding volumes follow a deformation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-#[non_exhaustive]
-pub enum Refit {
-    /// The paper's lazy evaluation: a node is refitted just before its first overlap test
-    /// after a position update, and only if it is tested at all.
-    #[default]
-    Lazy,
-    /// Every node is refitted exactly (from its vertices) in `update_positions`.
-    Eager,
-    /// Every node in `update_positions`, bottom-up: leaves exactly, each internal node as a
-    /// bound of its children (for DH, `r_p = max_c(|C_p - C_c| + r_c)`): cheaper, looser.
-    EagerBottomUp,
-}
-
-impl Refit {
-    /// The name in reports (and [`FromStr`](std::str::FromStr)): `lazy`, `eager`,
-    /// `bottom-up`.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Refit::Lazy => "lazy",
-            Refit::Eager => "eager",
-            Refit::EagerBottomUp => "bottom-up",
-        }
-    }
-}
-
-impl std::fmt::Display for Refit {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Refit {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self> {
-        match s {
-            "lazy" => Ok(Refit::Lazy),
-            "eager" => Ok(Refit::Eager),
-            "bottom-up" | "eager-bottom-up" => Ok(Refit::EagerBottomUp),
-            _ => Err(Error::UnknownRefit(s.to_owned())),
-        }
-    }
-}
-
-/// Which vertex of its region a DH node is centred on (chosen at build, fixed for life). The
-/// other kinds ignore it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-#[non_exhaustive]
-pub enum CentralVertex {
-    /// The paper's choice: the region vertex closest to the centroid (mean) of the region's
-    /// vertices at rest.
-    #[default]
-    RestCentroid,
-    /// The region vertex whose rest radius (largest distance to the region's vertices at
-    /// rest) is least: the tightest DH sphere at rest. Costlier to build (exact, pruned).
-    MinRadius,
-}
-
-impl CentralVertex {
-    /// Every choice, the default first.
-    pub const ALL: [CentralVertex; 2] = [CentralVertex::RestCentroid, CentralVertex::MinRadius];
-
-    /// The name on the command line and in reports: `rest-centroid`, `min-radius`.
-    pub const fn name(self) -> &'static str {
-        match self {
-            CentralVertex::RestCentroid => "rest-centroid",
-            CentralVertex::MinRadius => "min-radius",
-        }
-    }
-}
-
-impl std::fmt::Display for CentralVertex {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for CentralVertex {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self> {
-        CentralVertex::ALL
-            .into_iter()
-            .find(|c| c.name() == s)
-            .ok_or_else(|| Error::UnknownCentral(s.to_owned()))
-    }
-}
-
-/// Build options of a hierarchy.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Options {
-    /// A fixed depth for the region tree (root = level 0; the paper uses 5), or `None`
-    /// (the default) for an adaptive tree whose leaves hold at most `leaf_size` triangles.
-    pub levels: Option<usize>,
-    /// Largest number of triangles in a leaf of an adaptive tree (ignored with `levels`).
-    pub leaf_size: usize,
-    pub refit: Refit,
-    /// The DH central vertex of every node (ignored by the other kinds).
-    pub central: CentralVertex,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Self {
-            levels: None,
-            leaf_size: DEFAULT_LEAF_SIZE,
-            refit: Refit::Lazy,
-            central: CentralVertex::RestCentroid,
-        }
-    }
-}
-
-impl Options {
-    /// The paper's setting: a fixed depth of 5 levels, lazy refit, central vertices closest to
-    /// the rest centroid.
-    pub fn paper() -> Self {
-        Self {
-            levels: Some(PAPER_LEVELS),
-            ..Self::default()
-        }
-    }
-
-    /// The region tree these options ask for.
-    pub fn shape(&self) -> TreeShape {
-        match self.levels {
-            Some(levels) => TreeShape::Levels(levels),
-            None => TreeShape::Adaptive {
-                leaf_size: self.leaf_size,
-            },
-        }
-    }
-}
 
 /// A node whose bounding volume fails to enclose its region (a bug in dhcd, never bad input).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -462,58 +335,6 @@ impl<K: BvKind> Hierarchy<K> {
         }
     }
 
-    /// Marks every bounding volume stale without moving anything (the next query refits
-    /// what it tests). Used by calibration and benchmarks to repeat a step's refit work.
-    pub fn invalidate(&mut self) {
-        K::invalidate(&mut self.nodes);
-        self.tris.tiles.invalidate();
-        if let Some(edges) = self.edges.get_mut() {
-            edges.tiles.invalidate();
-        }
-    }
-
-    /// Refits the stale sibling groups of the nodes `ids` (each group once), as the lazy
-    /// traversal does; returns the number of nodes fitted. A node id out of range is an
-    /// [`Error::NodeOutOfRange`] and nothing is refitted.
-    pub fn refit_nodes(&mut self, ids: &[u32], par: crate::par::Par) -> Result<u64> {
-        if let Some(&n) = ids.iter().find(|&&n| n as usize >= self.node_count()) {
-            return Err(Error::NodeOutOfRange {
-                node: n,
-                node_count: self.node_count(),
-            });
-        }
-        let mut groups: Vec<usize> = ids
-            .iter()
-            .map(|&n| self.tree.group_of(n as usize))
-            .collect();
-        groups.sort_unstable();
-        groups.dedup();
-        Ok(dhcd_kernels::arch().dispatch(RefitGroups {
-            h: self,
-            groups: &groups,
-            par,
-        }))
-    }
-
-    /// The nodes fitted to the current positions (after a lazy query: the sibling groups it
-    /// refitted or found fresh), in increasing order.
-    pub fn fitted_nodes(&self) -> Vec<u32> {
-        (0..self.node_count() as u32)
-            .filter(|&n| self.is_fitted(n as usize))
-            .collect()
-    }
-
-    /// Refits every stale node exactly; returns the number of nodes fitted.
-    pub fn refit_all(&mut self) -> u64 {
-        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, false)
-    }
-
-    /// Refits every stale node bottom-up: leaves exactly, internal nodes from their children.
-    /// Returns the number of nodes fitted.
-    pub fn refit_bottom_up(&mut self) -> u64 {
-        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, true)
-    }
-
     /// Sibling group `g`'s volumes, fitted first if stale (the refit kernels on `simd`);
     /// whether this call fitted them.
     #[inline]
@@ -582,11 +403,13 @@ impl<K: BvKind> Hierarchy<K> {
     }
 
     /// Whether node `n` is fitted to the current positions (its sibling group is).
+    #[doc(hidden)]
     pub fn is_fitted(&self, n: usize) -> bool {
         K::group_current(&self.nodes, self.tree.group_of(n))
     }
 
     /// Node `n`'s record, if it is fitted to the current positions.
+    #[doc(hidden)]
     pub fn record(&self, n: usize) -> Option<K::Record> {
         K::record(&self.nodes, &self.tree, n)
     }
@@ -595,18 +418,21 @@ impl<K: BvKind> Hierarchy<K> {
         &self.tree
     }
 
+    #[doc(hidden)]
     pub fn nodes(&self) -> &K::Nodes {
         &self.nodes
     }
 
     /// Current positions in internal vertex order (see [`RegionTree::vert_order`]), as
     /// `f32` (the nearest `f32`s of an `f64` hierarchy's positions).
+    #[doc(hidden)]
     pub fn points(&self) -> &Points {
         &self.points
     }
 
     /// The exact current position of internal vertex `v`.
     #[inline]
+    #[doc(hidden)]
     pub fn position_f64(&self, v: usize) -> [f64; 3] {
         match &self.exact {
             Some(e) => e[v],
@@ -655,5 +481,61 @@ impl<K: BvKind> Hierarchy<K> {
     /// shared topology is [`RegionTree::topology_bytes`]).
     pub fn bv_bytes(&self) -> usize {
         self.node_count() * self.bytes_per_node()
+    }
+}
+
+impl<K: BvKind> Calibration for Hierarchy<K> {
+    fn invalidate(&mut self) {
+        K::invalidate(&mut self.nodes);
+        self.tris.tiles.invalidate();
+        if let Some(edges) = self.edges.get_mut() {
+            edges.tiles.invalidate();
+        }
+    }
+
+    fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<u64> {
+        if let Some(&n) = ids.iter().find(|&&n| n as usize >= self.node_count()) {
+            return Err(Error::NodeOutOfRange {
+                node: n,
+                node_count: self.node_count(),
+            });
+        }
+        let mut groups: Vec<usize> = ids
+            .iter()
+            .map(|&n| self.tree.group_of(n as usize))
+            .collect();
+        groups.sort_unstable();
+        groups.dedup();
+        Ok(dhcd_kernels::arch().dispatch(RefitGroups {
+            h: self,
+            groups: &groups,
+            par,
+        }))
+    }
+
+    fn fitted_nodes(&self) -> Vec<u32> {
+        (0..self.node_count() as u32)
+            .filter(|&n| self.is_fitted(n as usize))
+            .collect()
+    }
+
+    fn refit_all(&mut self) -> u64 {
+        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, false)
+    }
+
+    fn refit_bottom_up(&mut self) -> u64 {
+        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, true)
+    }
+
+    fn broad_phase(&self, other: &Self, ws: &mut Workspace, par: Par) -> Result<BroadPhase> {
+        Ok(contacts::broad_phase(self, other, ws, par))
+    }
+
+    fn self_broad_phase(&self, ws: &mut Workspace, par: Par) -> BroadPhase {
+        contacts::self_broad_phase(self, ws, par)
+    }
+
+    fn narrow_phase(&self, other: &Self, leaves: &[[u32; 2]], par: Par) -> Result<Contacts> {
+        contacts::narrow_phase(self, other, leaves, par)
     }
 }

@@ -83,6 +83,7 @@ macro_rules! define_method {
             }
 
             /// Other names accepted by [`Method::from_name`] (e.g. `sbv`, the paper's name).
+            #[doc(hidden)]
             pub const fn aliases(self) -> &'static [&'static str] {
                 match self { $(Method::$kind => &[$($alias),*],)* }
             }
@@ -129,11 +130,13 @@ impl Method {
     }
 
     /// The names of all kinds, for messages: `dh, sphere, aabb`.
+    #[doc(hidden)]
     pub fn names() -> String {
         Method::ALL.map(Method::name).join(", ")
     }
 
     /// Position in [`Method::ALL`] (e.g. to pick a colour from a palette).
+    #[doc(hidden)]
     pub fn index(self) -> usize {
         Method::ALL.iter().position(|&m| m == self).unwrap_or(0)
     }
@@ -148,7 +151,10 @@ impl std::fmt::Display for Method {
 impl std::str::FromStr for Method {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Method::from_name(s).ok_or_else(|| Error::UnknownMethod(s.to_owned()))
+        Method::from_name(s).ok_or_else(|| Error::UnknownMethod {
+            got: s.to_owned(),
+            expected: Method::names(),
+        })
     }
 }
 
@@ -221,8 +227,8 @@ macro_rules! match_kind_pair_arms {
         match ($a, $b) {
             $(($name::$kind($x), $name::$kind($y)) => Ok($e),)*
             (a, b) => Err($crate::error::Error::MethodMismatch {
-                a: a.method(),
-                b: b.method(),
+                a: a.method().name(),
+                b: b.method().name(),
             }),
         }
     };

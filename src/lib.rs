@@ -33,22 +33,27 @@
 //! their own on top of it.
 #![forbid(unsafe_code)]
 
-pub mod any;
+mod any;
 pub mod bv;
+pub mod calibration;
 pub mod ccd;
-pub mod counters;
-pub mod detail;
+mod counters;
 pub mod distance;
 pub mod error;
 pub mod hierarchy;
 pub mod io;
-pub mod kinds;
-pub mod mesh;
+mod kinds;
+mod mesh;
+#[doc(hidden)]
 pub mod narrow;
-pub mod par;
+mod options;
+mod par;
+#[doc(hidden)]
 pub mod points;
+mod precision;
 pub mod query;
 pub mod scene;
+pub mod segments;
 pub mod shapes;
 pub mod tree;
 mod walk;
@@ -57,18 +62,23 @@ pub use any::AnyHierarchy;
 pub use bv::Method;
 pub use counters::Counters;
 pub use error::{Error, Result};
-pub use hierarchy::{CentralVertex, Hierarchy, InvariantError, Options, Refit};
-pub use mesh::{Mesh, Precision};
+pub use hierarchy::{Hierarchy, InvariantError};
+pub use mesh::Mesh;
+pub use options::{CentralVertex, Options, Refit};
 pub use par::Par;
+pub use precision::Precision;
 pub use scene::{
     ObjectId, PairImpacts, PairProximity, Scene, SceneContacts, SceneImpacts, SceneProximity,
 };
+pub use segments::{contact_segments, self_contact_segments, Segment};
 
 pub use query::{
-    broad_phase, ccd_pair, ccd_pair_with, collide, collide_with, narrow_phase, proximity,
-    proximity_with, self_broad_phase, self_ccd, self_ccd_with, self_collide, self_collide_with,
-    self_proximity, self_proximity_with, BroadPhase, CcdMode, CcdQuery, Contacts, Impacts, Motion,
-    Proximity,
+    ccd_pair, ccd_pair_with, collide, collide_with, proximity, proximity_with, self_ccd,
+    self_ccd_with, self_collide, self_collide_with, self_proximity, self_proximity_with, CcdMode,
+    CcdQuery, Contacts, Impacts, Motion, Proximity,
 };
 pub use tree::RegionTree;
 pub use walk::{Workspace, DEFAULT_GRAIN};
+
+#[doc(hidden)]
+pub use mesh::{check_positions, check_positions_f64};

@@ -1,38 +1,7 @@
 //! Validated triangle meshes.
 
 use crate::error::{Error, Result};
-
-/// The floating-point type of a mesh's coordinates: every answer is exact for the
-/// coordinates as given in it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-#[non_exhaustive]
-pub enum Precision {
-    /// `f32` coordinates (the fastest path).
-    #[default]
-    F32,
-    /// `f64` coordinates, as simulators hold them. Bounding volumes stay `f32` records,
-    /// rounded outward; the triangle, proximity and CCD tests decide for the `f64` values.
-    F64,
-}
-
-impl Precision {
-    /// Every precision, the default first.
-    pub const ALL: [Precision; 2] = [Precision::F32, Precision::F64];
-
-    /// The name on the command line and in JSON reports: `f32`, `f64`.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Precision::F32 => "f32",
-            Precision::F64 => "f64",
-        }
-    }
-}
-
-impl std::fmt::Display for Precision {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+use crate::precision::Precision;
 
 impl std::str::FromStr for Precision {
     type Err = Error;
@@ -136,6 +105,7 @@ impl Mesh {
     }
 
     /// The positions as `f64`, exactly: an `f64` mesh's own, an `f32` mesh's converted.
+    #[doc(hidden)]
     pub fn to_f64_positions(&self) -> Vec<[f64; 3]> {
         match &self.exact {
             Some(p) => p.clone(),
@@ -196,6 +166,7 @@ impl Mesh {
 
     /// The three corners of triangle `t`.
     #[inline]
+    #[doc(hidden)]
     pub fn corners(&self, t: usize) -> [[f32; 3]; 3] {
         let [a, b, c] = self.triangles[t];
         [

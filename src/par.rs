@@ -1,26 +1,21 @@
-//! Parallelism as a parameter: [`Par::Seq`] or [`Par::Rayon`] with a thread count.
-//! Results never depend on it: parallel work is split into fixed chunks whose outputs are
-//! concatenated in chunk order.
+//! Parallelism as a parameter: [`Par::Seq`], [`Par::Rayon`] with a thread count, or
+//! [`Par::Ambient`]. Results never depend on it: parallel work is split into fixed chunks
+//! whose outputs are concatenated in chunk order.
 //!
 //! Thread counts are bounded here, in one place (`docs/LIMITS.md`):
 //!
-//! - A count a user gives (command line, C ABI, experiment) enters through [`Par::threads`],
-//!   which rejects counts above [`MAX_THREADS`] with [`Error::InvalidThreads`].
-//! - The count actually used never exceeds [`max_threads`], the machine's available
+//! - A count a user gives (command line, C ABI, Python, experiment) enters through
+//!   [`Par::threads`], which rejects counts above [`Par::MAX_THREADS`] with
+//!   [`Error::InvalidThreads`].
+//! - The count actually used never exceeds [`Par::max_threads`], the machine's available
 //!   parallelism: [`Par::Rayon`]`(n)` with a larger `n` runs on `max_threads()` threads.
-//! - Pools are cached, at most [`MAX_POOLS`] of them (least recently used evicted), so a host
-//!   that asks for many different counts holds at most `MAX_POOLS * max_threads()` threads.
+//! - Pools are cached, at most [`Par::MAX_POOLS`] of them (least recently used evicted), so
+//!   a host that asks for many different counts holds at most `MAX_POOLS * max_threads()`
+//!   threads.
 
 use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::error::{Error, Result};
-
-/// The largest thread count [`Par::threads`] accepts; larger counts are typos or garbage
-/// (`UINT32_MAX` from C), not machines. Counts up to it are clamped to [`max_threads`].
-pub const MAX_THREADS: usize = 1024;
-
-/// The most thread pools kept alive at once.
-pub const MAX_POOLS: usize = 4;
 
 /// How a query or refit runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -29,37 +24,54 @@ pub enum Par {
     /// On the calling thread.
     #[default]
     Seq,
-    /// On a pool of this many threads, at most [`max_threads`] (`0`: the ambient rayon pool,
-    /// i.e. rayon's global pool, or the pool the caller already runs in).
+    /// On a pool of `n` threads, at most [`Par::max_threads`]; `n <= 1` is [`Par::Seq`].
     Rayon(usize),
-}
-
-/// The machine's available parallelism (at least 1): no [`Par`] runs on more threads.
-pub fn max_threads() -> usize {
-    static MAX: OnceLock<usize> = OnceLock::new();
-    *MAX.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+    /// On rayon's ambient pool: the pool the caller already runs in, else rayon's global
+    /// pool (all cores unless the host configured it).
+    Ambient,
 }
 
 impl Par {
-    /// The parallelism for a thread count a user gave: `0` all cores (the ambient rayon
-    /// pool), `1` the calling thread, `n` a pool of `min(n, max_threads())` threads.
-    /// Counts above [`MAX_THREADS`] are an [`Error::InvalidThreads`].
+    /// The largest thread count [`Par::threads`] accepts; larger counts are typos or
+    /// garbage (`UINT32_MAX` from C), not machines. Counts up to it are clamped to
+    /// [`Par::max_threads`].
+    pub const MAX_THREADS: usize = 1024;
+
+    /// The most thread pools kept alive at once.
+    #[doc(hidden)]
+    pub const MAX_POOLS: usize = 4;
+
+    /// The machine's available parallelism (at least 1): no [`Par`] runs on more threads.
+    pub fn max_threads() -> usize {
+        static MAX: OnceLock<usize> = OnceLock::new();
+        *MAX.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+    }
+
+    /// The parallelism for a thread count a user gave (command line, C, Python): `0` all
+    /// cores ([`Par::Ambient`]), `1` the calling thread, `n` a pool of
+    /// `min(n, max_threads())` threads. Counts above [`Par::MAX_THREADS`] are an
+    /// [`Error::InvalidThreads`].
     pub fn threads(n: usize) -> Result<Par> {
         match n {
-            0 => Ok(Par::Rayon(0)),
+            0 => Ok(Par::Ambient),
             1 => Ok(Par::Seq),
-            n if n <= MAX_THREADS => Ok(Par::Rayon(n)),
-            got => Err(Error::InvalidThreads { got }),
+            n if n <= Par::MAX_THREADS => Ok(Par::Rayon(n)),
+            got => Err(Error::InvalidThreads {
+                got,
+                max: Par::MAX_THREADS,
+                cores: Par::max_threads(),
+            }),
         }
     }
 
-    /// What actually runs: `Rayon(n)` clamped to [`max_threads`], and [`Par::Seq`] when that
-    /// leaves one thread.
+    /// What actually runs: `Rayon(n)` clamped to [`Par::max_threads`], and [`Par::Seq`]
+    /// when that leaves one thread.
+    #[doc(hidden)]
     pub fn effective(self) -> Par {
         match self {
-            Par::Seq | Par::Rayon(0) => self,
-            Par::Rayon(n) => match n.min(max_threads()) {
-                1 => Par::Seq,
+            Par::Seq | Par::Ambient => self,
+            Par::Rayon(n) => match n.min(Par::max_threads()) {
+                0 | 1 => Par::Seq,
                 n => Par::Rayon(n),
             },
         }
@@ -69,20 +81,24 @@ impl Par {
     pub fn thread_count(self) -> usize {
         match self.effective() {
             Par::Seq => 1,
-            Par::Rayon(0) => rayon::current_num_threads(),
+            Par::Ambient => rayon::current_num_threads(),
             Par::Rayon(n) => n,
         }
     }
 
+    /// Whether the work runs on more than the calling thread (as far as this `Par` decides:
+    /// [`Par::Ambient`] counts as parallel).
+    #[doc(hidden)]
     pub fn is_parallel(self) -> bool {
         self.effective() != Par::Seq
     }
 
     /// Runs `f` inside the pool this `Par` names (see the module docs for the cache), or
-    /// directly for `Seq` and `Rayon(0)`.
+    /// directly for `Seq` and `Ambient`.
+    #[doc(hidden)]
     pub fn install<R: Send>(self, f: impl FnOnce() -> R + Send) -> R {
         match self.effective() {
-            Par::Seq | Par::Rayon(0) => f(),
+            Par::Seq | Par::Ambient => f(),
             // A pool that cannot be built (no threads to be had) runs the work here: the
             // result is the same, only slower.
             Par::Rayon(n) => match pool(n) {
@@ -101,7 +117,7 @@ struct PoolCache {
 
 impl PoolCache {
     /// The pool of `threads` threads, built if needed; evicts the least recently used pool
-    /// beyond [`MAX_POOLS`]. An evicted pool's threads end once the work already running on
+    /// beyond [`Par::MAX_POOLS`]. An evicted pool's threads end once the work already running on
     /// it (which holds its own `Arc`) is done.
     fn get(&mut self, threads: usize) -> Option<Arc<rayon::ThreadPool>> {
         if let Some(i) = self.pools.iter().position(|(n, _)| *n == threads) {
@@ -113,7 +129,7 @@ impl PoolCache {
                 .thread_name(move |i| format!("dhcd-{threads}-{i}"))
                 .build()
                 .ok()?;
-            if self.pools.len() == MAX_POOLS {
+            if self.pools.len() == Par::MAX_POOLS {
                 self.pools.remove(0);
             }
             self.pools.push((threads, Arc::new(p)));
@@ -141,7 +157,7 @@ mod tests {
         for n in [1, 2, 3, 1, 4, 5, 6] {
             let p = cache.get(n).unwrap();
             assert_eq!(p.current_num_threads(), n);
-            assert!(cache.pools.len() <= MAX_POOLS);
+            assert!(cache.pools.len() <= Par::MAX_POOLS);
         }
         // 1 was used again after 2 and 3, so 2 and 3 went first.
         let kept: Vec<usize> = cache.pools.iter().map(|(n, _)| *n).collect();

@@ -26,16 +26,18 @@ use rayon::prelude::*;
 use crate::bv::swept::{box_over_step, f32_up, Step};
 use crate::bv::{BvKind, Method};
 use crate::counters::Counters;
-use crate::detail::{segment, OriginalCorners, Segment};
 use crate::error::{Error, Result};
-use crate::hierarchy::{Hierarchy, Options};
+use crate::hierarchy::Hierarchy;
 use crate::kinds::{kinds, match_kind, with_kind};
-use crate::mesh::{check_positions, Mesh, Precision};
+use crate::mesh::{check_positions, Mesh};
+use crate::options::Options;
 use crate::par::Par;
+use crate::precision::Precision;
 use crate::query::ccd::{self, checked_step, earliest_bound, keep_earliest, Swept};
 use crate::query::contacts::contacts;
 use crate::query::proximity::{self, check_distance};
 use crate::query::{CcdQuery, Contacts, Impacts, Motion, Overlap, Posed, Proximity, Within};
+use crate::segments::{segment, OriginalCorners, Segment};
 use crate::walk::Workspace;
 
 /// Identifies an object of a [`Scene`]. Ids are handed out in increasing order from 0 and
@@ -641,7 +643,7 @@ fn run_walks<T: Sync, R: Send>(
     parallel: bool,
     query: impl Fn(&mut Workspace, &T, Option<&T>, Par) -> (R, [u64; 2]) + Sync,
 ) -> Vec<(R, [u64; 2])> {
-    let inner = if parallel { Par::Rayon(0) } else { Par::Seq };
+    let inner = if parallel { Par::Ambient } else { Par::Seq };
     let run = |ws: &mut Workspace, (a, b): (usize, usize)| {
         let other = (a != b).then(|| &sides[b]);
         query(ws, &sides[a], other, inner)

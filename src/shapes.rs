@@ -158,6 +158,7 @@ pub fn fold_x(positions: &[[f32; 3]], at: f32) -> Vec<[f32; 3]> {
 
 /// SplitMix64 (Steele, Lea, Flood 2014): advances `state` and returns its next 64-bit
 /// output. The seeded generator behind [`jitter`] and the simulator's scenes.
+#[doc(hidden)]
 pub fn splitmix64(state: &mut u64) -> u64 {
     *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
     let mut z = *state;

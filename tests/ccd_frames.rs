@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use dhcd::ccd::{self, CcdOptions};
 use dhcd::io::{load_as, Limits};
-use dhcd::mesh::Precision;
+use dhcd::Precision;
 
 fn data() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data")

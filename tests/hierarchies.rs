@@ -2,6 +2,7 @@
 //! sequences, all refit modes, bad input.
 
 use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
+use dhcd::calibration::Calibration;
 use dhcd::narrow::brute_force_pairs;
 use dhcd::shapes::{grid, icosphere, translated, wave};
 use dhcd::{
@@ -318,7 +319,10 @@ fn bad_mesh_input_is_a_typed_error() {
                 }
             )
             .err(),
-            Some(Error::InvalidLevels { got: levels })
+            Some(Error::InvalidLevels {
+                got: levels,
+                max: dhcd::tree::MAX_LEVELS
+            })
         );
     }
     // Messages are one clear line.
@@ -488,7 +492,7 @@ fn parallel_equals_sequential_for<K: BvKind>() {
             );
         }
     }
-    assert_eq!(sequence_with::<K>(dhcd::Par::Rayon(0), 3), seq);
+    assert_eq!(sequence_with::<K>(dhcd::Par::Ambient, 3), seq);
 }
 
 #[test]
@@ -508,8 +512,10 @@ fn broad_then_narrow_phase_equals_collide() {
         .unwrap();
     let whole = collide(&ha.clone(), &hb.clone());
     let mut ws = dhcd::Workspace::default();
-    let broad = dhcd::broad_phase(&ha, &hb, &mut ws, dhcd::Par::Seq);
-    let narrow = dhcd::narrow_phase(&ha, &hb, &broad.leaf_pairs, dhcd::Par::Rayon(2)).unwrap();
+    let broad = ha.broad_phase(&hb, &mut ws, dhcd::Par::Seq).unwrap();
+    let narrow = ha
+        .narrow_phase(&hb, &broad.leaf_pairs, dhcd::Par::Rayon(2))
+        .unwrap();
     assert_eq!(narrow.pairs, whole.pairs);
     assert_eq!(broad.counters.bv_tests, whole.counters.bv_tests);
     assert_eq!(broad.counters.bv_updates, whole.counters.bv_updates);
@@ -538,11 +544,12 @@ fn broad_then_narrow_phase_equals_collide() {
         })
     );
     assert!(matches!(
-        dhcd::narrow_phase(&ha, &hb, &[[n, 0]], dhcd::Par::Seq),
+        ha.narrow_phase(&hb, &[[n, 0]], dhcd::Par::Seq),
         Err(Error::NodeOutOfRange { node, .. }) if node == n
     ));
     assert_eq!(
-        dhcd::narrow_phase(&ha, &hb, &[[0, 0]], dhcd::Par::Seq).map(|c| c.pairs),
+        ha.narrow_phase(&hb, &[[0, 0]], dhcd::Par::Seq)
+            .map(|c| c.pairs),
         Err(Error::NotALeaf { node: 0 }),
         "root is no leaf"
     );

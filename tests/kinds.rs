@@ -27,7 +27,13 @@ fn names_and_numbers_round_trip() {
     assert_eq!(Method::from_code(Method::ALL.len() as i32), None);
     assert_eq!("sbv".parse::<Method>(), Ok(Method::Sphere));
     let err = "octree".parse::<Method>().unwrap_err();
-    assert_eq!(err, Error::UnknownMethod("octree".into()));
+    assert_eq!(
+        err,
+        Error::UnknownMethod {
+            got: "octree".into(),
+            expected: "dh, sphere, aabb".into()
+        }
+    );
     assert_eq!(
         err.to_string(),
         "unknown method \"octree\" (expected one of dh, sphere, aabb)"

@@ -1,5 +1,6 @@
 //! `f64` meshes: construction, range and precision checks, and the loaders at full precision.
 
+use dhcd::calibration::Calibration;
 use std::path::Path;
 
 use dhcd::io::{self, Format, Limits};

@@ -6,6 +6,7 @@
 //! The expected counts are the README's (an independent exact brute force, confirmed by
 //! CGAL). When the folder is absent the tests print why and pass.
 
+use dhcd::calibration::Calibration;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 

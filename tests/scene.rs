@@ -1,6 +1,7 @@
 //! Scenes of many deforming objects against brute force: every object pair, self-collision,
 //! add/remove/update, ids, broad-phase culling, parallel == sequential, contact segments.
 
+use dhcd::calibration::Calibration;
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs, intersection_segment};
 use dhcd::scene::{ObjectId, Scene, SceneContacts};
 use dhcd::shapes::{grid, icosphere, wave};

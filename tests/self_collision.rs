@@ -2,6 +2,7 @@
 //! every kind and refit mode, parallel == sequential.
 
 use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
+use dhcd::calibration::Calibration;
 use dhcd::narrow::brute_force_self_pairs;
 use dhcd::shapes::{grid, icosphere, wave};
 use dhcd::{
@@ -183,7 +184,7 @@ fn parallel_equals_sequential_for<K: BvKind>() {
             );
         }
     }
-    assert_eq!(sequence::<K>(Par::Rayon(0), 3), seq);
+    assert_eq!(sequence::<K>(Par::Ambient, 3), seq);
 }
 
 #[test]
@@ -229,7 +230,7 @@ fn self_broad_phase_matches_query_for<K: BvKind>() {
             let mut h = Hierarchy::<K>::new(&rest, Options::default()).unwrap();
             h.update_positions(&posed).unwrap();
             let mut ws = Workspace::default();
-            let broad = dhcd::self_broad_phase(&h, &mut ws, par);
+            let broad = h.self_broad_phase(&mut ws, par);
             let got = broad.counters;
             assert_eq!(got.bv_tests, want.bv_tests, "{:?} {par:?}", K::METHOD);
             assert_eq!(got.bv_updates, want.bv_updates, "{:?} {par:?}", K::METHOD);

@@ -2,37 +2,46 @@
 //! has, and a bounded number of pools whatever counts a host asks for (issue 9, items 1-2).
 
 use dhcd::bv::Dh;
-use dhcd::par::{max_threads, MAX_POOLS, MAX_THREADS};
 use dhcd::shapes::icosphere;
 use dhcd::{Error, Hierarchy, Options, Par, Workspace};
 
 #[test]
 fn out_of_range_thread_counts_are_typed_one_line_errors() {
-    for got in [MAX_THREADS + 1, 16_384, u32::MAX as usize, usize::MAX] {
+    for got in [Par::MAX_THREADS + 1, 16_384, u32::MAX as usize, usize::MAX] {
         let err = Par::threads(got).unwrap_err();
-        assert_eq!(err, Error::InvalidThreads { got });
+        assert_eq!(
+            err,
+            Error::InvalidThreads {
+                got,
+                max: Par::MAX_THREADS,
+                cores: Par::max_threads()
+            }
+        );
         let text = err.to_string();
         assert!(
             text.contains(&got.to_string()) && !text.contains('\n'),
             "{text}"
         );
     }
-    assert_eq!(Par::threads(0).unwrap(), Par::Rayon(0));
+    assert_eq!(Par::threads(0).unwrap(), Par::Ambient);
     assert_eq!(Par::threads(1).unwrap(), Par::Seq);
-    assert_eq!(Par::threads(MAX_THREADS).unwrap(), Par::Rayon(MAX_THREADS));
+    assert_eq!(
+        Par::threads(Par::MAX_THREADS).unwrap(),
+        Par::Rayon(Par::MAX_THREADS)
+    );
 }
 
 #[test]
 fn the_count_used_never_exceeds_the_machines_parallelism() {
-    for n in [2, 3, 64, MAX_THREADS, 65_535, usize::MAX] {
+    for n in [2, 3, 64, Par::MAX_THREADS, 65_535, usize::MAX] {
         let par = Par::Rayon(n);
-        assert!(par.thread_count() <= max_threads(), "{n}");
+        assert!(par.thread_count() <= Par::max_threads(), "{n}");
         let inside = par.install(rayon::current_num_threads);
         assert!(
-            inside <= max_threads(),
+            inside <= Par::max_threads(),
             "{n}: ran on a pool of {inside} threads"
         );
-        assert_eq!(par.is_parallel(), max_threads() > 1);
+        assert_eq!(par.is_parallel(), Par::max_threads() > 1);
     }
     assert_eq!(Par::Seq.thread_count(), 1);
     assert_eq!(Par::Rayon(1).effective(), Par::Seq);
@@ -72,9 +81,9 @@ fn pool_threads() -> usize {
 #[test]
 fn pools_stay_bounded_whatever_counts_a_host_asks_for() {
     for n in 2..=128 {
-        assert!(Par::Rayon(n).install(rayon::current_num_threads) <= max_threads());
+        assert!(Par::Rayon(n).install(rayon::current_num_threads) <= Par::max_threads());
     }
-    let bound = MAX_POOLS * max_threads();
+    let bound = Par::MAX_POOLS * Par::max_threads();
     // Evicted pools end their threads asynchronously: wait for them, generously.
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
     loop {

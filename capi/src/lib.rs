@@ -27,25 +27,25 @@
 //!
 //! `threads` arguments: `1` runs on the calling thread, `0` on rayon's global pool (all
 //! cores), `n` on a pool of `n` threads but never more than the machine's cores; above
-//! `dhcd::par::MAX_THREADS` (1024) is `DHCD_ERR_INVALID_ARGUMENT`. Results never depend on it.
+//! `dhcd::Par::MAX_THREADS` (1024) is `DHCD_ERR_INVALID_ARGUMENT`. Results never depend on it.
 
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use dhcd::any::AnyHierarchy;
 use dhcd::bv::Method;
 use dhcd::ccd::CcdOptions;
-use dhcd::counters::Counters;
 use dhcd::error::Error;
-use dhcd::hierarchy::Options;
-use dhcd::mesh::{Mesh, Precision};
-use dhcd::par::Par;
 use dhcd::scene::{ObjectId, Scene};
+use dhcd::AnyHierarchy;
+use dhcd::Counters;
+use dhcd::Options;
+use dhcd::Par;
 use dhcd::{
     CcdMode, CcdQuery, Contacts, Impacts, Motion, Proximity, SceneImpacts, SceneProximity,
     Workspace,
 };
+use dhcd::{Mesh, Precision};
 
 /// Success.
 pub const DHCD_OK: c_int = 0;
@@ -289,7 +289,7 @@ impl From<Error> for Fail {
             Error::RepeatedObject(_) => DHCD_ERR_REPEATED_OBJECT,
             Error::StaleContact { .. } => DHCD_ERR_STALE_CONTACT,
             Error::InvalidLevels { .. }
-            | Error::UnknownMethod(_)
+            | Error::UnknownMethod { .. }
             | Error::UnknownRefit(_)
             | Error::UnknownCentral(_)
             | Error::NodeOutOfRange { .. }

@@ -925,7 +925,7 @@ fn thread_counts_are_checked() {
     let (ha, hb) = (new_h(DHCD_METHOD_AABB, &a), new_h(DHCD_METHOD_AABB, &b));
     // SAFETY: live handles, writable outputs.
     unsafe {
-        for threads in [u32::MAX, dhcd::par::MAX_THREADS as u32 + 1] {
+        for threads in [u32::MAX, dhcd::Par::MAX_THREADS as u32 + 1] {
             let mut c = empty();
             assert_eq!(
                 dhcd_collide(ha, hb, threads, &mut c),
@@ -934,7 +934,7 @@ fn thread_counts_are_checked() {
             let message = last_error();
             assert!(message.contains(&threads.to_string()), "{message}");
         }
-        for threads in [0, 1, 2, dhcd::par::MAX_THREADS as u32] {
+        for threads in [0, 1, 2, dhcd::Par::MAX_THREADS as u32] {
             let mut c = empty();
             assert_eq!(dhcd_collide(ha, hb, threads, &mut c), DHCD_OK);
             assert_eq!(pairs_of(&c), brute_force_pairs(&a, &b), "{threads}");

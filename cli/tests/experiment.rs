@@ -226,7 +226,7 @@ fn bad_configs_are_errors() {
             ..small(1, 1)
         },
         Config {
-            threads: dhcd::par::MAX_THREADS + 1,
+            threads: dhcd::Par::MAX_THREADS + 1,
             ..small(1, 1)
         },
         Config {

@@ -96,7 +96,7 @@ fn large_accepted_thread_counts_use_at_most_the_machines_threads() {
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out_dir.join("report.json")).unwrap()).unwrap();
     let used = report["scene"]["threads"].as_u64().unwrap() as usize;
-    assert!(used >= 1 && used <= dhcd::par::max_threads(), "{used}");
+    assert!(used >= 1 && used <= dhcd::Par::max_threads(), "{used}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -24,7 +24,7 @@ use std::path::PathBuf;
 
 use dhcd::ccd::CcdOptions;
 use dhcd::distance::{EdgeEdge, PointTriangle};
-use dhcd::mesh::{check_positions, check_positions_f64};
+use dhcd::{check_positions, check_positions_f64};
 use dhcd::{
     AnyHierarchy, CcdMode, CcdQuery, Counters, Error, Mesh, Method, Motion, ObjectId, Options, Par,
     Precision, Workspace,
@@ -69,7 +69,7 @@ fn int_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<i64> {
 
 /// The thread count of a query, checked where every thread count is (`Par::threads`): `1`
 /// (the default, `None` here) the calling thread, `0` all cores, `n` a pool of at most the
-/// machine's threads; above `dhcd::par::MAX_THREADS`, or negative, a `ValueError`.
+/// machine's threads; above `dhcd::Par::MAX_THREADS`, or negative, a `ValueError`.
 fn par(threads: Option<&Bound<'_, PyAny>>) -> PyResult<Par> {
     let threads = match threads {
         None => 1,

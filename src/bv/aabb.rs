@@ -2,7 +2,7 @@
 
 use super::swept::{self, Step};
 use super::{sealed, Bounds, BvKind, Method};
-use crate::hierarchy::Options;
+use crate::options::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};

@@ -26,7 +26,7 @@
 //! icosphere of 163,842 vertices: 2.3 s against 0.15 s; `O(m^2)` would be minutes).
 
 use super::dist2_f64;
-use crate::hierarchy::CentralVertex;
+use crate::options::CentralVertex;
 use crate::points::Points;
 use crate::tree::RegionTree;
 

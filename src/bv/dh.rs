@@ -6,7 +6,7 @@
 use super::swept::{self, MovingBalls, Step};
 use super::{central, sealed, BvKind, Method};
 use super::{conservative_radius, conservative_sum, dist2_f64, exact_radius, Bounds};
-use crate::hierarchy::Options;
+use crate::options::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};

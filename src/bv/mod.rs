@@ -15,13 +15,19 @@ pub(crate) mod swept;
 
 pub(crate) use bounds::Bounds;
 
-pub use aabb::{Aabb, AabbNode, AabbNodes};
-pub use dh::{Dh, DhNode, DhNodes};
-pub use sphere::{Sphere, SphereNode, SphereNodes};
+pub use aabb::Aabb;
+#[doc(hidden)]
+pub use aabb::{AabbNode, AabbNodes};
+pub use dh::Dh;
+#[doc(hidden)]
+pub use dh::{DhNode, DhNodes};
+pub use sphere::Sphere;
+#[doc(hidden)]
+pub use sphere::{SphereNode, SphereNodes};
 
 pub use crate::kinds::Method;
 
-use crate::hierarchy::Options;
+use crate::options::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use swept::Step;
@@ -82,17 +88,21 @@ pub trait BvKind:
     /// One node as a plain record (`#[repr(C)]`, Pod; size pinned at compile time).
     type Record: bytemuck::Pod + std::fmt::Debug + PartialEq + Send + Sync;
     /// All nodes of one hierarchy, structure-of-arrays.
+    #[doc(hidden)]
     type Nodes: Clone + std::fmt::Debug + Send + Sync;
     /// The fitted bounds of one sibling group, as the overlap kernels read them.
+    #[doc(hidden)]
     type Block<'a>: Copy;
 
     /// Allocates the buffers and fits every node to the rest pose `rest` (all current);
     /// `options` say how (e.g. [`Options::central`] for DH).
+    #[doc(hidden)]
     fn build(tree: &RegionTree, rest: &Points, options: &Options) -> Self::Nodes;
     /// The bounds of sibling group `g`, fitting the group exactly to the current pose `p`
     /// first if it is stale (once per step, whichever thread asks first), with the refit
     /// kernels on the backend `simd` (the caller's: a walk dispatches once). Returns the
     /// block and whether this call fitted it.
+    #[doc(hidden)]
     fn group<'a, S: pulp::Simd>(
         simd: S,
         nodes: &'a Self::Nodes,
@@ -101,9 +111,11 @@ pub trait BvKind:
         g: usize,
     ) -> (Self::Block<'a>, bool);
     /// Whether sibling group `g` is fitted to the current pose.
+    #[doc(hidden)]
     fn group_current(nodes: &Self::Nodes, g: usize) -> bool;
     /// Overlap bits of entry `i` of block `a` against the first `n` entries of block `b`.
     /// Symmetric in the two volumes.
+    #[doc(hidden)]
     fn test<S: pulp::Simd>(
         simd: S,
         a: Self::Block<'_>,
@@ -113,6 +125,7 @@ pub trait BvKind:
     ) -> u32;
     /// [`BvKind::test`] with entry `i`'s volume grown by `margin` (finite, `>= 0`), rounded
     /// outward: the bits of every entry of `b` whose volume comes within `margin` of it.
+    #[doc(hidden)]
     fn test_within<S: pulp::Simd>(
         simd: S,
         a: Self::Block<'_>,
@@ -122,9 +135,11 @@ pub trait BvKind:
         margin: f32,
     ) -> u32;
     /// A size of entry `i` of a block, to descend the larger volume of an overlapping pair.
+    #[doc(hidden)]
     fn extent(a: Self::Block<'_>, i: usize) -> f32;
     /// The exact bounding volume of node `n` for the current positions `p` (reads the
     /// node's vertices), with the refit kernels on the backend `simd`.
+    #[doc(hidden)]
     fn fit<S: pulp::Simd>(
         simd: S,
         nodes: &Self::Nodes,
@@ -133,13 +148,16 @@ pub trait BvKind:
         n: usize,
     ) -> Self::Record;
     /// Node `n`'s record if its group is current.
+    #[doc(hidden)]
     fn record(nodes: &Self::Nodes, tree: &RegionTree, n: usize) -> Option<Self::Record>;
     /// Makes every node stale (a new step).
+    #[doc(hidden)]
     fn invalidate(nodes: &mut Self::Nodes);
     /// Fits every stale group now: exactly, or bottom-up (leaves exactly, each internal node
     /// as a bound of its children's volumes: for DH `r_p = max_c(|C_p - C_c| + r_c)`).
     /// Returns the number of nodes fitted. The refit kernels run on the backend `simd`
     /// (the crate dispatches once for the whole refit).
+    #[doc(hidden)]
     fn refit_all<S: pulp::Simd>(
         simd: S,
         nodes: &mut Self::Nodes,
@@ -149,17 +167,22 @@ pub trait BvKind:
     ) -> u64;
     /// Whether record `r` (its centres read from `p`) encloses `point` (checked in f64; for
     /// validation).
+    #[doc(hidden)]
     fn encloses(r: &Self::Record, p: &Points, point: [f64; 3]) -> bool;
 
     /// Every node's bound over a step (see `src/bv/swept.rs`), fitted lazily per sibling
     /// group.
+    #[doc(hidden)]
     type Swept: Send + Sync;
     /// One sibling group's bounds over a step, as the swept node test reads them.
+    #[doc(hidden)]
     type SweptBlock<'a>: Copy;
     /// Unfitted bounds over a step for the nodes of `tree`.
+    #[doc(hidden)]
     fn swept(tree: &RegionTree) -> Self::Swept;
     /// The bounds over `step` of sibling group `g`, fitted first if stale; whether this call
     /// fitted it. `nodes` are the hierarchy's (DH reads its central vertices).
+    #[doc(hidden)]
     fn swept_group<'a>(
         swept: &'a Self::Swept,
         nodes: &Self::Nodes,
@@ -169,6 +192,7 @@ pub trait BvKind:
     ) -> (Self::SweptBlock<'a>, bool);
     /// Bits of the first `n` entries of `b` whose bound comes within `margin` (finite,
     /// `>= 0`) of entry `i`'s at some time of the step; conservative, symmetric.
+    #[doc(hidden)]
     fn swept_test<S: pulp::Simd>(
         simd: S,
         a: Self::SweptBlock<'_>,
@@ -178,9 +202,11 @@ pub trait BvKind:
         margin: f64,
     ) -> u32;
     /// A size of entry `i` of a swept block, to descend the larger bound of a pair.
+    #[doc(hidden)]
     fn swept_extent(a: Self::SweptBlock<'_>, i: usize) -> f32;
     /// Whether node `n`'s fitted bound over the step encloses `point` at time `t` (checked
     /// in f64, for validation); `None` if its group is not fitted.
+    #[doc(hidden)]
     fn swept_encloses(
         swept: &Self::Swept,
         tree: &RegionTree,

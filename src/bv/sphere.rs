@@ -4,7 +4,7 @@
 use super::swept::{self, MovingBalls, Step};
 use super::{conservative_radius, conservative_sum, dist2_f64, exact_radius, Bounds};
 use super::{sealed, BvKind, Method};
-use crate::hierarchy::Options;
+use crate::options::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
 use dhcd_kernels::{overlap, refit};

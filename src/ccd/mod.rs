@@ -161,6 +161,7 @@ impl CcdOptions {
     }
 
     /// `Ok` iff `t_max` is in `[0, 1]` and `min_distance` is finite and `>= 0`.
+    #[doc(hidden)]
     pub fn validate(&self) -> Result<()> {
         if !(0.0..=1.0).contains(&self.t_max) {
             return Err(Error::InvalidTimeLimit(self.t_max));
@@ -177,6 +178,7 @@ impl CcdOptions {
 }
 
 /// `Ok` iff every coordinate of the query is finite.
+#[doc(hidden)]
 pub fn check_points(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> Result<()> {
     for (i, p) in x0.iter().chain(x1.iter()).enumerate() {
         if !p.iter().all(|c| c.is_finite()) {
@@ -283,6 +285,7 @@ fn query(
 }
 
 /// The exact path alone, without the float filter (slow; for tests and comparisons).
+#[doc(hidden)]
 pub fn vertex_face_exact(
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],
@@ -300,6 +303,7 @@ pub fn vertex_face_exact(
 }
 
 /// The exact path alone for edge-edge.
+#[doc(hidden)]
 pub fn edge_edge_exact(
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],

@@ -25,10 +25,15 @@ mod stl;
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::mesh::{Mesh, Precision};
+use crate::mesh::Mesh;
+use crate::precision::Precision;
 
-pub use obj::{parse_obj, parse_obj_bytes, write_obj};
+pub use obj::write_obj;
+#[doc(hidden)]
+pub use obj::{parse_obj, parse_obj_bytes};
+#[doc(hidden)]
 pub use ply::parse_ply;
+#[doc(hidden)]
 pub use stl::parse_stl;
 
 /// The mesh file formats `dhcd` reads.
@@ -45,6 +50,7 @@ pub enum Format {
 
 impl Format {
     /// The format named by `path`'s extension (case-insensitive), if any.
+    #[doc(hidden)]
     pub fn from_extension(path: &Path) -> Option<Format> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
         match ext.as_str() {
@@ -56,6 +62,7 @@ impl Format {
     }
 
     /// Guesses the format from the first bytes of a file, if they are recognisable.
+    #[doc(hidden)]
     pub fn sniff(bytes: &[u8]) -> Option<Format> {
         if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r") {
             return Some(Format::Ply);
@@ -210,23 +217,9 @@ impl Coordinate for f64 {
     }
 }
 
-/// Loads a Wavefront OBJ file (default [`Limits`]).
-pub fn load_obj(path: &Path) -> Result<Mesh> {
-    parse_obj_bytes(&read(path, &Limits::default())?, path)
-}
-
-/// Loads an STL file (ASCII or binary, detected from the contents; default [`Limits`]).
-pub fn load_stl(path: &Path) -> Result<Mesh> {
-    parse_stl(&read(path, &Limits::default())?, path)
-}
-
-/// Loads a PLY file (ASCII, binary little- or big-endian; default [`Limits`]).
-pub fn load_ply(path: &Path) -> Result<Mesh> {
-    parse_ply(&read(path, &Limits::default())?, path)
-}
-
 /// Reads a whole mesh file: only regular files (symbolic links followed), at most
 /// `limits.max_file_bytes`.
+#[doc(hidden)]
 pub fn read(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
     use std::io::Read;
     let io = |message: String| Error::Io {

@@ -2,7 +2,8 @@
 
 use super::predicates::Coordinate;
 use super::tritri::{tri_tri, Decide};
-use crate::mesh::{Mesh, Precision};
+use crate::mesh::Mesh;
+use crate::precision::Precision;
 
 /// The triangles of a mesh as corner coordinates of type `C`, with their closed boxes.
 struct Tris<C> {

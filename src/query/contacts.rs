@@ -26,7 +26,8 @@ pub struct Contacts {
     pub counters: Counters,
 }
 
-/// Result of [`broad_phase`]: the overlapping leaf pairs (node ids) and the counted work.
+/// Result of [`Calibration::broad_phase`](crate::calibration::Calibration::broad_phase): the
+/// overlapping leaf pairs (node ids) and the counted work.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct BroadPhase {
     /// `[leaf of A, leaf of B]` (`x <= y` in a self query, a leaf with itself included), in
@@ -130,7 +131,7 @@ fn finish(mut pairs: Vec<[u32; 2]>, mut counters: Counters) -> Contacts {
 /// The broad phase alone: lazy refit and traversal down to the overlapping leaf pairs (a list
 /// that, unlike a query's memory, grows with the work). With [`narrow_phase`] it is
 /// [`collide_with`] split in two, for benchmarks and cost-model calibration.
-pub fn broad_phase<K: BvKind>(
+pub(crate) fn broad_phase<K: BvKind>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
     ws: &mut Workspace,
@@ -142,7 +143,11 @@ pub fn broad_phase<K: BvKind>(
 /// [`broad_phase`] of one object against itself: the lazy refit and traversal of
 /// [`self_collide_with`] down to the overlapping leaf pairs; no triangle is tested. What a
 /// self query costs besides its narrow phase (`dhcd bench --broad-only`).
-pub fn self_broad_phase<K: BvKind>(h: &Hierarchy<K>, ws: &mut Workspace, par: Par) -> BroadPhase {
+pub(crate) fn self_broad_phase<K: BvKind>(
+    h: &Hierarchy<K>,
+    ws: &mut Workspace,
+    par: Par,
+) -> BroadPhase {
     broad(Posed::single(h, Overlap), ws, par)
 }
 
@@ -172,7 +177,7 @@ fn broad<K: BvKind>(posed: Posed<'_, K, Overlap>, ws: &mut Workspace, par: Par) 
 /// ids, as [`broad_phase`] returns them). Counts `prim_tests` and `contacts`. A pair naming
 /// a node beyond its hierarchy is an [`Error::NodeOutOfRange`], one naming an internal node
 /// an [`Error::NotALeaf`].
-pub fn narrow_phase<K: BvKind>(
+pub(crate) fn narrow_phase<K: BvKind>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
     leaves: &[[u32; 2]],

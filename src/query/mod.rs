@@ -2,8 +2,8 @@
 //! a leaf action), with its public entry points.
 //!
 //! - `contacts.rs`: exact intersecting triangle pairs ([`collide`], [`self_collide`]), and
-//!   the split of that query into [`broad_phase`] (overlapping leaf pairs) and
-//!   [`narrow_phase`] for calibration and benchmarks;
+//!   the split of that query into a broad phase (overlapping leaf pairs) and a narrow phase
+//!   for calibration and benchmarks ([`crate::calibration`]);
 //! - `proximity.rs`: every vertex-triangle and edge-edge pair within a distance
 //!   ([`proximity`], [`self_proximity`]), with distances and closest sub-features;
 //! - `ccd.rs`: continuous collision detection over a step ([`ccd_pair`], [`self_ccd`]): every
@@ -24,10 +24,7 @@ pub use ccd::{
     ccd_pair, ccd_pair_with, self_ccd, self_ccd_with, CcdMode, CcdQuery, EdgeImpact, FaceImpact,
     Impacts, Motion, VertexImpact,
 };
-pub use contacts::{
-    broad_phase, collide, collide_with, narrow_phase, self_broad_phase, self_collide,
-    self_collide_with, BroadPhase, Contacts,
-};
+pub use contacts::{collide, collide_with, self_collide, self_collide_with, Contacts};
 pub use proximity::{
     proximity, proximity_with, self_proximity, self_proximity_with, EdgePair, FaceVertex,
     Proximity, VertexFace,

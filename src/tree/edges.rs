@@ -72,9 +72,4 @@ impl LeafEdges {
     pub(crate) fn all(&self) -> &[[u32; 2]] {
         &self.edges
     }
-
-    /// Every unique edge.
-    pub(crate) fn len(&self) -> usize {
-        self.edges.len()
-    }
 }

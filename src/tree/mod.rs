@@ -39,7 +39,7 @@ pub const MAX_LEAF_SIZE: usize = 4096;
 /// padded to a multiple of this many slots: a wide test or row filter then loads whole
 /// vectors of x86-v3 (partial loads are out-of-line calls there), and a node's children are
 /// one block whatever the backend.
-pub const BLOCK: usize = 8;
+pub(crate) const BLOCK: usize = 8;
 const _: () = assert!(MAX_CHILDREN <= BLOCK, "a sibling group fits one block");
 
 /// How far the region tree is subdivided.
@@ -64,13 +64,20 @@ impl Default for TreeShape {
 
 impl TreeShape {
     /// A typed error for a depth or leaf size out of range.
+    #[doc(hidden)]
     pub fn check(self) -> Result<()> {
         match self {
             TreeShape::Levels(levels) if levels == 0 || levels > MAX_LEVELS => {
-                Err(Error::InvalidLevels { got: levels })
+                Err(Error::InvalidLevels {
+                    got: levels,
+                    max: MAX_LEVELS,
+                })
             }
             TreeShape::Adaptive { leaf_size } if leaf_size == 0 || leaf_size > MAX_LEAF_SIZE => {
-                Err(Error::InvalidLeafSize { got: leaf_size })
+                Err(Error::InvalidLeafSize {
+                    got: leaf_size,
+                    max: MAX_LEAF_SIZE,
+                })
             }
             _ => Ok(()),
         }
@@ -141,68 +148,69 @@ impl RegionTree {
 
     /// Number of sibling groups: the root's, and one per internal node (its children, which
     /// a wide test reads as one block and the lazy refit fits together).
-    pub fn group_count(&self) -> usize {
+    pub(crate) fn group_count(&self) -> usize {
         self.group_start.len() - 1
     }
 
     /// The nodes of sibling group `g` (consecutive ids).
     #[inline]
-    pub fn group_nodes(&self, g: usize) -> Range<usize> {
+    pub(crate) fn group_nodes(&self, g: usize) -> Range<usize> {
         self.group_start[g] as usize..self.group_start[g + 1] as usize
     }
 
     /// The sibling group of node `n` (0 for the root).
     #[inline]
-    pub fn group_of(&self, n: usize) -> usize {
+    pub(crate) fn group_of(&self, n: usize) -> usize {
         self.node_group[n] as usize
     }
 
     /// The group of `n`'s children (`None` for a leaf).
     #[inline]
-    pub fn child_group(&self, n: usize) -> Option<usize> {
+    pub(crate) fn child_group(&self, n: usize) -> Option<usize> {
         (self.child_count[n] > 0).then(|| self.node_group[self.first_child[n] as usize] as usize)
     }
 
     /// Index of leaf `n` among the leaves (`0..leaf_count()`), `None` for internal nodes.
     #[inline]
-    pub fn leaf_rank(&self, n: usize) -> Option<usize> {
+    pub(crate) fn leaf_rank(&self, n: usize) -> Option<usize> {
         let r = self.leaf_rank[n];
         (r != u32::MAX).then_some(r as usize)
     }
 
     /// Number of slots of the padded node layout.
-    pub fn slot_count(&self) -> usize {
+    pub(crate) fn slot_count(&self) -> usize {
         self.group_count() * BLOCK
     }
 
     /// The slots of sibling group `g` (its nodes first, in order, then padding; a multiple
     /// of [`BLOCK`]).
     #[inline]
-    pub fn group_slots(&self, g: usize) -> Range<usize> {
+    pub(crate) fn group_slots(&self, g: usize) -> Range<usize> {
         g * BLOCK..(g + 1) * BLOCK
     }
 
     /// Number of slots of the padded triangle layout.
-    pub fn tri_slot_count(&self) -> usize {
+    pub(crate) fn tri_slot_count(&self) -> usize {
         *self.leaf_slot.last().unwrap_or(&0) as usize
     }
 
     /// The triangle slots of the leaf of rank `r` (its triangles first, in order, then
     /// padding; a multiple of [`BLOCK`]).
     #[inline]
-    pub fn leaf_slots(&self, r: usize) -> Range<usize> {
+    pub(crate) fn leaf_slots(&self, r: usize) -> Range<usize> {
         self.leaf_slot[r] as usize..self.leaf_slot[r + 1] as usize
     }
 
     /// The corner indices of the leaf of rank `r`, as a tile over its padded slots: corner
     /// `k` of triangle `i` at `k * stride + i` (`u32::MAX` in padding).
     #[inline]
-    pub fn leaf_vertex_tile(&self, r: usize) -> &[u32] {
+    pub(crate) fn leaf_vertex_tile(&self, r: usize) -> &[u32] {
         let s = self.leaf_slots(r);
         &self.leaf_vertex[3 * s.start..3 * s.end]
     }
 
     /// The leaves, in id order (`leaves()[leaf_rank(n)] == n`).
+    #[doc(hidden)]
     pub fn leaves(&self) -> impl Iterator<Item = usize> + '_ {
         (0..self.node_count()).filter(|&n| self.is_leaf(n))
     }
@@ -212,21 +220,24 @@ impl RegionTree {
     }
 
     /// Nodes at depth `d` are `level_nodes(d)`; `d` ranges over `0..depth_count()`.
-    pub fn level_nodes(&self, d: usize) -> Range<usize> {
+    pub(crate) fn level_nodes(&self, d: usize) -> Range<usize> {
         self.level_start[d] as usize..self.level_start[d + 1] as usize
     }
 
     /// Number of non-empty levels.
+    #[doc(hidden)]
     pub fn depth_count(&self) -> usize {
         self.level_start.len() - 1
     }
 
     #[inline]
+    #[doc(hidden)]
     pub fn is_leaf(&self, n: usize) -> bool {
         self.child_count[n] == 0
     }
 
     #[inline]
+    #[doc(hidden)]
     pub fn children(&self, n: usize) -> Range<usize> {
         let f = self.first_child[n] as usize;
         f..f + self.child_count[n] as usize
@@ -234,41 +245,44 @@ impl RegionTree {
 
     /// The parent of `n`, `None` for the root.
     #[inline]
-    pub fn parent(&self, n: usize) -> Option<usize> {
+    pub(crate) fn parent(&self, n: usize) -> Option<usize> {
         let p = self.parent[n];
         (p != u32::MAX).then_some(p as usize)
     }
 
     #[inline]
+    #[doc(hidden)]
     pub fn depth(&self, n: usize) -> usize {
         self.depth[n] as usize
     }
 
     /// The node's triangles, as a run of internal triangle indices.
     #[inline]
+    #[doc(hidden)]
     pub fn tri_range(&self, n: usize) -> Range<usize> {
         self.tri_start[n] as usize..self.tri_end[n] as usize
     }
 
     /// The node's own contiguous run of internal vertex indices.
     #[inline]
-    pub fn vert_run(&self, n: usize) -> Range<usize> {
+    pub(crate) fn vert_run(&self, n: usize) -> Range<usize> {
         self.vert_start[n] as usize..self.vert_end[n] as usize
     }
 
     /// The node's other vertices (internal indices below its run, owned by earlier subtrees).
     #[inline]
-    pub fn borrowed(&self, n: usize) -> &[u32] {
+    pub(crate) fn borrowed(&self, n: usize) -> &[u32] {
         &self.borrowed[self.borrowed_start[n] as usize..self.borrowed_start[n + 1] as usize]
     }
 
     /// Size of the node's vertex set.
     #[inline]
-    pub fn vertex_count(&self, n: usize) -> usize {
+    pub(crate) fn vertex_count(&self, n: usize) -> usize {
         self.vert_run(n).len() + self.borrowed(n).len()
     }
 
     /// Internal vertex indices of every vertex of the node's region.
+    #[doc(hidden)]
     pub fn region_vertices(&self, n: usize) -> impl Iterator<Item = u32> + '_ {
         self.vert_run(n)
             .map(|v| v as u32)
@@ -277,18 +291,14 @@ impl RegionTree {
 
     /// Internal triangles (corner indices are internal vertex indices).
     #[inline]
+    #[doc(hidden)]
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.tris
     }
 
-    /// Corner `k` of every internal triangle (`triangles()[t][k] == tri_vertex(k)[t]`).
-    #[inline]
-    pub fn tri_vertex(&self, k: usize) -> &[u32] {
-        &self.tri_vertex[k]
-    }
-
     /// Internal triangle index -> the caller's triangle index.
     #[inline]
+    #[doc(hidden)]
     pub fn tri_order(&self) -> &[u32] {
         &self.tri_order
     }
@@ -296,13 +306,13 @@ impl RegionTree {
     /// Internal vertex index -> the caller's vertex index (every vertex of the mesh; those no
     /// triangle uses come last).
     #[inline]
-    pub fn vert_order(&self) -> &[u32] {
+    pub(crate) fn vert_order(&self) -> &[u32] {
         &self.vert_order
     }
 
     /// Caller's vertex index -> internal vertex index.
     #[inline]
-    pub fn vert_slot(&self) -> &[u32] {
+    pub(crate) fn vert_slot(&self) -> &[u32] {
         &self.vert_slot
     }
 
@@ -315,7 +325,7 @@ impl RegionTree {
     }
 
     /// Vertices used by at least one triangle (internal indices `0..referenced_vertices()`).
-    pub fn referenced_vertices(&self) -> usize {
+    pub(crate) fn referenced_vertices(&self) -> usize {
         self.referenced_vertices as usize
     }
 
@@ -324,6 +334,7 @@ impl RegionTree {
     /// from a table built by the first call (counted directly for a mesh over the table's
     /// budget). A node beyond the tree is an [`Error::NodeOutOfRange`], an internal node an
     /// [`Error::NotALeaf`].
+    #[doc(hidden)]
     pub fn shared_pairs(&self, x: usize, y: usize) -> Result<u64> {
         for n in [x, y] {
             if n >= self.node_count() {
@@ -361,11 +372,6 @@ impl RegionTree {
     /// Each leaf's own edges (built by the first call; see `edges.rs`).
     pub(crate) fn leaf_edges(&self) -> &edges::LeafEdges {
         self.edges.get_or_init(|| edges::LeafEdges::build(self))
-    }
-
-    /// The number of unique edges of the triangles (each vertex pair once).
-    pub fn edge_count(&self) -> usize {
-        self.leaf_edges().len()
     }
 
     /// Bytes of topology (shared by the three kinds; not part of a BV's record; the

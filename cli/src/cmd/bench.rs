@@ -7,6 +7,7 @@
 //! different work make the overall median fall between them), and each frame's contacts and
 //! counters.
 
+use dhcd::calibration::Calibration;
 use std::path::PathBuf;
 use std::time::Instant;
 

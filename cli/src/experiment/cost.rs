@@ -26,9 +26,10 @@
 
 use std::time::Instant;
 
-use dhcd::any::AnyHierarchy;
-use dhcd::counters::Counters;
-use dhcd::par::Par;
+use dhcd::calibration::Calibration;
+use dhcd::AnyHierarchy;
+use dhcd::Counters;
+use dhcd::Par;
 use dhcd::Workspace;
 
 use super::{two_mut, ExperimentError};

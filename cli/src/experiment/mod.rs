@@ -32,15 +32,16 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use crate::sim::{pawn_scene, scene_with_mesh, ObjectContact, SimConfig, SimError, Simulation};
-use dhcd::any::AnyHierarchy;
 use dhcd::bv::Method;
-use dhcd::counters::Counters;
+use dhcd::calibration::Calibration;
 use dhcd::error::Error;
-use dhcd::hierarchy::{CentralVertex, Options, Refit};
-use dhcd::mesh::Mesh;
-use dhcd::par::Par;
 use dhcd::tree::{RegionTree, TreeShape, PAPER_LEVELS};
+use dhcd::AnyHierarchy;
+use dhcd::Counters;
+use dhcd::Mesh;
+use dhcd::Par;
 use dhcd::Workspace;
+use dhcd::{CentralVertex, Options, Refit};
 
 pub use cost::{Constant, Costs, Spread};
 
@@ -85,7 +86,7 @@ pub struct Config {
     /// Methods to measure, in report order (no duplicates).
     pub methods: Vec<Method>,
     /// Threads of each query, as [`Par::threads`] takes them: 1 sequential, 0 all cores,
-    /// `n` at most the machine's threads; above [`dhcd::par::MAX_THREADS`] an error.
+    /// `n` at most the machine's threads; above [`dhcd::Par::MAX_THREADS`] an error.
     pub threads: usize,
     /// Seed of the scene (object turns, wobble phases).
     pub seed: u64,

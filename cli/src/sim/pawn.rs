@@ -11,7 +11,7 @@
 use std::f64::consts::PI;
 
 use super::{check, SimError};
-use dhcd::mesh::Mesh;
+use dhcd::Mesh;
 
 /// Rings of the paper-sized pawn (excluding the two poles).
 pub const PAWN_RINGS: usize = 32;

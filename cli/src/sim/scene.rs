@@ -5,7 +5,7 @@ use glam::DVec3;
 use super::pawn::pawn_mesh;
 use super::simulation::{splitmix64, SimConfig, Simulation};
 use super::SimError;
-use dhcd::mesh::Mesh;
+use dhcd::Mesh;
 
 /// Number of objects in [`pawn_scene`] and [`scene_with_mesh`] (the paper's eight pawns).
 pub const SCENE_OBJECTS: usize = 8;

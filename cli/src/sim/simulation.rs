@@ -49,7 +49,7 @@ use rayon::prelude::*;
 
 use super::ObjectContact;
 use super::{check, SimError};
-use dhcd::mesh::Mesh;
+use dhcd::Mesh;
 
 /// Parameters of [`Simulation`]. The defaults are tuned for the pawn scene: the pawns touch
 /// after about ten frames, dent each other and stay pressed together for hundreds of frames.

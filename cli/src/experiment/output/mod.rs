@@ -11,7 +11,7 @@ use serde_json::{json, Value};
 use super::{cost::Constant, MethodReport, RefitRow, RefitStudy, Report, Step, StepTotals};
 use dhcd::bv::Method;
 use dhcd::error::{Error, Result};
-use dhcd::hierarchy::Refit;
+use dhcd::Refit;
 
 /// Files written by [`write_all`], in order.
 pub const FILES: [&str; 8] = [
