@@ -23,9 +23,11 @@
 //! # Ok::<(), dhcd::Error>(())
 //! ```
 
+use crate::bv::BvKind;
 use crate::error::Result;
+use crate::hierarchy::Hierarchy;
 use crate::par::Par;
-use crate::query::Contacts;
+use crate::query::{contacts, Contacts};
 use crate::walk::Workspace;
 
 pub use crate::query::contacts::BroadPhase;
@@ -68,4 +70,38 @@ pub trait Calibration {
     /// of a whole query when given its broad phase's pairs. A node out of range or not a
     /// leaf, or hierarchies of different methods, are an error.
     fn narrow_phase(&self, other: &Self, leaves: &[[u32; 2]], par: Par) -> Result<Contacts>;
+}
+
+impl<K: BvKind> Calibration for Hierarchy<K> {
+    fn invalidate(&mut self) {
+        Hierarchy::invalidate(self)
+    }
+
+    fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<u64> {
+        Hierarchy::refit_nodes(self, ids, par)
+    }
+
+    fn refit_all(&mut self) -> u64 {
+        Hierarchy::refit_all(self)
+    }
+
+    fn refit_bottom_up(&mut self) -> u64 {
+        Hierarchy::refit_bottom_up(self)
+    }
+
+    fn fitted_nodes(&self) -> Vec<u32> {
+        Hierarchy::fitted_nodes(self)
+    }
+
+    fn broad_phase(&self, other: &Self, ws: &mut Workspace, par: Par) -> Result<BroadPhase> {
+        Ok(contacts::broad_phase(self, other, ws, par))
+    }
+
+    fn self_broad_phase(&self, ws: &mut Workspace, par: Par) -> BroadPhase {
+        contacts::self_broad_phase(self, ws, par)
+    }
+
+    fn narrow_phase(&self, other: &Self, leaves: &[[u32; 2]], par: Par) -> Result<Contacts> {
+        contacts::narrow_phase(self, other, leaves, par)
+    }
 }

@@ -4,16 +4,13 @@
 use std::sync::Arc;
 
 use crate::bv::{BvKind, Method};
-use crate::calibration::{BroadPhase, Calibration};
 use crate::error::{Error, Result};
 use crate::mesh::{check_positions, check_positions_f64, Mesh};
 use crate::options::{Options, Refit};
 use crate::par::Par;
 use crate::points::Points;
 use crate::precision::Precision;
-use crate::query::{contacts, Contacts};
 use crate::tree::RegionTree;
-use crate::walk::Workspace;
 use dhcd_kernels::lazy::LazyTiles;
 use dhcd_kernels::narrow::TriSoa;
 use dhcd_kernels::overlap::BoxRows;
@@ -335,6 +332,53 @@ impl<K: BvKind> Hierarchy<K> {
         }
     }
 
+    /// See [`Calibration::invalidate`](crate::calibration::Calibration::invalidate).
+    pub(crate) fn invalidate(&mut self) {
+        K::invalidate(&mut self.nodes);
+        self.tris.tiles.invalidate();
+        if let Some(edges) = self.edges.get_mut() {
+            edges.tiles.invalidate();
+        }
+    }
+
+    /// See [`Calibration::refit_nodes`](crate::calibration::Calibration::refit_nodes).
+    pub(crate) fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<u64> {
+        if let Some(&n) = ids.iter().find(|&&n| n as usize >= self.node_count()) {
+            return Err(Error::NodeOutOfRange {
+                node: n,
+                node_count: self.node_count(),
+            });
+        }
+        let mut groups: Vec<usize> = ids
+            .iter()
+            .map(|&n| self.tree.group_of(n as usize))
+            .collect();
+        groups.sort_unstable();
+        groups.dedup();
+        Ok(dhcd_kernels::arch().dispatch(RefitGroups {
+            h: self,
+            groups: &groups,
+            par,
+        }))
+    }
+
+    /// See [`Calibration::fitted_nodes`](crate::calibration::Calibration::fitted_nodes).
+    pub(crate) fn fitted_nodes(&self) -> Vec<u32> {
+        (0..self.node_count() as u32)
+            .filter(|&n| self.is_fitted(n as usize))
+            .collect()
+    }
+
+    /// Refits every stale node exactly; returns the number of nodes fitted.
+    pub(crate) fn refit_all(&mut self) -> u64 {
+        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, false)
+    }
+
+    /// Refits every stale node bottom-up; returns the number of nodes fitted.
+    pub(crate) fn refit_bottom_up(&mut self) -> u64 {
+        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, true)
+    }
+
     /// Sibling group `g`'s volumes, fitted first if stale (the refit kernels on `simd`);
     /// whether this call fitted them.
     #[inline]
@@ -481,61 +525,5 @@ impl<K: BvKind> Hierarchy<K> {
     /// shared topology is [`RegionTree::topology_bytes`]).
     pub fn bv_bytes(&self) -> usize {
         self.node_count() * self.bytes_per_node()
-    }
-}
-
-impl<K: BvKind> Calibration for Hierarchy<K> {
-    fn invalidate(&mut self) {
-        K::invalidate(&mut self.nodes);
-        self.tris.tiles.invalidate();
-        if let Some(edges) = self.edges.get_mut() {
-            edges.tiles.invalidate();
-        }
-    }
-
-    fn refit_nodes(&mut self, ids: &[u32], par: Par) -> Result<u64> {
-        if let Some(&n) = ids.iter().find(|&&n| n as usize >= self.node_count()) {
-            return Err(Error::NodeOutOfRange {
-                node: n,
-                node_count: self.node_count(),
-            });
-        }
-        let mut groups: Vec<usize> = ids
-            .iter()
-            .map(|&n| self.tree.group_of(n as usize))
-            .collect();
-        groups.sort_unstable();
-        groups.dedup();
-        Ok(dhcd_kernels::arch().dispatch(RefitGroups {
-            h: self,
-            groups: &groups,
-            par,
-        }))
-    }
-
-    fn fitted_nodes(&self) -> Vec<u32> {
-        (0..self.node_count() as u32)
-            .filter(|&n| self.is_fitted(n as usize))
-            .collect()
-    }
-
-    fn refit_all(&mut self) -> u64 {
-        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, false)
-    }
-
-    fn refit_bottom_up(&mut self) -> u64 {
-        crate::bv::refit_all::<K>(&mut self.nodes, &self.tree, &self.points, true)
-    }
-
-    fn broad_phase(&self, other: &Self, ws: &mut Workspace, par: Par) -> Result<BroadPhase> {
-        Ok(contacts::broad_phase(self, other, ws, par))
-    }
-
-    fn self_broad_phase(&self, ws: &mut Workspace, par: Par) -> BroadPhase {
-        contacts::self_broad_phase(self, ws, par)
-    }
-
-    fn narrow_phase(&self, other: &Self, leaves: &[[u32; 2]], par: Par) -> Result<Contacts> {
-        contacts::narrow_phase(self, other, leaves, par)
     }
 }

@@ -82,7 +82,6 @@
 //! order, no fused multiply-add; the canonical form's vertex choices are selects).
 
 use crate::lanes::{load_prefix, load_prefix_u32, mask_bits};
-use crate::reference::Verdict;
 use crate::Tile;
 use pulp::Simd;
 
@@ -461,6 +460,17 @@ impl Row {
     pub fn candidates(&self) -> u64 {
         self.contact | self.undecided
     }
+}
+
+/// The verdict on one pair (the unit of the scalar references in [`crate::reference`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Certainly disjoint.
+    Apart,
+    /// Certainly intersecting.
+    Contact,
+    /// Not certified either way.
+    Undecided,
 }
 
 /// [`pair_verdict`] with the union extents of the pair's boxes: the plane filter and the

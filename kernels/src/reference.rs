@@ -162,16 +162,7 @@ pub fn plane_separated(a: &[[f32; 3]; 3], b: &[[f32; 3]; 3]) -> bool {
     narrow::one_side(sa) || narrow::one_side(sb)
 }
 
-/// The verdict on one pair (the scalar reference's unit).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Verdict {
-    /// Certainly disjoint.
-    Apart,
-    /// Certainly intersecting.
-    Contact,
-    /// Not certified either way.
-    Undecided,
-}
+pub use crate::narrow::Verdict;
 
 /// The verdict of the plane filter and the certified canonical form on one pair (the
 /// [`narrow`] module doc), in the kernel's arithmetic, boxes from the corners.

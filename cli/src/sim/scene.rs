@@ -3,8 +3,9 @@
 use glam::DVec3;
 
 use super::pawn::pawn_mesh;
-use super::simulation::{splitmix64, SimConfig, Simulation};
+use super::simulation::{bounds, SimConfig, Simulation};
 use super::SimError;
+use dhcd::shapes::splitmix64;
 use dhcd::Mesh;
 
 /// Number of objects in [`pawn_scene`] and [`scene_with_mesh`] (the paper's eight pawns).
@@ -67,16 +68,4 @@ pub fn scene_with_mesh(mesh: Mesh, config: &SimConfig) -> Result<Simulation, Sim
         objects.push(Mesh::new(positions, mesh.triangles().to_vec())?);
     }
     Simulation::new(objects, config.clone())
-}
-
-/// Axis-aligned bounds of a point set, in f64.
-pub(crate) fn bounds(points: &[[f32; 3]]) -> (DVec3, DVec3) {
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for p in points {
-        let q = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
-        lo = lo.min(q);
-        hi = hi.max(q);
-    }
-    (lo, hi)
 }

@@ -269,7 +269,7 @@ impl Simulation {
         let h = config.frame_dt / f64::from(config.substeps);
         let mut scale: f64 = 0.0;
         for mesh in &objects {
-            let (lo, hi) = super::scene::bounds(mesh.positions());
+            let (lo, hi) = bounds(mesh.positions());
             scale = scale.max((hi - lo).max_element());
         }
         if !(scale.is_finite() && scale > 0.0) {
@@ -684,3 +684,15 @@ fn unit(x: u64) -> f64 {
 /// SplitMix64: a tiny, well-mixed, dependency-free generator; all we need for seeded
 /// phases and turns.
 pub(crate) use dhcd::shapes::splitmix64;
+
+/// Axis-aligned bounds of a point set, in f64.
+pub(crate) fn bounds(points: &[[f32; 3]]) -> (DVec3, DVec3) {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for p in points {
+        let q = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    (lo, hi)
+}
