@@ -1,9 +1,9 @@
 //! CCD over the real simulation steps (`../shared/data/real-frames/`, frame N -> N+1, `f64`):
 //! one iteration = `self_ccd` over the whole step, one thread, default options.
 //!
-//! Ids: `ccd/<frame>/<kind>` (every colliding pair with its time of impact) and
-//! `ccd-earliest/<frame>/<kind>` (the earliest time of impact, what a line search asks). The
-//! setup asserts that every kind finds the same pairs. Without the folder, nothing is
+//! Ids: `ccd/<frame>/<method>` (every colliding pair with its time of impact) and
+//! `ccd-earliest/<frame>/<method>` (the earliest time of impact, what a line search asks). The
+//! setup asserts that every method finds the same pairs. Without the folder, nothing is
 //! registered and a message says so. The IPC Toolkit's figure on the same steps comes from
 //! `benches/scripts/ccd-vs-ipctk.sh`. (The per-query bench on the sample queries is
 //! `benches/ccd.rs`.)

@@ -16,7 +16,7 @@
 //! cycle of `FRAMES` frames is computed once and each iteration applies the next one (lazy
 //! refit has real work every iteration).
 //!
-//! The setup asserts that dhcd's contacts (all three kinds) equal the exact brute force on a
+//! The setup asserts that dhcd's contacts (all three methods) equal the exact brute force on a
 //! few frames, and prints how parry's GJK contacts compare (not exact; not asserted).
 use dhcd::calibration::Calibration;
 use std::collections::BTreeSet;
@@ -24,7 +24,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
+use dhcd::bv::{Aabb, BoundingVolume, Dh, Sphere};
 use dhcd::{collide_with, Counters, Hierarchy, Mesh, Method, ObjectId, Options, Par, Workspace};
 use parry3d::bounding_volume::Aabb as PAabb;
 use parry3d::math::{Pose, Vector};
@@ -141,14 +141,14 @@ fn two_mut<T>(v: &mut [T], i: usize, j: usize) -> (&mut T, &mut T) {
     (&mut lo[i], &mut hi[0])
 }
 
-struct DhcdWorld<K: BvKind> {
+struct DhcdWorld<K: BoundingVolume> {
     hs: Vec<Hierarchy<K>>,
     ws: Workspace,
     /// Each pair's overlapping leaf pairs of the last [`DhcdWorld::hier`].
     leaves: Vec<Vec<[u32; 2]>>,
 }
 
-impl<K: BvKind> DhcdWorld<K> {
+impl<K: BoundingVolume> DhcdWorld<K> {
     fn new(scene: &Scene) -> Self {
         let hs = scene
             .meshes
@@ -352,7 +352,7 @@ fn check(scene: &Scene) {
     );
 }
 
-fn bench_kind<K: BvKind>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
+fn bench_kind<K: BoundingVolume>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
     let mut w = DhcdWorld::<K>::new(scene);
     let mut f = 0;
     c.bench_function(&format!("frame/{}/{id}", scene.name), |b| {

@@ -3,7 +3,7 @@
 //! one step = `update_positions_f64` to the other frame of a pair (alternating N and N+1) +
 //! `self_proximity`, one thread, default options.
 //!
-//! Ids: `proximity/<frame>/<kind>`. The setup asserts that every kind finds the same pairs
+//! Ids: `proximity/<frame>/<method>`. The setup asserts that every method finds the same pairs
 //! on both frames. Without the folder, nothing is registered and a message says so. The
 //! IPC Toolkit's figure on the same frames comes from `benches/scripts/proximity-vs-ipctk.sh`.
 //!
@@ -59,7 +59,7 @@ fn proximity(c: &mut Criterion) {
         for method in Method::ALL {
             let mut h = AnyHierarchy::new(method, &rest, Options::default()).expect("hierarchy");
             let mut ws = Workspace::default();
-            // Every kind finds the same pairs on both frames.
+            // Every method finds the same pairs on both frames.
             for f in &frames {
                 h.update_positions_f64(f).expect("a pose");
                 let mut p = h.self_proximity(d, &mut ws, Par::Seq).expect("distance");

@@ -31,7 +31,7 @@
 #include <stdlib.h>
 
 /**
- * Hierarchy kinds (`method` arguments).
+ * Hierarchy methods (`method` arguments).
  */
 #define DHCD_METHOD_DH 0
 #define DHCD_METHOD_SPHERE 1
@@ -97,7 +97,7 @@
 #define DHCD_ERR_LENGTH_MISMATCH -4
 
 /**
- * Two hierarchies of different kinds.
+ * Two hierarchies of different methods.
  */
 #define DHCD_ERR_WRONG_KIND -5
 
@@ -398,7 +398,7 @@ int dhcd_hierarchy_precision(const struct DhcdHierarchy *h, int *out);
 
 /**
  * All intersecting triangle pairs `[tri of a, tri of b]` between two hierarchies of the
- * same kind, into `*out` (release with `dhcd_contacts_free`). `a` and `b` must be
+ * same method, into `*out` (release with `dhcd_contacts_free`). `a` and `b` must be
  * different handles (use `dhcd_self_collide` for one object).
  *
  * # Safety
@@ -445,7 +445,7 @@ void dhcd_contacts_free(struct DhcdContacts *c);
 
 /**
  * Every vertex-triangle and edge-edge pair of `a` and `b` (two hierarchies of the same
- * kind) whose closed features are within distance `d` (finite, `>= 0`; else
+ * method) whose closed features are within distance `d` (finite, `>= 0`; else
  * `DHCD_ERR_INVALID_ARGUMENT`), decided exactly, into `*out` (see `DhcdProximity`; release
  * with `dhcd_proximity_free`). `a` and `b` must be different handles (use
  * `dhcd_self_proximity` for one object); they may differ in precision (each is exact for
@@ -520,7 +520,7 @@ int dhcd_self_ccd(struct DhcdHierarchy *h,
  * vertex of `b` (`face_vertex`) and every edge of `a` against every edge of `b`
  * (`edge_edge`) that touches during the step, `a` moving from `a0` to `a1` (`3 *
  * a_vertex_count` doubles each) and `b` from `b0` to `b1`, into `*out` (see `DhcdImpacts`;
- * release with `dhcd_impacts_free`). `a` and `b` are different handles of the same kind
+ * release with `dhcd_impacts_free`). `a` and `b` are different handles of the same method
  * (use `dhcd_self_ccd` for one mesh), of either precision; the other arguments as in
  * `dhcd_self_ccd`.
  *

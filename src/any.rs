@@ -1,5 +1,5 @@
-//! [`AnyHierarchy`]: the boundary where the bounding-volume kind is chosen at run time
-//! (CLI, experiment, C ABI). Everything inside is monomorphised per kind.
+//! [`AnyHierarchy`]: the boundary where the method is chosen at run time
+//! (CLI, experiment, C ABI). Everything inside is monomorphised per method.
 
 use std::sync::Arc;
 
@@ -7,8 +7,8 @@ use crate::bv::Method;
 use crate::calibration::{BroadPhase, Calibration};
 use crate::error::Result;
 use crate::hierarchy::{Hierarchy, InvariantError};
-use crate::kinds::{kinds, match_kind, match_kind_pair, with_kind};
 use crate::mesh::Mesh;
+use crate::methods::{match_method, match_method_pair, methods, with_method};
 use crate::options::Options;
 use crate::par::Par;
 use crate::precision::Precision;
@@ -19,9 +19,9 @@ use crate::query::{
 use crate::tree::RegionTree;
 use crate::walk::Workspace;
 
-kinds!(crate::kinds::kind_enum {
-    /// A hierarchy of a kind chosen at run time: one variant per row of the table of kinds
-    /// ([`crate::kinds`]).
+methods!(crate::methods::method_enum {
+    /// A hierarchy of a method chosen at run time: one variant per row of the table of methods
+    /// ([`crate::methods`]).
     #[derive(Clone, Debug)]
     #[non_exhaustive]
     pub enum AnyHierarchy(Hierarchy)
@@ -29,15 +29,15 @@ kinds!(crate::kinds::kind_enum {
 
 macro_rules! each {
     ($self:expr, $h:ident => $e:expr) => {
-        match_kind!(AnyHierarchy, $self, $h => $e)
+        match_method!(AnyHierarchy, $self, $h => $e)
     };
 }
 
-/// Applies `$e` to two hierarchies of the same kind (bound as `$a`, `$b`); a
-/// [`crate::Error::MethodMismatch`] when the kinds differ.
+/// Applies `$e` to two hierarchies of the same method (bound as `$a`, `$b`); a
+/// [`crate::Error::MethodMismatch`] when the methods differ.
 macro_rules! pairwise {
     ($x:expr, $y:expr, $a:ident, $b:ident => $e:expr) => {
-        match_kind_pair!(AnyHierarchy, $x, $y, $a, $b => $e)
+        match_method_pair!(AnyHierarchy, $x, $y, $a, $b => $e)
     };
 }
 
@@ -54,7 +54,7 @@ impl AnyHierarchy {
         mesh: &Mesh,
         options: Options,
     ) -> Result<Self> {
-        Ok(with_kind!(method, K => Hierarchy::<K>::with_tree(tree, mesh, options)?.into()))
+        Ok(with_method!(method, K => Hierarchy::<K>::with_tree(tree, mesh, options)?.into()))
     }
 
     /// See [`Hierarchy::update_positions`]: the number of volumes refitted now.
@@ -92,7 +92,7 @@ impl AnyHierarchy {
         each!(self, h => h.tree())
     }
 
-    /// Contacts between two hierarchies of the same kind; an error if the kinds differ.
+    /// Contacts between two hierarchies of the same method; an error if the methods differ.
     pub fn collide(&self, other: &AnyHierarchy, ws: &mut Workspace, par: Par) -> Result<Contacts> {
         pairwise!(self, other, a, b => collide_with(a, b, ws, par))
     }
@@ -102,8 +102,8 @@ impl AnyHierarchy {
         each!(self, h => self_collide_with(h, ws, par))
     }
 
-    /// Feature pairs within `d` between two hierarchies of the same kind (see
-    /// [`proximity`](crate::proximity())); an error if the kinds differ or `d` is invalid.
+    /// Feature pairs within `d` between two hierarchies of the same method (see
+    /// [`proximity`](crate::proximity())); an error if the methods differ or `d` is invalid.
     pub fn proximity(
         &self,
         other: &AnyHierarchy,
@@ -122,7 +122,7 @@ impl AnyHierarchy {
 
     /// Colliding feature pairs between this object moving by `motion` and `other` moving by
     /// `other_motion` over a step (see [`ccd_pair`](crate::ccd_pair())); an error if the
-    /// kinds differ or the input is invalid.
+    /// methods differ or the input is invalid.
     pub fn ccd_pair(
         &self,
         motion: Motion<'_>,
@@ -148,7 +148,7 @@ impl AnyHierarchy {
     }
 
     /// Intersection segments of contacts between `self` and `other` (see
-    /// [`contact_segments`](crate::segments::contact_segments)); an error if the kinds differ.
+    /// [`contact_segments`](crate::segments::contact_segments)); an error if the methods differ.
     pub fn contact_segments(
         &self,
         other: &AnyHierarchy,

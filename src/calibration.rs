@@ -23,7 +23,7 @@
 //! # Ok::<(), dhcd::Error>(())
 //! ```
 
-use crate::bv::BvKind;
+use crate::bv::BoundingVolume;
 use crate::error::Result;
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
@@ -72,7 +72,7 @@ pub trait Calibration {
     fn narrow_phase(&self, other: &Self, leaves: &[[u32; 2]], par: Par) -> Result<Contacts>;
 }
 
-impl<K: BvKind> Calibration for Hierarchy<K> {
+impl<K: BoundingVolume> Calibration for Hierarchy<K> {
     fn invalidate(&mut self) {
         Hierarchy::invalidate(self)
     }

@@ -1,9 +1,9 @@
 //! A bounding-volume hierarchy of one deformable mesh: the shared region tree, the live
-//! vertex positions (internal order), the node buffers of one kind, and the lazy-refit state.
+//! vertex positions (internal order), the node buffers of one method, and the lazy-refit state.
 
 use std::sync::Arc;
 
-use crate::bv::{BvKind, Method};
+use crate::bv::{BoundingVolume, Method};
 use crate::error::{Error, Result};
 use crate::mesh::{check_positions, check_positions_f64, Mesh};
 use crate::options::{Options, Refit};
@@ -27,10 +27,10 @@ pub struct InvariantError {
     pub record: String,
 }
 
-/// The hierarchy of one deformable mesh, for bounding-volume kind `K`
+/// The hierarchy of one deformable mesh, for method `K`
 /// ([`Dh`](crate::bv::Dh), [`Sphere`](crate::bv::Sphere) or [`Aabb`](crate::bv::Aabb)).
 #[derive(Clone, Debug)]
-pub struct Hierarchy<K: BvKind> {
+pub struct Hierarchy<K: BoundingVolume> {
     tree: Arc<RegionTree>,
     /// The current positions as `f32` (internal order): exact for an `f32` hierarchy, the
     /// nearest `f32`s of `exact` for an `f64` one. Bounds are fitted from them.
@@ -139,13 +139,13 @@ impl TriCache {
 }
 
 /// [`Hierarchy::refit_nodes`]'s fits of the stale `groups` on one dispatched backend.
-struct RefitGroups<'a, K: BvKind> {
+struct RefitGroups<'a, K: BoundingVolume> {
     h: &'a Hierarchy<K>,
     groups: &'a [usize],
     par: crate::par::Par,
 }
 
-impl<K: BvKind> pulp::WithSimd for RefitGroups<'_, K> {
+impl<K: BoundingVolume> pulp::WithSimd for RefitGroups<'_, K> {
     type Output = u64;
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) -> u64 {
@@ -227,7 +227,7 @@ fn three_rows(rows: &[f32], stride: usize, n: usize) -> Soa3<'_> {
     Soa3::new(row(0), row(1), row(2))
 }
 
-impl<K: BvKind> Hierarchy<K> {
+impl<K: BoundingVolume> Hierarchy<K> {
     /// Builds the region tree over `mesh` (its positions are the rest pose) and fits `K`'s
     /// volumes to it.
     pub fn new(mesh: &Mesh, options: Options) -> Result<Self> {
@@ -235,7 +235,7 @@ impl<K: BvKind> Hierarchy<K> {
         Self::with_tree(tree, mesh, options)
     }
 
-    /// Fits `K`'s volumes over an existing region tree of `mesh`, so several kinds can
+    /// Fits `K`'s volumes over an existing region tree of `mesh`, so several methods can
     /// share one tree (identical regions). The tree's shape is the given tree's: `options`'
     /// `levels` and `leaf_size` are not read.
     pub fn with_tree(tree: Arc<RegionTree>, mesh: &Mesh, options: Options) -> Result<Self> {

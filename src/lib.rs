@@ -42,8 +42,8 @@ pub mod distance;
 pub mod error;
 pub mod hierarchy;
 pub mod io;
-mod kinds;
 mod mesh;
+mod methods;
 #[doc(hidden)]
 pub mod narrow;
 mod options;

@@ -50,7 +50,7 @@ impl std::str::FromStr for Refit {
 }
 
 /// Which vertex of its region a DH node is centred on (chosen at build, fixed for life). The
-/// other kinds ignore it.
+/// other methods ignore it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum CentralVertex {
@@ -101,7 +101,7 @@ pub struct Options {
     /// Largest number of triangles in a leaf of an adaptive tree (ignored with `levels`).
     pub leaf_size: usize,
     pub refit: Refit,
-    /// The DH central vertex of every node (ignored by the other kinds).
+    /// The DH central vertex of every node (ignored by the other methods).
     pub central: CentralVertex,
 }
 

@@ -24,12 +24,12 @@ use std::borrow::Cow;
 use rayon::prelude::*;
 
 use crate::bv::swept::{box_over_step, f32_up, Step};
-use crate::bv::{BvKind, Method};
+use crate::bv::{BoundingVolume, Method};
 use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
-use crate::kinds::{kinds, match_kind, with_kind};
 use crate::mesh::{check_positions, Mesh};
+use crate::methods::{match_method, methods, with_method};
 use crate::options::Options;
 use crate::par::Par;
 use crate::precision::Precision;
@@ -128,7 +128,7 @@ pub struct SceneImpacts {
 
 /// One object of the scene.
 #[derive(Clone, Debug)]
-struct Object<K: BvKind> {
+struct Object<K: BoundingVolume> {
     id: u64,
     h: Hierarchy<K>,
     self_collision: bool,
@@ -138,7 +138,7 @@ struct Object<K: BvKind> {
     refitted: u64,
 }
 
-impl<K: BvKind> Object<K> {
+impl<K: BoundingVolume> Object<K> {
     /// The root box from the referenced vertices (finite: `update_positions` checks).
     ///
     /// PERF: the SIMD bounds kernel; a scalar `min`/`max` chain per axis waited on each
@@ -155,21 +155,21 @@ impl<K: BvKind> Object<K> {
     }
 }
 
-/// The objects of one kind, sorted by id.
+/// The objects of one method, sorted by id.
 type Objs<K> = Vec<Object<K>>;
 
-kinds!(crate::kinds::kind_enum {
+methods!(crate::methods::method_enum {
     #[derive(Clone, Debug)]
     enum Objects(Objs)
 });
 
 macro_rules! each {
     ($self:expr, $v:ident => $e:expr) => {
-        match_kind!(Objects, $self, $v => $e)
+        match_method!(Objects, $self, $v => $e)
     };
 }
 
-/// A set of deformable objects of one bounding-volume kind.
+/// A set of deformable objects of one method.
 ///
 /// ```
 /// use dhcd::{scene::Scene, shapes, Method, Options, Par};
@@ -205,9 +205,9 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// An empty scene whose objects get hierarchies of kind `method` built with `options`.
+    /// An empty scene whose objects get hierarchies of method `method` built with `options`.
     pub fn new(method: Method, options: Options) -> Self {
-        let objects = with_kind!(method, K => Objs::<K>::new().into());
+        let objects = with_method!(method, K => Objs::<K>::new().into());
         Self {
             options,
             next_id: 0,
@@ -479,7 +479,11 @@ impl Scene {
     }
 }
 
-fn proximity_of<K: BvKind>(objects: &mut [Object<K>], d: f64, parallel: bool) -> SceneProximity {
+fn proximity_of<K: BoundingVolume>(
+    objects: &mut [Object<K>],
+    d: f64,
+    parallel: bool,
+) -> SceneProximity {
     let within = Within::distance(d);
     let boxes = objects.iter().map(|o| o.bounds);
     let (jobs, broad_phase_tests) = jobs_of(objects, boxes, within.margin);
@@ -539,7 +543,7 @@ fn broad_phase(bounds: &[[[f32; 3]; 2]]) -> (Vec<(usize, usize)>, u64) {
 /// Applies `slot[i]` to object `i` (in parallel in the ambient pool if `parallel`), after
 /// checking every one: on error (the first failing object in scene order, whatever
 /// `parallel`) nothing changes.
-fn update_objects<K: BvKind>(
+fn update_objects<K: BoundingVolume>(
     objects: &mut [Object<K>],
     slot: &[Option<&[[f32; 3]]>],
     parallel: bool,
@@ -586,7 +590,7 @@ fn map_objects<R: Send>(n: usize, parallel: bool, f: impl Fn(usize) -> R + Sync 
 /// The jobs of a query: the object pairs whose boxes (`boxes`, one per object: the root
 /// boxes of the pose, or the boxes over a step), grown by `margin`, overlap, and the objects
 /// with self-collision on (`(a, a)`), sorted; and the broad phase's box tests.
-fn jobs_of<K: BvKind>(
+fn jobs_of<K: BoundingVolume>(
     objects: &[Object<K>],
     boxes: impl Iterator<Item = [[f32; 3]; 2]>,
     margin: f32,
@@ -619,7 +623,7 @@ fn jobs_of<K: BvKind>(
 /// group once, whoever needs it first; each query may also split its own walk on the same
 /// pool), and credits each object's refits (the nodes fitted on it in every job, plus its
 /// eager refits) to its first job: results in job order, each with its counters.
-fn run_jobs<K: BvKind, R: Send>(
+fn run_jobs<K: BoundingVolume, R: Send>(
     objects: &mut [Object<K>],
     jobs: &[(usize, usize)],
     parallel: bool,
@@ -691,7 +695,7 @@ fn credit_refits<R>(
     results.into_iter().map(|(r, _)| r).collect()
 }
 
-fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
+fn contacts_of<K: BoundingVolume>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
     let (jobs, broad_phase_tests) = jobs_of(objects, objects.iter().map(|o| o.bounds), 0.0);
     let results = run_jobs(
         objects,
@@ -730,7 +734,7 @@ fn contacts_of<K: BvKind>(objects: &mut [Object<K>], parallel: bool) -> SceneCon
 
 /// [`Scene::ccd`] once the ids and options are checked: `motions[i]` is object `i`'s motion
 /// (`None`: still).
-fn ccd_of<K: BvKind>(
+fn ccd_of<K: BoundingVolume>(
     objects: &[Object<K>],
     motions: &[Option<Motion<'_>>],
     query: &CcdQuery,

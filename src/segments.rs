@@ -2,7 +2,7 @@
 //! need contact points rather than triangle pairs. The queries never compute it; call these
 //! on their results, in the same pose.
 
-use crate::bv::BvKind;
+use crate::bv::BoundingVolume;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::narrow::intersection_segment;
@@ -12,12 +12,12 @@ use crate::narrow::intersection_segment;
 pub type Segment = [[f32; 3]; 2];
 
 /// Corners of triangles by the caller's original index, in a hierarchy's current pose.
-pub(crate) struct OriginalCorners<'h, K: BvKind> {
+pub(crate) struct OriginalCorners<'h, K: BoundingVolume> {
     h: &'h Hierarchy<K>,
     slot: Vec<u32>,
 }
 
-impl<'h, K: BvKind> OriginalCorners<'h, K> {
+impl<'h, K: BoundingVolume> OriginalCorners<'h, K> {
     pub(crate) fn new(h: &'h Hierarchy<K>) -> Self {
         let order = h.tree().tri_order();
         let mut slot = vec![0; order.len()];
@@ -55,7 +55,7 @@ impl<'h, K: BvKind> OriginalCorners<'h, K> {
 /// assert!(seg[0].iter().all(|p| p[2] == 0.0)); // on A's plane z = 0
 /// # Ok::<(), dhcd::Error>(())
 /// ```
-pub fn contact_segments<K: BvKind>(
+pub fn contact_segments<K: BoundingVolume>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
     pairs: &[[u32; 2]],
@@ -68,7 +68,7 @@ pub fn contact_segments<K: BvKind>(
 }
 
 /// [`contact_segments`] for self-contacts of one hierarchy.
-pub fn self_contact_segments<K: BvKind>(
+pub fn self_contact_segments<K: BoundingVolume>(
     h: &Hierarchy<K>,
     pairs: &[[u32; 2]],
 ) -> Result<Vec<Segment>> {

@@ -1,15 +1,15 @@
 //! CCD over whole meshes ([`dhcd::self_ccd`], [`dhcd::ccd_pair`]): every colliding
 //! vertex-triangle and edge-edge pair equal to the brute force over every pair (the exact
-//! tests of `dhcd::ccd`), for every kind, 1 and 2 threads, both modes, minimum distances;
+//! tests of `dhcd::ccd`), for every method, 1 and 2 threads, both modes, minimum distances;
 //! and every labelled pair of the real simulation steps through the whole pipeline.
 
-use dhcd::bv::BvKind;
+use dhcd::bv::BoundingVolume;
 use dhcd::ccd::CcdOptions;
 use dhcd::io::{load_as, Limits};
 use dhcd::narrow::{brute_force_ccd, brute_force_self_ccd};
 use dhcd::shapes::{grid, icosphere, jitter, splitmix64, wave};
 use dhcd::{
-    ccd_pair_with, for_each_kind, self_ccd_with, CcdMode, CcdQuery, Error, Hierarchy, Impacts,
+    ccd_pair_with, for_each_method, self_ccd_with, CcdMode, CcdQuery, Error, Hierarchy, Impacts,
     Mesh, Motion, Options, Par, Precision, Workspace,
 };
 
@@ -39,7 +39,13 @@ fn earliest_of(all: &Impacts) -> Impacts {
     e
 }
 
-fn check_self<K: BvKind>(m: &Mesh, x0: &[[f64; 3]], x1: &[[f64; 3]], deltas: &[f64], what: &str) {
+fn check_self<K: BoundingVolume>(
+    m: &Mesh,
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    deltas: &[f64],
+    what: &str,
+) {
     let h = Hierarchy::<K>::new(m, Options::default()).unwrap();
     let motion = Motion::new(x0, x1);
     for &d in deltas {
@@ -61,7 +67,7 @@ fn check_self<K: BvKind>(m: &Mesh, x0: &[[f64; 3]], x1: &[[f64; 3]], deltas: &[f
 }
 
 #[allow(clippy::too_many_arguments)]
-fn check_pair<K: BvKind>(
+fn check_pair<K: BoundingVolume>(
     a: &Mesh,
     am: Motion<'_>,
     b: &Mesh,
@@ -93,7 +99,7 @@ fn check_pair<K: BvKind>(
 }
 
 /// Two spheres flying through each other within the step: at t0 and t1 apart, so a
-/// discrete test at either end sees nothing (tunnelling); every kind finds the same pairs.
+/// discrete test at either end sees nothing (tunnelling); every method finds the same pairs.
 #[test]
 fn spheres_tunnelling_through_each_other() {
     let a = icosphere(1, 0.5, [0.0; 3]);
@@ -109,7 +115,7 @@ fn spheres_tunnelling_through_each_other() {
     let (am, bm) = (Motion::new(&a0, &a1), Motion::new(&b0, &b1));
     let all = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
     assert!(all.counters.contacts > 20 && all.toi.unwrap() > 0.0 && all.toi.unwrap() < 1.0);
-    for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "spheres"));
+    for_each_method!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "spheres"));
 }
 
 /// A sheet folding onto itself over the step, with jitter: self-CCD against the brute
@@ -121,7 +127,7 @@ fn folding_sheet_self_ccd() {
     let x1 = crate::fixtures::folded_through(&x0, 1.0);
     let all = brute_force_self_ccd(&g, Motion::new(&x0, &x1), &CcdOptions::default());
     assert!(all.counters.contacts > 0);
-    for_each_kind!(K => check_self::<K>(&g, &x0, &x1, &[0.0], "folding sheet"));
+    for_each_method!(K => check_self::<K>(&g, &x0, &x1, &[0.0], "folding sheet"));
 }
 
 /// Random motions of a deformed sphere (vertices moving far relative to the triangles), and
@@ -140,8 +146,8 @@ fn random_motions_and_still_meshes() {
             })
         })
         .collect();
-    for_each_kind!(K => check_self::<K>(&m, &x0, &x1, &[0.0], "random"));
-    for_each_kind!(K => check_self::<K>(&m, &x0, &x0, &[0.0], "still"));
+    for_each_method!(K => check_self::<K>(&m, &x0, &x1, &[0.0], "random"));
+    for_each_method!(K => check_self::<K>(&m, &x0, &x0, &[0.0], "still"));
 }
 
 /// Degenerate motions: grids sliding in their common plane (coplanar motion all step,
@@ -162,14 +168,14 @@ fn coplanar_sliding_and_contact_at_the_end() {
     let (am, bm) = (Motion::new(&a0, &a0), Motion::new(&b0, &b1));
     let all = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
     assert!(all.counters.contacts > 0);
-    for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "coplanar"));
+    for_each_method!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "coplanar"));
     // b descends onto a, touching at exactly t = 1.
     let b0: Vec<[f64; 3]> = a0.iter().map(|p| [p[0] + 0.1, p[1] + 0.1, 0.5]).collect();
     let b1: Vec<[f64; 3]> = a0.iter().map(|p| [p[0] + 0.1, p[1] + 0.1, 0.0]).collect();
     let bm = Motion::new(&b0, &b1);
     let all = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
     assert_eq!(all.toi, Some(1.0));
-    for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "contact at t = 1"));
+    for_each_method!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "contact at t = 1"));
 }
 
 /// A minimum distance `delta > 0` (pairs collide when they come within it): two spheres
@@ -189,7 +195,7 @@ fn minimum_distance_small_meshes() {
     let near = brute_force_ccd(&a, am, &b, bm, &CcdOptions::new(1.0, 0.1).unwrap());
     let touch = brute_force_ccd(&a, am, &b, bm, &CcdOptions::default());
     assert!(near.counters.contacts > touch.counters.contacts);
-    for_each_kind!(K => check_pair::<K>(&a, am, &b, bm, &[0.05], "spheres near"));
+    for_each_method!(K => check_pair::<K>(&a, am, &b, bm, &[0.05], "spheres near"));
     let g = grid(3, 3, 0.1, [0.0; 3]);
     let x0 = f64s(g.positions());
     let x1: Vec<[f64; 3]> = x0
@@ -202,7 +208,7 @@ fn minimum_distance_small_meshes() {
             }
         })
         .collect();
-    for_each_kind!(K => check_self::<K>(&g, &x0, &x1, &[0.03], "folding near"));
+    for_each_method!(K => check_self::<K>(&g, &x0, &x1, &[0.03], "folding near"));
 }
 
 #[test]
@@ -246,7 +252,7 @@ fn bad_input_is_a_typed_error() {
 /// The real simulation steps of `../shared/data/real-frames` through the whole pipeline
 /// (loader at f64, DH walk over the step, feature culling, exact test): every labelled pair
 /// of `../shared/data/ccd/frame-truth` is reported iff its label is 1. The rod-twist step
-/// also runs every kind and 1 thread against 2.
+/// also runs every method and 1 thread against 2.
 #[test]
 fn frame_truth_through_the_pipeline() {
     let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
@@ -309,7 +315,7 @@ fn frame_truth_through_the_pipeline() {
             wrong[..wrong.len().min(20)].join("\n")
         );
         if name.starts_with("rod") {
-            for_each_kind!(K => {
+            for_each_method!(K => {
                 let hk = Hierarchy::<K>::new(&m0, Options::default()).unwrap();
                 for (par, mode) in [(Par::Seq, CcdMode::All), (Par::Rayon(2), CcdMode::Earliest)] {
                     let q = CcdQuery { mode, ..CcdQuery::default() };

@@ -1,12 +1,12 @@
-//! The hierarchies against the exact brute-force oracle: every kind, many poses, deforming
+//! The hierarchies against the exact brute-force oracle: every method, many poses, deforming
 //! sequences, all refit modes, bad input.
 
-use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
+use dhcd::bv::{Aabb, BoundingVolume, Dh, Sphere};
 use dhcd::calibration::Calibration;
 use dhcd::narrow::brute_force_pairs;
 use dhcd::shapes::{grid, icosphere, translated, wave};
 use dhcd::{
-    collide, for_each_kind, CentralVertex, Error, Hierarchy, Mesh, Method, Options, Refit,
+    collide, for_each_method, CentralVertex, Error, Hierarchy, Mesh, Method, Options, Refit,
     RegionTree,
 };
 use proptest::prelude::*;
@@ -17,8 +17,8 @@ fn with_positions(mesh: &Mesh, positions: Vec<[f32; 3]>) -> Mesh {
     Mesh::new(positions, mesh.triangles().to_vec()).unwrap()
 }
 
-/// Collides `a` and `b` (rest poses) with kind `K`, checks invariants, returns the pairs.
-fn pairs_of<K: BvKind>(a: &Mesh, b: &Mesh, options: Options) -> Vec<[u32; 2]> {
+/// Collides `a` and `b` (rest poses) with method `K`, checks invariants, returns the pairs.
+fn pairs_of<K: BoundingVolume>(a: &Mesh, b: &Mesh, options: Options) -> Vec<[u32; 2]> {
     let ha = Hierarchy::<K>::new(a, options).unwrap();
     let hb = Hierarchy::<K>::new(b, options).unwrap();
     ha.tree().check_topology(a).unwrap();
@@ -35,14 +35,14 @@ fn pairs_of<K: BvKind>(a: &Mesh, b: &Mesh, options: Options) -> Vec<[u32; 2]> {
     c.pairs
 }
 
-/// Every kind returns exactly the brute-force set.
+/// Every method returns exactly the brute-force set.
 fn assert_exact(a: &Mesh, b: &Mesh, levels: usize) -> Vec<[u32; 2]> {
     let expected = brute_force_pairs(a, b);
     let options = Options {
         levels: Some(levels),
         ..Options::default()
     };
-    for_each_kind!(K => assert_eq!(
+    for_each_method!(K => assert_eq!(
         pairs_of::<K>(a, b, options),
         expected,
         "{}, levels {levels}",
@@ -127,8 +127,8 @@ fn degenerate_triangles_at_build() {
 }
 
 /// A deforming sequence: two spheres wobble through each other for `steps` steps; every step
-/// compares every kind and refit mode with brute force and checks invariants after refit.
-fn deforming_sequence<K: BvKind>(
+/// compares every method and refit mode with brute force and checks invariants after refit.
+fn deforming_sequence<K: BoundingVolume>(
     refit: Refit,
     central: CentralVertex,
     steps: usize,
@@ -181,7 +181,7 @@ fn deforming_sequences_all_kinds_all_refit_modes() {
             "the spheres must meet"
         );
         for central in CentralVertex::ALL {
-            for_each_kind!(K => if K::METHOD != Method::Dh || central != CentralVertex::default() {
+            for_each_method!(K => if K::METHOD != Method::Dh || central != CentralVertex::default() {
                 assert_eq!(dh, deforming_sequence::<K>(refit, central, 24));
             });
         }
@@ -451,7 +451,7 @@ proptest! {
 
 /// Runs a deforming sequence with the given parallelism and grain; returns every step's
 /// contacts and counters.
-fn sequence_with<K: BvKind>(par: dhcd::Par, grain: usize) -> Vec<dhcd::Contacts> {
+fn sequence_with<K: BoundingVolume>(par: dhcd::Par, grain: usize) -> Vec<dhcd::Contacts> {
     let a = icosphere(3, 1.0, [0.0, 0.0, 0.0]);
     let b = icosphere(3, 0.9, [0.0, 0.0, 0.0]);
     let mut ha = Hierarchy::<K>::new(&a, Options::default()).unwrap();
@@ -477,7 +477,7 @@ fn sequence_with<K: BvKind>(par: dhcd::Par, grain: usize) -> Vec<dhcd::Contacts>
         .collect()
 }
 
-fn parallel_equals_sequential_for<K: BvKind>() {
+fn parallel_equals_sequential_for<K: BoundingVolume>() {
     let seq = sequence_with::<K>(dhcd::Par::Seq, 1024);
     assert!(seq.iter().any(|c| !c.pairs.is_empty()));
     for threads in [1, 2, 3] {
@@ -497,7 +497,7 @@ fn parallel_equals_sequential_for<K: BvKind>() {
 
 #[test]
 fn parallel_equals_sequential_every_kind() {
-    for_each_kind!(K => parallel_equals_sequential_for::<K>());
+    for_each_method!(K => parallel_equals_sequential_for::<K>());
 }
 
 #[test]

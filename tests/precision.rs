@@ -167,11 +167,11 @@ fn real_frames_read_as_f64_keep_their_doubles() {
 // f64 hierarchies: bounds enclose the exact points, contacts are exact for the f64 input
 // ---------------------------------------------------------------------------------------------
 
-use dhcd::bv::BvKind;
+use dhcd::bv::BoundingVolume;
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs};
 use dhcd::shapes::splitmix64;
 use dhcd::{
-    collide_with, for_each_kind, self_collide_with, Hierarchy, Options, Par, Refit, Workspace,
+    collide_with, for_each_method, self_collide_with, Hierarchy, Options, Par, Refit, Workspace,
 };
 
 fn unit(state: &mut u64) -> f64 {
@@ -246,7 +246,7 @@ fn rounding_to_f32_changes_near_touching_answers() {
     assert!(exact.iter().all(|p| p[0] == p[1]));
 }
 
-fn f64_contacts_for<K: BvKind>() {
+fn f64_contacts_for<K: BoundingVolume>() {
     let (a, b) = near_touching(200, 11);
     let exact = brute_force_pairs(&a, &b);
     for refit in [Refit::Lazy, Refit::Eager, Refit::EagerBottomUp] {
@@ -313,11 +313,11 @@ fn f64_contacts_for<K: BvKind>() {
 
 #[test]
 fn f64_contacts_are_exact_for_every_kind() {
-    for_each_kind!(K => f64_contacts_for::<K>());
+    for_each_method!(K => f64_contacts_for::<K>());
 }
 
 /// The real rod frames (f64): contacts of an f64 hierarchy equal the exact f64 brute force on
-/// a slab of the rod (the whole frame would take minutes of brute force), for every kind.
+/// a slab of the rod (the whole frame would take minutes of brute force), for every method.
 #[test]
 fn f64_hierarchy_bounds_hold_on_a_real_frame() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
@@ -333,7 +333,7 @@ fn f64_hierarchy_bounds_hold_on_a_real_frame() {
         Precision::F64,
     )
     .unwrap();
-    for_each_kind!(K => {
+    for_each_method!(K => {
         let mut h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
         assert_eq!(h.validate().unwrap(), h.node_count());
         let c = self_collide_with(&h, &mut Workspace::default(), Par::Rayon(2));

@@ -1,11 +1,11 @@
 //! Proximity queries: every vertex-triangle and edge-edge pair within a distance, exact,
-//! equal to the brute force for every kind and thread count, `f64` included.
+//! equal to the brute force for every method and thread count, `f64` included.
 
-use dhcd::bv::BvKind;
+use dhcd::bv::BoundingVolume;
 use dhcd::narrow::{brute_force_proximity, brute_force_self_proximity};
 use dhcd::shapes::{grid, icosphere, jitter, wave};
 use dhcd::{
-    for_each_kind, proximity_with, self_proximity_with, Error, Hierarchy, Mesh, Options, Par,
+    for_each_method, proximity_with, self_proximity_with, Error, Hierarchy, Mesh, Options, Par,
     Proximity, Workspace,
 };
 
@@ -23,7 +23,7 @@ fn assert_same(got: &Proximity, want: &Proximity, what: &str) {
     assert!(got.counters.prim_tests >= got.counters.contacts, "{what}");
 }
 
-fn pair_for<K: BvKind>(a: &Mesh, b: &Mesh, distances: &[f64], what: &str) {
+fn pair_for<K: BoundingVolume>(a: &Mesh, b: &Mesh, distances: &[f64], what: &str) {
     let (ha, hb) = (
         Hierarchy::<K>::new(a, Options::default()).unwrap(),
         Hierarchy::<K>::new(b, Options::default()).unwrap(),
@@ -41,7 +41,7 @@ fn pair_for<K: BvKind>(a: &Mesh, b: &Mesh, distances: &[f64], what: &str) {
     }
 }
 
-fn self_for<K: BvKind>(m: &Mesh, distances: &[f64], what: &str) {
+fn self_for<K: BoundingVolume>(m: &Mesh, distances: &[f64], what: &str) {
     let h = Hierarchy::<K>::new(m, Options::default()).unwrap();
     for &d in distances {
         let want = brute_force_self_proximity(m, d);
@@ -63,7 +63,7 @@ fn two_deformed_spheres_every_kind() {
     let a = with_positions(&a, wave(a.positions(), 0.4, 0.05, [0.0; 3]));
     let b = with_positions(&b, jitter(b.positions(), [0.01; 3], 3));
     let ds = [0.0, 0.02, 0.1, 0.3];
-    for_each_kind!(K => pair_for::<K>(&a, &b, &ds, "spheres"));
+    for_each_method!(K => pair_for::<K>(&a, &b, &ds, "spheres"));
 }
 
 /// A folded, jittered sheet: its layers come within the distance of each other, and every
@@ -84,7 +84,7 @@ fn folded_sheet_self_proximity_every_kind() {
         .collect();
     let m = with_positions(&g, jitter(&folded, [0.003; 3], 9));
     let ds = [0.0, 0.03, 0.08, 0.15];
-    for_each_kind!(K => self_for::<K>(&m, &ds, "folded sheet"));
+    for_each_method!(K => self_for::<K>(&m, &ds, "folded sheet"));
 }
 
 /// Parallel grids `0.25` apart (exact in binary): at `d = 0.25` every vertex above a
@@ -95,7 +95,7 @@ fn distance_equal_to_d_to_the_last_bit() {
     let a = grid(4, 4, 0.5, [0.0, 0.0, 0.0]);
     let b = grid(4, 4, 0.5, [0.0, 0.0, 0.25]);
     let at = 0.25f64;
-    for_each_kind!(K => {
+    for_each_method!(K => {
         let (ha, hb) = (
             Hierarchy::<K>::new(&a, Options::default()).unwrap(),
             Hierarchy::<K>::new(&b, Options::default()).unwrap(),
@@ -120,7 +120,7 @@ fn f64_proximity_is_exact_for_the_f64_input() {
     let a = Mesh::new_f64(pa, g.triangles().to_vec()).unwrap();
     let b = Mesh::new_f64(pb, g.triangles().to_vec()).unwrap();
     assert_eq!(a.positions(), b.positions(), "the f32 roundings coincide");
-    for_each_kind!(K => {
+    for_each_method!(K => {
         let (ha, hb) = (
             Hierarchy::<K>::new(&a, Options::default()).unwrap(),
             Hierarchy::<K>::new(&b, Options::default()).unwrap(),
@@ -139,7 +139,7 @@ fn all_kinds_give_the_same_pairs() {
     let m = icosphere(3, 1.0, [0.0; 3]);
     let m = with_positions(&m, wave(m.positions(), 1.3, 0.4, [0.0; 3]));
     let mut results = Vec::new();
-    for_each_kind!(K => {
+    for_each_method!(K => {
         let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
         let mut p = self_proximity_with(&h, 0.05, &mut Workspace::default(), Par::Rayon(2)).unwrap();
         p.counters = Default::default();

@@ -1,6 +1,6 @@
 //! Real simulation frames (`../shared/data/real-frames/`, beside the checkout; see its
-//! README): exact self-collision counts on every frame, for every kind, on a fresh build and
-//! after a refit from the other frame of the pair; identical pairs for the three kinds;
+//! README): exact self-collision counts on every frame, for every method, on a fresh build and
+//! after a refit from the other frame of the pair; identical pairs for the three methods;
 //! two threads equal to one (pairs and counters); invariants after build and refit.
 //!
 //! The expected counts are the README's (an independent exact brute force, confirmed by
@@ -80,7 +80,7 @@ fn validate_all(h: &mut AnyHierarchy, what: &str) {
 
 /// Both frames of a pair, every kind: build on `first`, query, refit to `second`, query;
 /// then build on `second`, query, refit to `first`, query. Every count is the README's, the
-/// three kinds' pair lists are identical, two threads equal one on every frame (on the
+/// three methods' pair lists are identical, two threads equal one on every frame (on the
 /// refit path), and the invariants hold after the build and after every query.
 fn check_pair(first: &str, second: &str) {
     let Some(dir) = frames_dir(&format!("{first}+{second}")) else {
@@ -111,7 +111,7 @@ fn check_pair(first: &str, second: &str) {
                     names[frame],
                     if frame == build { "" } else { " (refit)" }
                 );
-                // Two threads on the refit path: each frame once per kind.
+                // Two threads on the refit path: each frame once per method.
                 let refit = (frame != build).then(|| meshes[frame].positions());
                 let c = self_collide_at(&mut h, refit, &what);
                 assert_eq!(c.pairs.len(), expected(names[frame]), "{what}: contacts");

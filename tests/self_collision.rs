@@ -1,12 +1,12 @@
 //! Self-collision against the brute-force oracle: folded and crumpled meshes, many poses,
-//! every kind and refit mode, parallel == sequential.
+//! every method and refit mode, parallel == sequential.
 
-use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
+use dhcd::bv::{Aabb, BoundingVolume, Dh, Sphere};
 use dhcd::calibration::Calibration;
 use dhcd::narrow::brute_force_self_pairs;
 use dhcd::shapes::{grid, icosphere, wave};
 use dhcd::{
-    for_each_kind, self_collide, self_collide_with, CentralVertex, Hierarchy, Mesh, Options, Par,
+    for_each_method, self_collide, self_collide_with, CentralVertex, Hierarchy, Mesh, Options, Par,
     Refit, Workspace,
 };
 
@@ -40,9 +40,9 @@ fn crumpled_sphere(subdivisions: u32, t: f32, amplitude: f32) -> (Mesh, Vec<[f32
     (s, posed)
 }
 
-/// Self-contacts of `posed` (a pose of `rest`) with kind `K` equal brute force, after a
+/// Self-contacts of `posed` (a pose of `rest`) with method `K` equal brute force, after a
 /// build on the rest pose and a lazy (or eager) update; invariants hold.
-fn check<K: BvKind>(rest: &Mesh, posed: &[[f32; 3]], options: Options) -> Vec<[u32; 2]> {
+fn check<K: BoundingVolume>(rest: &Mesh, posed: &[[f32; 3]], options: Options) -> Vec<[u32; 2]> {
     let expected = brute_force_self_pairs(&with_positions(rest, posed.to_vec()));
     let mut h = Hierarchy::<K>::new(rest, options).unwrap();
     h.update_positions(posed).unwrap();
@@ -68,7 +68,7 @@ fn check_all(rest: &Mesh, posed: &[[f32; 3]], levels: usize) -> usize {
                 central,
                 ..Options::default()
             };
-            for_each_kind!(K => found = check::<K>(rest, posed, options).len());
+            for_each_method!(K => found = check::<K>(rest, posed, options).len());
         }
     }
     found
@@ -157,7 +157,7 @@ fn single_triangle_and_shared_vertices() {
 }
 
 /// A deforming crumpling sequence with the given parallelism and grain.
-fn sequence<K: BvKind>(par: Par, grain: usize) -> Vec<dhcd::Contacts> {
+fn sequence<K: BoundingVolume>(par: Par, grain: usize) -> Vec<dhcd::Contacts> {
     let s = icosphere(3, 1.0, [0.0; 3]);
     let mut h = Hierarchy::<K>::new(&s, Options::default()).unwrap();
     let mut ws = Workspace::with_grain(grain);
@@ -172,7 +172,7 @@ fn sequence<K: BvKind>(par: Par, grain: usize) -> Vec<dhcd::Contacts> {
         .collect()
 }
 
-fn parallel_equals_sequential_for<K: BvKind>() {
+fn parallel_equals_sequential_for<K: BoundingVolume>() {
     let seq = sequence::<K>(Par::Seq, 1024);
     assert!(seq.iter().any(|c| !c.pairs.is_empty()));
     for threads in [1, 2, 3] {
@@ -217,7 +217,7 @@ fn any_hierarchy_self_collide_matches_generic() {
 /// The self broad phase is the self query without its triangle tests: the same node tests,
 /// refits and counted triangle pairs, no contacts, leaf pairs `[x, y]` with `x <= y` (a leaf
 /// with itself included), the same for every thread count.
-fn self_broad_phase_matches_query_for<K: BvKind>() {
+fn self_broad_phase_matches_query_for<K: BoundingVolume>() {
     let (rest, _) = folded_grid(12, 0.0, 0.0);
     let mut found_pairs = false;
     for step in 0..3 {

@@ -1,6 +1,6 @@
 //! Self-collision steps on a cycle of frames, shared by the `real` and `scale` benches: one
 //! step = new positions (refit) + self-collision, on one thread, default options, for dhcd's
-//! kinds and for parry3d as a user of its deformable `TriMesh` would run it.
+//! methods and for parry3d as a user of its deformable `TriMesh` would run it.
 //!
 //! parry3d: one `Bvh` leaf per triangle, built once on the first frame (`Binned`, as
 //! `TriMesh` does); per step every leaf box is updated from the new positions and the tree

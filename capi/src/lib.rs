@@ -7,7 +7,7 @@
 //!   single-pair CCD calls return 1 (collide) or 0 (do not) on success;
 //! - no panic crosses the boundary: every entry runs inside `catch_unwind` and a panic
 //!   becomes [`DHCD_ERR_PANIC`];
-//! - null pointers, misaligned arrays, mismatched lengths and hierarchies of different kinds
+//! - null pointers, misaligned arrays, mismatched lengths and hierarchies of different methods
 //!   are errors, never undefined behaviour on the library's side;
 //! - handles (`DhcdHierarchy`, `DhcdScene`) are created by `*_new` and released by
 //!   `*_free`; results (`DhcdContacts`, `DhcdSceneContacts`, `DhcdProximity`,
@@ -65,7 +65,7 @@ pub const DHCD_ERR_INVALID_MESH: c_int = -3;
 /// A position update (or CCD positions at t0 and t1) whose vertex count differs from the
 /// mesh's.
 pub const DHCD_ERR_LENGTH_MISMATCH: c_int = -4;
-/// Two hierarchies of different kinds.
+/// Two hierarchies of different methods.
 pub const DHCD_ERR_WRONG_KIND: c_int = -5;
 /// No object with this id in the scene.
 pub const DHCD_ERR_UNKNOWN_OBJECT: c_int = -6;
@@ -85,8 +85,8 @@ pub const DHCD_PRECISION_F32: c_int = 32;
 /// `dhcd_hierarchy_precision` of a hierarchy built from `double` positions.
 pub const DHCD_PRECISION_F64: c_int = 64;
 
-// The kinds' numbers (`DHCD_METHOD_DH` = 0, ...) are not constants here: they are
-// `Method::code()`, from the library's table of kinds, and the header's `DHCD_METHOD_*`
+// The methods' numbers (`DHCD_METHOD_DH` = 0, ...) are not constants here: they are
+// `Method::code()`, from the library's table of methods, and the header's `DHCD_METHOD_*`
 // defines are generated from that table with the rest of the header (capi/tests/capi.rs).
 // Likewise the distance types' numbers (`DHCD_PT_*`, `DHCD_EE_*`) are the library's
 // `PointTriangle` / `EdgeEdge` discriminants (IPC's), generated from their `ALL` tables.
@@ -961,7 +961,7 @@ fn precision_code(p: Precision) -> Result<c_int, Fail> {
 }
 
 /// All intersecting triangle pairs `[tri of a, tri of b]` between two hierarchies of the
-/// same kind, into `*out` (release with `dhcd_contacts_free`). `a` and `b` must be
+/// same method, into `*out` (release with `dhcd_contacts_free`). `a` and `b` must be
 /// different handles (use `dhcd_self_collide` for one object).
 ///
 /// # Safety
@@ -1071,7 +1071,7 @@ pub unsafe extern "C" fn dhcd_contacts_free(c: *mut DhcdContacts) {
 }
 
 /// Every vertex-triangle and edge-edge pair of `a` and `b` (two hierarchies of the same
-/// kind) whose closed features are within distance `d` (finite, `>= 0`; else
+/// method) whose closed features are within distance `d` (finite, `>= 0`; else
 /// `DHCD_ERR_INVALID_ARGUMENT`), decided exactly, into `*out` (see `DhcdProximity`; release
 /// with `dhcd_proximity_free`). `a` and `b` must be different handles (use
 /// `dhcd_self_proximity` for one object); they may differ in precision (each is exact for
@@ -1247,7 +1247,7 @@ pub unsafe extern "C" fn dhcd_self_ccd(
 /// vertex of `b` (`face_vertex`) and every edge of `a` against every edge of `b`
 /// (`edge_edge`) that touches during the step, `a` moving from `a0` to `a1` (`3 *
 /// a_vertex_count` doubles each) and `b` from `b0` to `b1`, into `*out` (see `DhcdImpacts`;
-/// release with `dhcd_impacts_free`). `a` and `b` are different handles of the same kind
+/// release with `dhcd_impacts_free`). `a` and `b` are different handles of the same method
 /// (use `dhcd_self_ccd` for one mesh), of either precision; the other arguments as in
 /// `dhcd_self_ccd`.
 ///

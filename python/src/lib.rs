@@ -589,7 +589,7 @@ fn widen(pairs: Vec<[u32; 2]>) -> Vec<[u64; 2]> {
     pairs.into_iter().map(|p| p.map(u64::from)).collect()
 }
 
-/// Intersecting face pairs `[face of a, face of b]` between two hierarchies of one kind.
+/// Intersecting face pairs `[face of a, face of b]` between two hierarchies of one method.
 #[pyfunction]
 #[pyo3(signature = (a, b, threads = None), text_signature = "(a, b, threads=1)")]
 fn collide(
@@ -1105,7 +1105,7 @@ fn load_mesh<'py>(
     Ok((v.into_pyarray(py), f.into_pyarray(py)))
 }
 
-/// Many deformable objects of one kind; object ids are ints from 0 up, never reused.
+/// Many deformable objects of one method; object ids are ints from 0 up, never reused.
 #[pyclass(module = "dhcd")]
 struct Scene {
     scene: dhcd::Scene,

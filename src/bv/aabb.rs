@@ -1,7 +1,7 @@
 //! Axis-aligned bounding boxes: min/max over the region's vertices (exact in f32).
 
 use super::swept::{self, Step};
-use super::{sealed, Bounds, BvKind, Method};
+use super::{sealed, BoundingVolume, Bounds, Method};
 use crate::options::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
@@ -49,7 +49,7 @@ fn fit_node<S: Simd>(simd: S, tree: &RegionTree, p: &Points, n: usize) -> AabbNo
     AabbNode { min, max }
 }
 
-impl BvKind for Aabb {
+impl BoundingVolume for Aabb {
     const METHOD: Method = Method::Aabb;
     type Record = AabbNode;
     type Nodes = AabbNodes;

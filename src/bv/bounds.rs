@@ -1,12 +1,12 @@
 //! The lazily fitted node bounds of every kind: one buffer, one tile per sibling group.
-//! (A `pub` type in a private module: it appears in the sealed [`super::BvKind`]'s
+//! (A `pub` type in a private module: it appears in the sealed [`super::BoundingVolume`]'s
 //! associated types, and is not nameable outside the crate.)
 
 use crate::tree::RegionTree;
 use dhcd_kernels::lazy::LazyTiles;
 use dhcd_kernels::Tile;
 
-/// The lazily fitted bounds of one kind, `F` fields of `T` per node, one tile per sibling
+/// The lazily fitted bounds of one method, `F` fields of `T` per node, one tile per sibling
 /// group: the group's `F` fields over its padded slots (`tree.group_slots(g)`, its nodes
 /// first in order; see [`crate::tree::BLOCK`]), side by side in one buffer. This is the one
 /// place that knows the layout (`f32` for the bounds of a pose, `f64` for the moving

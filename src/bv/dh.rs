@@ -4,7 +4,7 @@
 //! centre moves with the mesh for free; only the radius is ever recomputed.
 
 use super::swept::{self, MovingBalls, Step};
-use super::{central, sealed, BvKind, Method};
+use super::{central, sealed, BoundingVolume, Method};
 use super::{conservative_radius, conservative_sum, dist2_f64, exact_radius, Bounds};
 use crate::options::Options;
 use crate::points::Points;
@@ -47,7 +47,7 @@ fn radius<S: Simd>(simd: S, tree: &RegionTree, p: &Points, n: usize, c: [f32; 3]
     exact_radius(p, c, conservative_radius(run.max(borrowed)))
 }
 
-impl BvKind for Dh {
+impl BoundingVolume for Dh {
     const METHOD: Method = Method::Dh;
     type Record = DhNode;
     type Nodes = DhNodes;

@@ -1,10 +1,10 @@
-//! The three bounding-volume kinds over one region tree: Distance Hierarchy (`Dh`), spheres
+//! The three methods over one region tree: Distance Hierarchy (`Dh`), spheres
 //! (`Sphere`, the paper's SBV) and axis-aligned boxes (`Aabb`).
 //!
-//! The kind is a compile-time policy ([`BvKind`]); node data lives in structure-of-arrays
+//! The method is a compile-time policy ([`BoundingVolume`]); node data lives in structure-of-arrays
 //! buffers (one array per record field) whose sibling groups are contiguous, so one SIMD
-//! load covers the children of a node. [`Method`] names a kind where it is chosen at run
-//! time; every kind is a row of the table in [`crate::kinds`].
+//! load covers the children of a node. [`Method`] names a method where it is chosen at run
+//! time; every method is a row of the table in [`crate::methods`].
 
 mod aabb;
 mod bounds;
@@ -25,7 +25,7 @@ pub use sphere::Sphere;
 #[doc(hidden)]
 pub use sphere::{SphereNode, SphereNodes};
 
-pub use crate::kinds::Method;
+pub use crate::methods::Method;
 
 use crate::options::Options;
 use crate::points::Points;
@@ -73,15 +73,15 @@ mod sealed {
 }
 
 /// A bounding-volume kind: its node record, its SoA buffers, how to fit a node to the
-/// current pose, and the wide overlap test. Sealed: the kinds are the rows of the table in
-/// [`crate::kinds`], the set the library compares; everything generic over them is
+/// current pose, and the wide overlap test. Sealed: the methods are the rows of the table in
+/// [`crate::methods`], the set the library compares; everything generic over them is
 /// monomorphised (no per-node dispatch).
 ///
 /// Node bounds live in `LazyTiles` buffers grouped by *sibling group* (the children of one
 /// node, [`RegionTree::group_nodes`]): a group is fitted as a whole, just before its first
 /// test in a step, by whichever thread needs it first. A wide test reads one node of a
 /// fitted group against a block of another fitted group.
-pub trait BvKind:
+pub trait BoundingVolume:
     sealed::Sealed + Copy + Default + Send + Sync + std::fmt::Debug + 'static
 {
     const METHOD: Method;
@@ -123,7 +123,7 @@ pub trait BvKind:
         b: Self::Block<'_>,
         n: usize,
     ) -> u32;
-    /// [`BvKind::test`] with entry `i`'s volume grown by `margin` (finite, `>= 0`), rounded
+    /// [`BoundingVolume::test`] with entry `i`'s volume grown by `margin` (finite, `>= 0`), rounded
     /// outward: the bits of every entry of `b` whose volume comes within `margin` of it.
     #[doc(hidden)]
     fn test_within<S: pulp::Simd>(
@@ -216,21 +216,21 @@ pub trait BvKind:
     ) -> Option<bool>;
 }
 
-/// [`BvKind::refit_all`] on the runtime-detected backend, dispatched once for the whole
+/// [`BoundingVolume::refit_all`] on the runtime-detected backend, dispatched once for the whole
 /// refit.
-pub(crate) fn refit_all<K: BvKind>(
+pub(crate) fn refit_all<K: BoundingVolume>(
     nodes: &mut K::Nodes,
     tree: &RegionTree,
     p: &Points,
     bottom_up: bool,
 ) -> u64 {
-    struct Op<'a, K: BvKind> {
+    struct Op<'a, K: BoundingVolume> {
         nodes: &'a mut K::Nodes,
         tree: &'a RegionTree,
         p: &'a Points,
         bottom_up: bool,
     }
-    impl<K: BvKind> pulp::WithSimd for Op<'_, K> {
+    impl<K: BoundingVolume> pulp::WithSimd for Op<'_, K> {
         type Output = u64;
         #[inline(always)]
         fn with_simd<S: pulp::Simd>(self, simd: S) -> u64 {

@@ -3,7 +3,7 @@
 
 use super::swept::{self, MovingBalls, Step};
 use super::{conservative_radius, conservative_sum, dist2_f64, exact_radius, Bounds};
-use super::{sealed, BvKind, Method};
+use super::{sealed, BoundingVolume, Method};
 use crate::options::Options;
 use crate::points::Points;
 use crate::tree::RegionTree;
@@ -64,7 +64,7 @@ fn fit_node<S: Simd>(simd: S, tree: &RegionTree, p: &Points, n: usize) -> Sphere
     }
 }
 
-impl BvKind for Sphere {
+impl BoundingVolume for Sphere {
     const METHOD: Method = Method::Sphere;
     type Record = SphereNode;
     type Nodes = SphereNodes;

@@ -1,7 +1,7 @@
 //! Bounds of every region over a step, for continuous collision detection.
 //!
 //! Over a step every vertex moves on the straight line `x(t) = x0 + t (x1 - x0)`,
-//! `t` in `[0, 1]`. Each kind bounds a region over the whole step, on the same region tree
+//! `t` in `[0, 1]`. Each method bounds a region over the whole step, on the same region tree
 //! as its bounds of a pose:
 //!
 //! - **AABB**: the union of the region's boxes at t0 and t1. Every coordinate of a point is
@@ -14,7 +14,7 @@
 //!   all t. The record is the central vertex (fixed at build) and the two radii: 12 bytes;
 //!   the lazily fitted tile also stages both centres, in `f64`, so the test reads contiguous
 //!   arrays (64 bytes of scratch per node).
-//! - **Sphere**: the same moving ball with the sphere kind's own centres, the means of the
+//! - **Sphere**: the same moving ball with the sphere method's own centres, the means of the
 //!   region at t0 and at t1. Any two centres work (the argument above needs only that the
 //!   centre moves linearly); the means keep the radii those of the sphere hierarchy.
 //!   Record: two centres and two radii, 32 bytes in `f32`; staged as the DH tile.
@@ -26,7 +26,7 @@
 //! Radii are computed in `f64` from the `f64` positions and rounded up by a bound on their
 //! rounding error, so every bound is conservative for the positions as given.
 //!
-//! (`pub` items of a private module: they appear in the sealed [`super::BvKind`]'s
+//! (`pub` items of a private module: they appear in the sealed [`super::BoundingVolume`]'s
 //! signatures and are not nameable outside the crate.)
 
 use super::Bounds;

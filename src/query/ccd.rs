@@ -22,7 +22,7 @@
 //! whole interval, and the result is the least of those times with the pairs that reach it.
 //! (Its work counters do depend on the order.)
 //!
-//! Results are in the caller's original indices, sorted, the same for every kind and thread
+//! Results are in the caller's original indices, sorted, the same for every method and thread
 //! count. `prim_tests` counts the feature pairs given to the exact test, `contacts` the
 //! pairs reported, `bv_updates` the bounds fitted over the step.
 
@@ -33,7 +33,7 @@ use pulp::Simd;
 
 use super::features::{grown, meet, meeting, ordered_edge, points_box_f64, union_of};
 use crate::bv::swept::{f32_up, Step};
-use crate::bv::BvKind;
+use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
 use crate::counters::Counters;
 use crate::error::Result;
@@ -159,7 +159,7 @@ pub struct Impacts {
 ///
 /// The hierarchies give their region trees and triangles (and DH its central vertices);
 /// their current poses are not read: the positions are the motions'.
-pub fn ccd_pair<K: BvKind>(
+pub fn ccd_pair<K: BoundingVolume>(
     a: &Hierarchy<K>,
     a_motion: Motion<'_>,
     b: &Hierarchy<K>,
@@ -179,7 +179,7 @@ pub fn ccd_pair<K: BvKind>(
 
 /// [`ccd_pair`] with caller-owned scratch and a choice of parallelism. The result does not
 /// depend on `par`.
-pub fn ccd_pair_with<K: BvKind>(
+pub fn ccd_pair_with<K: BoundingVolume>(
     a: &Hierarchy<K>,
     a_motion: Motion<'_>,
     b: &Hierarchy<K>,
@@ -197,7 +197,7 @@ pub fn ccd_pair_with<K: BvKind>(
 
 /// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
 /// (sharing no vertex) of one mesh that collides during the step, on the calling thread.
-pub fn self_ccd<K: BvKind>(
+pub fn self_ccd<K: BoundingVolume>(
     h: &Hierarchy<K>,
     motion: Motion<'_>,
     query: &CcdQuery,
@@ -206,7 +206,7 @@ pub fn self_ccd<K: BvKind>(
 }
 
 /// [`self_ccd`] with caller-owned scratch and a choice of parallelism.
-pub fn self_ccd_with<K: BvKind>(
+pub fn self_ccd_with<K: BoundingVolume>(
     h: &Hierarchy<K>,
     motion: Motion<'_>,
     query: &CcdQuery,
@@ -222,7 +222,7 @@ pub fn self_ccd_with<K: BvKind>(
 /// One hierarchy over a step: its positions at t0 and t1 (internal order), its node bounds
 /// over the step (fitted lazily by the walk), and the boxes over the step of its triangles
 /// (internal order) and own edges (leaf-edge order), as six rows each.
-pub(crate) struct Swept<'h, K: BvKind> {
+pub(crate) struct Swept<'h, K: BoundingVolume> {
     h: &'h Hierarchy<K>,
     step: Cow<'h, Step>,
     bounds: K::Swept,
@@ -263,7 +263,7 @@ fn box_rows<const N: usize>(
     rows
 }
 
-impl<'h, K: BvKind> Swept<'h, K> {
+impl<'h, K: BoundingVolume> Swept<'h, K> {
     pub(crate) fn new(h: &'h Hierarchy<K>, motion: Motion<'_>) -> Result<Self> {
         Ok(Self::of_step(
             h,
@@ -322,7 +322,7 @@ impl<'h, K: BvKind> Swept<'h, K> {
 const PRUNE_SLACK: f64 = 4.0 * TOI_TOLERANCE;
 
 /// The CCD walk: two hierarchies over a step, the exact test and the mode.
-struct SweptQuery<'s, 'h, K: BvKind> {
+struct SweptQuery<'s, 'h, K: BoundingVolume> {
     a: &'s Swept<'h, K>,
     b: &'s Swept<'h, K>,
     self_query: bool,
@@ -363,7 +363,7 @@ pub(crate) fn earliest_bound(query: &CcdQuery) -> Option<AtomicU64> {
 
 /// The CCD walk of `a` against `b` (options checked), pruned by `best` in earliest mode; also
 /// the bounds fitted on each side.
-pub(crate) fn run<K: BvKind>(
+pub(crate) fn run<K: BoundingVolume>(
     a: &Swept<'_, K>,
     b: &Swept<'_, K>,
     self_query: bool,
@@ -422,7 +422,7 @@ pub(crate) fn keep_earliest(walks: &mut [Impacts]) -> Option<f64> {
     least
 }
 
-impl<K: BvKind> SweptQuery<'_, '_, K> {
+impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     fn side(&self, side: Side) -> &Swept<'_, K> {
         match side {
             Side::A => self.a,
@@ -512,7 +512,7 @@ fn inverse(order: &[u32]) -> Vec<u32> {
     inv
 }
 
-impl<K: BvKind> Swept<'_, K> {
+impl<K: BoundingVolume> Swept<'_, K> {
     /// Internal vertex `v` at t0 and t1.
     #[inline(always)]
     fn step_at(&self, v: usize) -> ([f64; 3], [f64; 3]) {
@@ -523,7 +523,7 @@ impl<K: BvKind> Swept<'_, K> {
 /// The exact vertex-face test of internal vertex `v` of `sv` and internal triangle `t` of
 /// `st`.
 #[inline(always)]
-fn vertex_face_toi<K: BvKind>(
+fn vertex_face_toi<K: BoundingVolume>(
     sv: &Swept<'_, K>,
     v: usize,
     st: &Swept<'_, K>,
@@ -558,7 +558,7 @@ fn edge_edge_toi(
     ccd::edge_edge(&x0, &x1, options)
 }
 
-impl<'s, 'h, K: BvKind> Query for SweptQuery<'s, 'h, K> {
+impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
     type Block = K::SweptBlock<'s>;
     type Out = ImpactOut;
 
@@ -646,7 +646,7 @@ impl<'s, 'h, K: BvKind> Query for SweptQuery<'s, 'h, K> {
     }
 }
 
-impl<K: BvKind> SweptQuery<'_, '_, K> {
+impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     /// The own vertices of leaf `x` of `sv` against the triangles of leaf `y` of `st`:
     /// `emit(vertex, triangle, toi)` (internal indices) for each pair that collides.
     #[allow(clippy::too_many_arguments)]

@@ -9,7 +9,7 @@
 use pulp::Simd;
 
 use super::{LeafAction, NodeTest, Overlap, Posed, PosedQuery};
-use crate::bv::BvKind;
+use crate::bv::BoundingVolume;
 use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
@@ -40,13 +40,13 @@ pub struct BroadPhase {
 
 /// All intersecting triangle pairs between `a` and `b`, with counters, on the calling
 /// thread. Refits (lazily) the nodes it tests; `bv_updates` counts those refits.
-pub fn collide<K: BvKind>(a: &Hierarchy<K>, b: &Hierarchy<K>) -> Contacts {
+pub fn collide<K: BoundingVolume>(a: &Hierarchy<K>, b: &Hierarchy<K>) -> Contacts {
     collide_with(a, b, &mut Workspace::default(), Par::Seq)
 }
 
 /// [`collide`] with caller-owned scratch and a choice of parallelism. The result does not
 /// depend on `par`.
-pub fn collide_with<K: BvKind>(
+pub fn collide_with<K: BoundingVolume>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
     ws: &mut Workspace,
@@ -77,19 +77,23 @@ pub fn collide_with<K: BvKind>(
 /// assert_eq!(c.pairs, dhcd::narrow::brute_force_self_pairs(&mesh));
 /// # Ok::<(), dhcd::Error>(())
 /// ```
-pub fn self_collide<K: BvKind>(h: &Hierarchy<K>) -> Contacts {
+pub fn self_collide<K: BoundingVolume>(h: &Hierarchy<K>) -> Contacts {
     self_collide_with(h, &mut Workspace::default(), Par::Seq)
 }
 
 /// [`self_collide`] with caller-owned scratch and a choice of parallelism. The result does
 /// not depend on `par`.
-pub fn self_collide_with<K: BvKind>(h: &Hierarchy<K>, ws: &mut Workspace, par: Par) -> Contacts {
+pub fn self_collide_with<K: BoundingVolume>(
+    h: &Hierarchy<K>,
+    ws: &mut Workspace,
+    par: Par,
+) -> Contacts {
     contacts(Posed::single(h, Overlap), ws, par).0
 }
 
 /// The contact query on `posed`; also the nodes fitted on each side (the scene credits them
 /// per object).
-pub(crate) fn contacts<K: BvKind, T: NodeTest>(
+pub(crate) fn contacts<K: BoundingVolume, T: NodeTest>(
     posed: Posed<'_, K, T>,
     ws: &mut Workspace,
     par: Par,
@@ -131,7 +135,7 @@ fn finish(mut pairs: Vec<[u32; 2]>, mut counters: Counters) -> Contacts {
 /// The broad phase alone: lazy refit and traversal down to the overlapping leaf pairs (a list
 /// that, unlike a query's memory, grows with the work). With [`narrow_phase`] it is
 /// [`collide_with`] split in two, for benchmarks and cost-model calibration.
-pub(crate) fn broad_phase<K: BvKind>(
+pub(crate) fn broad_phase<K: BoundingVolume>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
     ws: &mut Workspace,
@@ -143,7 +147,7 @@ pub(crate) fn broad_phase<K: BvKind>(
 /// [`broad_phase`] of one object against itself: the lazy refit and traversal of
 /// [`self_collide_with`] down to the overlapping leaf pairs; no triangle is tested. What a
 /// self query costs besides its narrow phase (`dhcd bench --broad-only`).
-pub(crate) fn self_broad_phase<K: BvKind>(
+pub(crate) fn self_broad_phase<K: BoundingVolume>(
     h: &Hierarchy<K>,
     ws: &mut Workspace,
     par: Par,
@@ -151,7 +155,11 @@ pub(crate) fn self_broad_phase<K: BvKind>(
     broad(Posed::single(h, Overlap), ws, par)
 }
 
-fn broad<K: BvKind>(posed: Posed<'_, K, Overlap>, ws: &mut Workspace, par: Par) -> BroadPhase {
+fn broad<K: BoundingVolume>(
+    posed: Posed<'_, K, Overlap>,
+    ws: &mut Workspace,
+    par: Par,
+) -> BroadPhase {
     let q = PosedQuery {
         posed,
         action: CollectLeaves,
@@ -177,7 +185,7 @@ fn broad<K: BvKind>(posed: Posed<'_, K, Overlap>, ws: &mut Workspace, par: Par) 
 /// ids, as [`broad_phase`] returns them). Counts `prim_tests` and `contacts`. A pair naming
 /// a node beyond its hierarchy is an [`Error::NodeOutOfRange`], one naming an internal node
 /// an [`Error::NotALeaf`].
-pub(crate) fn narrow_phase<K: BvKind>(
+pub(crate) fn narrow_phase<K: BoundingVolume>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
     leaves: &[[u32; 2]],
@@ -221,7 +229,7 @@ pub(crate) fn sort_pairs(pairs: &mut [[u32; 2]]) {
 
 /// Which pairs of leaf pair `(x, y)` are tested, and how many of them share a vertex.
 #[inline(always)]
-pub(crate) fn leaf_pair_kind<K: BvKind, T: NodeTest>(
+pub(crate) fn leaf_pair_kind<K: BoundingVolume, T: NodeTest>(
     posed: &Posed<'_, K, T>,
     x: usize,
     y: usize,
@@ -250,7 +258,7 @@ struct ContactOut<'h> {
     last: [Option<(usize, LeafSide<'h>)>; 2],
 }
 
-impl<'h, K: BvKind, const ROUNDED: bool> LeafAction<'h, K> for ContactAction<ROUNDED> {
+impl<'h, K: BoundingVolume, const ROUNDED: bool> LeafAction<'h, K> for ContactAction<ROUNDED> {
     type Out = ContactOut<'h>;
 
     fn out(&self) -> ContactOut<'h> {
@@ -271,7 +279,7 @@ impl<'h, K: BvKind, const ROUNDED: bool> LeafAction<'h, K> for ContactAction<ROU
         counters: &mut Counters,
         out: &mut ContactOut<'h>,
     ) {
-        fn side<'h, K: BvKind, S: Simd>(
+        fn side<'h, K: BoundingVolume, S: Simd>(
             simd: S,
             h: &'h Hierarchy<K>,
             leaf: usize,
@@ -314,7 +322,7 @@ impl<'h, K: BvKind, const ROUNDED: bool> LeafAction<'h, K> for ContactAction<ROU
 /// narrow phase would count.
 struct CollectLeaves;
 
-impl<'h, K: BvKind> LeafAction<'h, K> for CollectLeaves {
+impl<'h, K: BoundingVolume> LeafAction<'h, K> for CollectLeaves {
     type Out = Vec<[u32; 2]>;
 
     fn out(&self) -> Vec<[u32; 2]> {

@@ -32,7 +32,7 @@ pub use proximity::{
 
 use pulp::Simd;
 
-use crate::bv::BvKind;
+use crate::bv::BoundingVolume;
 use crate::counters::Counters;
 use crate::hierarchy::Hierarchy;
 use crate::tree::RegionTree;
@@ -40,7 +40,7 @@ use crate::walk::{Query, Side};
 
 /// A node test on the volumes of the current pose.
 pub(crate) trait NodeTest: Copy + Send + Sync {
-    fn test<K: BvKind, S: Simd>(
+    fn test<K: BoundingVolume, S: Simd>(
         self,
         simd: S,
         a: K::Block<'_>,
@@ -56,7 +56,7 @@ pub(crate) struct Overlap;
 
 impl NodeTest for Overlap {
     #[inline(always)]
-    fn test<K: BvKind, S: Simd>(
+    fn test<K: BoundingVolume, S: Simd>(
         self,
         simd: S,
         a: K::Block<'_>,
@@ -69,7 +69,7 @@ impl NodeTest for Overlap {
 }
 
 /// The volumes come within a distance: `margin`, an `f32` at least the query's distance
-/// (rounded up), by which entry `i`'s volume is grown ([`BvKind::test_within`]).
+/// (rounded up), by which entry `i`'s volume is grown ([`BoundingVolume::test_within`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Within {
     pub(crate) margin: f32,
@@ -86,7 +86,7 @@ impl Within {
 
 impl NodeTest for Within {
     #[inline(always)]
-    fn test<K: BvKind, S: Simd>(
+    fn test<K: BoundingVolume, S: Simd>(
         self,
         simd: S,
         a: K::Block<'_>,
@@ -100,14 +100,14 @@ impl NodeTest for Within {
 
 /// Two hierarchies in their current pose (one, on both sides, for a self query) and a node
 /// test: everything a query on the current pose needs but its leaf action.
-pub(crate) struct Posed<'h, K: BvKind, T: NodeTest> {
+pub(crate) struct Posed<'h, K: BoundingVolume, T: NodeTest> {
     pub(crate) a: &'h Hierarchy<K>,
     pub(crate) b: &'h Hierarchy<K>,
     pub(crate) self_query: bool,
     pub(crate) node_test: T,
 }
 
-impl<'h, K: BvKind, T: NodeTest> Posed<'h, K, T> {
+impl<'h, K: BoundingVolume, T: NodeTest> Posed<'h, K, T> {
     pub(crate) fn pair(a: &'h Hierarchy<K>, b: &'h Hierarchy<K>, node_test: T) -> Self {
         Self {
             a,
@@ -136,7 +136,7 @@ impl<'h, K: BvKind, T: NodeTest> Posed<'h, K, T> {
 }
 
 /// The action a query on the current pose takes on an overlapping leaf pair.
-pub(crate) trait LeafAction<'h, K: BvKind>: Sync {
+pub(crate) trait LeafAction<'h, K: BoundingVolume>: Sync {
     type Out: Send;
     fn out(&self) -> Self::Out;
     fn leaf_pair<S: Simd, T: NodeTest>(
@@ -152,12 +152,12 @@ pub(crate) trait LeafAction<'h, K: BvKind>: Sync {
 }
 
 /// A query on the current pose: [`Posed`] plus a [`LeafAction`].
-pub(crate) struct PosedQuery<'h, K: BvKind, T: NodeTest, L> {
+pub(crate) struct PosedQuery<'h, K: BoundingVolume, T: NodeTest, L> {
     pub(crate) posed: Posed<'h, K, T>,
     pub(crate) action: L,
 }
 
-impl<'h, K: BvKind, T: NodeTest, L: LeafAction<'h, K>> Query for PosedQuery<'h, K, T, L> {
+impl<'h, K: BoundingVolume, T: NodeTest, L: LeafAction<'h, K>> Query for PosedQuery<'h, K, T, L> {
     type Block = K::Block<'h>;
     type Out = L::Out;
 

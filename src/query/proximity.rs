@@ -13,14 +13,14 @@
 //! the exact tests of [`crate::distance`].
 //!
 //! Results are in the caller's original indices, sorted, and the same for every thread count
-//! and every kind. `prim_tests` counts the feature pairs given to the exact test; `contacts`
+//! and every method. `prim_tests` counts the feature pairs given to the exact test; `contacts`
 //! the pairs reported.
 
 use pulp::Simd;
 
 use super::features::{grown, meet, meeting, ordered_edge, points_box, union_of};
 use super::{LeafAction, NodeTest, Posed, PosedQuery, Within};
-use crate::bv::BvKind;
+use crate::bv::BoundingVolume;
 use crate::counters::Counters;
 use crate::distance::{self, EdgeEdge, PointTriangle};
 use crate::error::{Error, Result};
@@ -95,13 +95,17 @@ pub(crate) fn check_distance(d: f64) -> Result<()> {
 
 /// Every vertex-triangle and edge-edge pair of `a` and `b` within distance `d` (finite,
 /// `>= 0`; else [`Error::InvalidDistance`]), on the calling thread.
-pub fn proximity<K: BvKind>(a: &Hierarchy<K>, b: &Hierarchy<K>, d: f64) -> Result<Proximity> {
+pub fn proximity<K: BoundingVolume>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    d: f64,
+) -> Result<Proximity> {
     proximity_with(a, b, d, &mut Workspace::default(), Par::Seq)
 }
 
 /// [`proximity`] with caller-owned scratch and a choice of parallelism. The result does not
 /// depend on `par`.
-pub fn proximity_with<K: BvKind>(
+pub fn proximity_with<K: BoundingVolume>(
     a: &Hierarchy<K>,
     b: &Hierarchy<K>,
     d: f64,
@@ -114,12 +118,12 @@ pub fn proximity_with<K: BvKind>(
 
 /// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
 /// (sharing no vertex) of one mesh within distance `d`, on the calling thread.
-pub fn self_proximity<K: BvKind>(h: &Hierarchy<K>, d: f64) -> Result<Proximity> {
+pub fn self_proximity<K: BoundingVolume>(h: &Hierarchy<K>, d: f64) -> Result<Proximity> {
     self_proximity_with(h, d, &mut Workspace::default(), Par::Seq)
 }
 
 /// [`self_proximity`] with caller-owned scratch and a choice of parallelism.
-pub fn self_proximity_with<K: BvKind>(
+pub fn self_proximity_with<K: BoundingVolume>(
     h: &Hierarchy<K>,
     d: f64,
     ws: &mut Workspace,
@@ -131,7 +135,7 @@ pub fn self_proximity_with<K: BvKind>(
 
 /// The proximity query on `posed` (distance already checked); also the nodes fitted on each
 /// side (the scene credits them per object).
-pub(crate) fn run<K: BvKind>(
+pub(crate) fn run<K: BoundingVolume>(
     posed: Posed<'_, K, Within>,
     d: f64,
     ws: &mut Workspace,
@@ -168,12 +172,12 @@ struct FeatureOut {
 
 /// One side of a leaf pair: a hierarchy and one of its leaves.
 #[derive(Clone, Copy)]
-struct Leaf<'h, K: BvKind> {
+struct Leaf<'h, K: BoundingVolume> {
     h: &'h Hierarchy<K>,
     node: usize,
 }
 
-impl<'h, K: BvKind> Leaf<'h, K> {
+impl<'h, K: BoundingVolume> Leaf<'h, K> {
     fn own_edges(&self) -> &'h [[u32; 2]] {
         let tree = self.h.tree();
         tree.leaf_edges()
@@ -181,7 +185,7 @@ impl<'h, K: BvKind> Leaf<'h, K> {
     }
 }
 
-impl<'h, K: BvKind> LeafAction<'h, K> for Features {
+impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features {
     type Out = FeatureOut;
 
     fn out(&self) -> FeatureOut {
@@ -253,9 +257,9 @@ impl<'h, K: BvKind> LeafAction<'h, K> for Features {
 
 impl Features {
     /// The own vertices of leaf `lv` against the triangles of leaf `lt`: `emit(vertex,
-    /// triangle, distance_sq, kind)` for each pair within the distance (original indices).
+    /// triangle, distance_sq, method)` for each pair within the distance (original indices).
     #[inline(always)]
-    fn vertices_vs_triangles<S: Simd, K: BvKind>(
+    fn vertices_vs_triangles<S: Simd, K: BoundingVolume>(
         &self,
         simd: S,
         lv: Leaf<'_, K>,
@@ -311,7 +315,7 @@ impl Features {
     /// The own edges of leaf `la` against those of `lb` (a leaf with itself: each unordered
     /// pair once): each pair within the distance into `out`.
     #[inline(always)]
-    fn edges_vs_edges<S: Simd, K: BvKind>(
+    fn edges_vs_edges<S: Simd, K: BoundingVolume>(
         &self,
         simd: S,
         la: Leaf<'_, K>,

@@ -1,5 +1,5 @@
 //! The region tree: one topology over the rest pose, shared by all three bounding-volume
-//! kinds so that they bound identical regions. Each node has up to [`MAX_CHILDREN`]
+//! methods so that they bound identical regions. Each node has up to [`MAX_CHILDREN`]
 //! children (an octree's fan-out, so one SIMD block tests a node against all of them).
 //!
 //! Layout (all indices are `u32`):
@@ -374,7 +374,7 @@ impl RegionTree {
         self.edges.get_or_init(|| edges::LeafEdges::build(self))
     }
 
-    /// Bytes of topology (shared by the three kinds; not part of a BV's record; the
+    /// Bytes of topology (shared by the three methods; not part of a BV's record; the
     /// shared-pair table once a self query built it).
     pub fn topology_bytes(&self) -> usize {
         use std::mem::size_of_val;

@@ -1,5 +1,5 @@
 //! The paper's experiment: deformable objects pushed into each other, simulated once, then
-//! every hierarchy kind processes the identical frames, with counted work, measured time, and
+//! every hierarchy method processes the identical frames, with counted work, measured time, and
 //! the cost model `T = N_V*C_V + N_P*C_P + N_U*C_U` calibrated on this machine.
 //!
 //! Phases of [`run`]:
@@ -202,7 +202,7 @@ pub struct SceneInfo {
     pub vertices: usize,
     pub triangles_per_object: usize,
     pub vertices_per_object: usize,
-    /// Nodes of one object's region tree (the same for the three kinds).
+    /// Nodes of one object's region tree (the same for the three methods).
     pub nodes_per_hierarchy: usize,
     pub frames: usize,
     pub levels: usize,

@@ -1,10 +1,10 @@
-//! The table of kinds: names, aliases and numbers map both ways, and the kinds agree with
-//! their `BvKind` implementations.
+//! The table of methods: names, aliases and numbers map both ways, and the methods agree with
+//! their `BoundingVolume` implementations.
 
 use std::collections::HashSet;
 
-use dhcd::bv::BvKind;
-use dhcd::{for_each_kind, AnyHierarchy, Error, Hierarchy, Method, Options};
+use dhcd::bv::BoundingVolume;
+use dhcd::{for_each_method, AnyHierarchy, Error, Hierarchy, Method, Options};
 
 #[test]
 fn names_and_numbers_round_trip() {
@@ -44,7 +44,7 @@ fn names_and_numbers_round_trip() {
 fn every_kind_matches_its_row() {
     let mesh = dhcd::shapes::icosphere(1, 1.0, [0.0; 3]);
     let mut seen = Vec::new();
-    for_each_kind!(K => {
+    for_each_method!(K => {
         let h = Hierarchy::<K>::new(&mesh, Options::default()).unwrap();
         assert_eq!(h.method(), K::METHOD);
         assert_eq!(h.bytes_per_node(), K::METHOD.bytes_per_node());

@@ -1,26 +1,26 @@
-//! The one table of bounding-volume kinds.
+//! The one table of methods.
 //!
-//! Every run-time mapping of a kind follows from the rows of [`kinds!`]: the [`Method`] enum
+//! Every run-time mapping of a method follows from the rows of [`methods!`]: the [`Method`] enum
 //! with its names (command line, Python, JSON reports), report labels and C ABI numbers, and
 //! the dispatch of [`AnyHierarchy`](crate::AnyHierarchy) and [`Scene`](crate::Scene). A
-//! fourth kind is one file in `bv/` implementing [`BvKind`] plus one row here.
+//! fourth method is one file in `bv/` implementing [`BoundingVolume`] plus one row here.
 //!
 //! The table is a macro that hands its rows to a callback macro, so each user generates its
-//! code (an enum with a variant per kind, a `match` with an arm per kind) from the same rows.
+//! code (an enum with a variant per method, a `match` with an arm per method) from the same rows.
 
-use crate::bv::BvKind;
+use crate::bv::BoundingVolume;
 use crate::error::Error;
 
-/// `kinds!(path::to::callback { args })` calls `callback! { { args } rows }` with one row
+/// `methods!(path::to::callback { args })` calls `callback! { { args } rows }` with one row
 /// `(Kind, number, "name", [aliases], "label")` per kind: `Kind` is the kind's type in [`crate::bv`] and its [`Method`] variant;
 /// `number` its stable number in the C ABI (`DHCD_METHOD_*`); `"name"` its name on the
 /// command line, in Python and in JSON reports; `aliases` other names accepted when parsing;
 /// `"label"` its name in human-readable reports.
 ///
-/// Exported (hidden) only because [`for_each_kind!`](crate::for_each_kind) expands to it.
+/// Exported (hidden) only because [`for_each_method!`](crate::for_each_method) expands to it.
 #[doc(hidden)]
 #[macro_export]
-macro_rules! __kinds {
+macro_rules! __methods {
     ($($callback:tt)::+ { $($args:tt)* }) => {
         $($callback)::+! { { $($args)* }
             (Dh, 0, "dh", [], "DH")
@@ -29,29 +29,29 @@ macro_rules! __kinds {
         }
     };
 }
-pub(crate) use crate::__kinds as kinds;
+pub(crate) use crate::__methods as methods;
 
 /// Runs `expr` once per kind of the table, in table order, with the type `K` naming the kind:
-/// generic code (tests, benchmarks) covers every kind, a kind added later included.
+/// generic code (tests, benchmarks) covers every method, a method added later included.
 ///
 /// ```
-/// use dhcd::{bv::BvKind, for_each_kind, Hierarchy, Options};
+/// use dhcd::{bv::BoundingVolume, for_each_method, Hierarchy, Options};
 /// let mesh = dhcd::shapes::icosphere(1, 1.0, [0.0; 3]);
 /// let mut bytes = Vec::new();
-/// for_each_kind!(K => bytes.push(Hierarchy::<K>::new(&mesh, Options::default())?.bytes_per_node()));
+/// for_each_method!(K => bytes.push(Hierarchy::<K>::new(&mesh, Options::default())?.bytes_per_node()));
 /// assert_eq!(bytes, [8, 16, 24]);
 /// # Ok::<(), dhcd::Error>(())
 /// ```
 #[macro_export]
-macro_rules! for_each_kind {
+macro_rules! for_each_method {
     ($k:ident => $e:expr) => {
-        $crate::__kinds!($crate::__for_each_kind_arms { $k, $e })
+        $crate::__methods!($crate::__for_each_method_arms { $k, $e })
     };
 }
 
 #[doc(hidden)]
 #[macro_export]
-macro_rules! __for_each_kind_arms {
+macro_rules! __for_each_method_arms {
     ({ $k:ident, $e:expr } $(($kind:ident, $($rest:tt)*))*) => {
         $({
             type $k = $crate::bv::$kind;
@@ -62,8 +62,8 @@ macro_rules! __for_each_kind_arms {
 
 macro_rules! define_method {
     ({} $(($kind:ident, $code:literal, $name:literal, [$($alias:literal),*], $label:literal))*) => {
-        /// A bounding-volume kind chosen at run time: one variant per row of the table of
-        /// kinds (see [`crate::kinds`]).
+        /// A method chosen at run time: one variant per row of the table of
+        /// methods (see [`crate::methods`]).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
         #[non_exhaustive]
         pub enum Method {
@@ -74,7 +74,7 @@ macro_rules! define_method {
         }
 
         impl Method {
-            /// Every kind, in table order.
+            /// Every method, in table order.
             pub const ALL: [Method; [$($code),*].len()] = [$(Method::$kind),*];
 
             /// The name on the command line, in Python and in JSON reports.
@@ -93,12 +93,12 @@ macro_rules! define_method {
                 match self { $(Method::$kind => $label,)* }
             }
 
-            /// The kind's number in the C ABI (`DHCD_METHOD_*`); stable across versions.
+            /// The method's number in the C ABI (`DHCD_METHOD_*`); stable across versions.
             pub const fn code(self) -> i32 {
                 match self { $(Method::$kind => $code,)* }
             }
 
-            /// The kind with C ABI number `code`.
+            /// The method with C ABI number `code`.
             pub const fn from_code(code: i32) -> Option<Method> {
                 match code {
                     $($code => Some(Method::$kind),)*
@@ -109,19 +109,19 @@ macro_rules! define_method {
             /// Size of one node record in bytes (8, 16, 24 for DH, sphere, AABB).
             pub fn bytes_per_node(self) -> usize {
                 match self {
-                    $(Method::$kind => std::mem::size_of::<<crate::bv::$kind as BvKind>::Record>(),)*
+                    $(Method::$kind => std::mem::size_of::<<crate::bv::$kind as BoundingVolume>::Record>(),)*
                 }
             }
         }
 
-        // Each kind's `BvKind::METHOD` is its own row.
-        $(const _: () = assert!(matches!(<crate::bv::$kind as BvKind>::METHOD, Method::$kind));)*
+        // Each method's `BoundingVolume::METHOD` is its own row.
+        $(const _: () = assert!(matches!(<crate::bv::$kind as BoundingVolume>::METHOD, Method::$kind));)*
     };
 }
-kinds!(define_method {});
+methods!(define_method {});
 
 impl Method {
-    /// The kind named `name` (case-insensitive; a name or an alias).
+    /// The method named `name` (case-insensitive; a name or an alias).
     pub fn from_name(name: &str) -> Option<Method> {
         let name = name.to_ascii_lowercase();
         Method::ALL
@@ -129,7 +129,7 @@ impl Method {
             .find(|m| m.name() == name || m.aliases().contains(&name.as_str()))
     }
 
-    /// The names of all kinds, for messages: `dh, sphere, aabb`.
+    /// The names of all methods, for messages: `dh, sphere, aabb`.
     #[doc(hidden)]
     pub fn names() -> String {
         Method::ALL.map(Method::name).join(", ")
@@ -158,9 +158,9 @@ impl std::str::FromStr for Method {
     }
 }
 
-/// Defines `$vis enum $name` with one variant per kind, each holding `$wrap<Kind>` (a type
-/// alias or type with one parameter), plus `From<$wrap<Kind>>` and `method()`.
-macro_rules! kind_enum {
+/// Defines `$vis enum $name` with one variant per method, each holding `$wrap<Method>` (a type
+/// alias or type with one parameter), plus `From<$wrap<Method>>` and `method()`.
+macro_rules! method_enum {
     ({ $(#[$attr:meta])* $vis:vis enum $name:ident($wrap:ident) } $(($kind:ident, $($rest:tt)*))*) => {
         $(#[$attr])*
         $vis enum $name {
@@ -175,19 +175,19 @@ macro_rules! kind_enum {
 
         impl $name {
             /// The kind of the hierarchies inside.
-            $vis fn method(&self) -> crate::kinds::Method {
-                match self { $($name::$kind(_) => crate::kinds::Method::$kind,)* }
+            $vis fn method(&self) -> crate::methods::Method {
+                match self { $($name::$kind(_) => crate::methods::Method::$kind,)* }
             }
         }
     };
 }
-pub(crate) use kind_enum;
+pub(crate) use method_enum;
 
-/// `match_kind!(Enum, value, x => expr)`: `expr` with `x` bound to the contents of whichever
-/// variant `value` (an `Enum` defined by [`kind_enum!`], or a reference to one) holds.
-macro_rules! match_kind {
+/// `match_method!(Enum, value, x => expr)`: `expr` with `x` bound to the contents of whichever
+/// variant `value` (an `Enum` defined by [`method_enum!`], or a reference to one) holds.
+macro_rules! match_method {
     ($name:ident, $value:expr, $x:ident => $e:expr) => {
-        $crate::kinds::kinds!($crate::kinds::match_kind_arms {
+        $crate::methods::methods!($crate::methods::match_method_arms {
             $name,
             $value,
             $x,
@@ -195,22 +195,22 @@ macro_rules! match_kind {
         })
     };
 }
-pub(crate) use match_kind;
+pub(crate) use match_method;
 
-macro_rules! match_kind_arms {
+macro_rules! match_method_arms {
     ({ $name:ident, $value:expr, $x:ident, $e:expr } $(($kind:ident, $($rest:tt)*))*) => {
         match $value {
             $($name::$kind($x) => $e,)*
         }
     };
 }
-pub(crate) use match_kind_arms;
+pub(crate) use match_method_arms;
 
-/// `match_kind_pair!(Enum, a, b, x, y => expr)`: `Ok(expr)` with `x`, `y` bound to the
-/// contents of `a` and `b` when they hold the same kind, else [`Error::MethodMismatch`].
-macro_rules! match_kind_pair {
+/// `match_method_pair!(Enum, a, b, x, y => expr)`: `Ok(expr)` with `x`, `y` bound to the
+/// contents of `a` and `b` when they hold the same method, else [`Error::MethodMismatch`].
+macro_rules! match_method_pair {
     ($name:ident, $a:expr, $b:expr, $x:ident, $y:ident => $e:expr) => {
-        $crate::kinds::kinds!($crate::kinds::match_kind_pair_arms {
+        $crate::methods::methods!($crate::methods::match_method_pair_arms {
             $name,
             $a,
             $b,
@@ -220,9 +220,9 @@ macro_rules! match_kind_pair {
         })
     };
 }
-pub(crate) use match_kind_pair;
+pub(crate) use match_method_pair;
 
-macro_rules! match_kind_pair_arms {
+macro_rules! match_method_pair_arms {
     ({ $name:ident, $a:expr, $b:expr, $x:ident, $y:ident, $e:expr } $(($kind:ident, $($rest:tt)*))*) => {
         match ($a, $b) {
             $(($name::$kind($x), $name::$kind($y)) => Ok($e),)*
@@ -233,24 +233,24 @@ macro_rules! match_kind_pair_arms {
         }
     };
 }
-pub(crate) use match_kind_pair_arms;
+pub(crate) use match_method_pair_arms;
 
-/// `with_kind!(method, K => expr)`: `expr` with the type `K` naming the kind `method` names.
-macro_rules! with_kind {
+/// `with_method!(method, K => expr)`: `expr` with the type `K` naming the method `method` names.
+macro_rules! with_method {
     ($method:expr, $k:ident => $e:expr) => {
-        $crate::kinds::kinds!($crate::kinds::with_kind_arms { $method, $k, $e })
+        $crate::methods::methods!($crate::methods::with_method_arms { $method, $k, $e })
     };
 }
-pub(crate) use with_kind;
+pub(crate) use with_method;
 
-macro_rules! with_kind_arms {
+macro_rules! with_method_arms {
     ({ $method:expr, $k:ident, $e:expr } $(($kind:ident, $($rest:tt)*))*) => {
         match $method {
-            $($crate::kinds::Method::$kind => {
+            $($crate::methods::Method::$kind => {
                 type $k = $crate::bv::$kind;
                 $e
             })*
         }
     };
 }
-pub(crate) use with_kind_arms;
+pub(crate) use with_method_arms;
