@@ -12,9 +12,8 @@ use crate::points::Points;
 use crate::precision::Precision;
 use crate::tree::RegionTree;
 use dhcd_kernels::lazy::LazyTiles;
-use dhcd_kernels::narrow::TriSoa;
+use dhcd_kernels::narrow::{self, TriSoa};
 use dhcd_kernels::overlap::BoxRows;
-use dhcd_kernels::{refit, Soa3, Tile};
 use pulp::Simd;
 
 /// A node whose bounding volume fails to enclose its region (a bug in dhcd, never bad input).
@@ -81,11 +80,6 @@ impl EdgeCache {
     }
 }
 
-/// Fields per triangle of the cache tiles.
-const TRI_FIELDS: usize = 15;
-/// Entries of a leaf's union box (min xyz, max xyz), after its tile.
-const BOX_FIELDS: usize = 6;
-
 /// The cached triangles of one leaf: the tile of its padded slots (its `len` triangles
 /// first, then padding up to a multiple of [`crate::tree::BLOCK`]).
 #[derive(Clone, Copy, Debug)]
@@ -97,14 +91,15 @@ pub(crate) struct LeafTris<'a> {
 
 impl TriCache {
     fn new(tree: &RegionTree) -> Self {
-        // Leaf `r`'s group: its tile, then its union box.
+        // Leaf `r`'s group, in rank order (the layout is `TriSoa`'s).
+        let mut len = 0;
         let groups = (0..tree.leaf_count())
             .map(|r| {
-                let s = tree.leaf_slots(r);
-                TRI_FIELDS * s.start + BOX_FIELDS * r..TRI_FIELDS * s.end + BOX_FIELDS * (r + 1)
+                let start = len;
+                len += TriSoa::group_len(tree.leaf_slots(r).len());
+                start..len
             })
             .collect();
-        let len = TRI_FIELDS * tree.tri_slot_count() + BOX_FIELDS * tree.leaf_count();
         Self {
             tiles: LazyTiles::new(len, groups),
         }
@@ -124,16 +119,11 @@ impl TriCache {
         let stride = tree.leaf_slots(r).len();
         let vertices = tree.leaf_vertex_tile(r);
         let (group, _) = self.tiles.get_or_fill(r, |group| {
-            fill_leaf_tile(simd, group, stride, len, vertices, p)
+            narrow::fill_group_with(simd, group, stride, len, vertices, p.soa(), p.is_rounded())
         });
-        let (tile, union) = group.split_at(TRI_FIELDS * stride);
-        let union = (
-            [union[0], union[1], union[2]],
-            [union[3], union[4], union[5]],
-        );
         LeafTris {
             len,
-            soa: TriSoa::new(Tile::new(tile, stride), vertices).with_bounds(union),
+            soa: TriSoa::from_group(group, stride, vertices),
         }
     }
 }
@@ -164,67 +154,6 @@ impl<K: BoundingVolume> pulp::WithSimd for RefitGroups<'_, K> {
             self.groups.iter().map(fit).sum()
         }
     }
-}
-
-/// Writes the group of a leaf of `n` triangles: its tile (rows of `stride` slots: row
-/// `3c + k` holds axis `k` of corner `c`, rows 9-11 the boxes' minima, rows 12-14 their
-/// maxima), then the union of the boxes (min xyz, max xyz), which the narrow kernel would
-/// otherwise compute for every leaf pair. `vertices` is the leaf's vertex tile (corner `c`
-/// of triangle `i` at `c * stride + i`).
-///
-/// PERF: one gather loop per corner and axis, then the box rows from the corner rows. The
-/// per-triangle form (gather three points, write fifteen scattered entries) took ~190
-/// instructions a triangle and 10-13% of an n-body step.
-fn fill_leaf_tile<S: Simd>(
-    simd: S,
-    group: &mut [f32],
-    stride: usize,
-    n: usize,
-    vertices: &[u32],
-    p: &Points,
-) {
-    let (tile, union) = group.split_at_mut(TRI_FIELDS * stride);
-    let (corners, boxes) = tile.split_at_mut(9 * stride);
-    let axes = [&p.x[..], &p.y[..], &p.z[..]];
-    for c in 0..3 {
-        let ids = &vertices[c * stride..][..n];
-        for (k, axis) in axes.iter().enumerate() {
-            let row = &mut corners[(3 * c + k) * stride..][..n];
-            for (x, &v) in row.iter_mut().zip(ids) {
-                *x = axis[v as usize];
-            }
-        }
-    }
-    let (lo, hi) = boxes.split_at_mut(3 * stride);
-    for k in 0..3 {
-        let corner = |c: usize| &corners[(3 * c + k) * stride..][..n];
-        let (a, b, c) = (corner(0), corner(1), corner(2));
-        let lo = &mut lo[k * stride..][..n];
-        let hi = &mut hi[k * stride..][..n];
-        for i in 0..n {
-            lo[i] = a[i].min(b[i]).min(c[i]);
-            hi[i] = a[i].max(b[i]).max(c[i]);
-        }
-        if p.is_rounded() {
-            // Rounded corners: the next f32 outward holds the exact ones.
-            for x in lo.iter_mut() {
-                *x = x.next_down();
-            }
-            for x in hi.iter_mut() {
-                *x = x.next_up();
-            }
-        }
-    }
-    // The union of the boxes: the minima's least, the maxima's greatest (the SIMD bounds
-    // reduction; a single `min` chain per axis waits on each one's latency).
-    union[..3].copy_from_slice(&refit::bounds_with(simd, three_rows(lo, stride, n)).0);
-    union[3..].copy_from_slice(&refit::bounds_with(simd, three_rows(hi, stride, n)).1);
-}
-
-/// The first `n` entries of three consecutive rows of `stride` slots, as x, y and z.
-fn three_rows(rows: &[f32], stride: usize, n: usize) -> Soa3<'_> {
-    let row = |k: usize| &rows[k * stride..][..n];
-    Soa3::new(row(0), row(1), row(2))
 }
 
 impl<K: BoundingVolume> Hierarchy<K> {

@@ -82,7 +82,7 @@
 //! order, no fused multiply-add; the canonical form's vertex choices are selects).
 
 use crate::lanes::{load_prefix, load_prefix_u32, mask_bits};
-use crate::Tile;
+use crate::{refit, Soa3, Tile};
 use pulp::Simd;
 
 /// Lane counts for which the filter culls rows per lane vector of the second block (see
@@ -141,9 +141,20 @@ pub(crate) fn union_magnitude(a: &([f32; 3], [f32; 3]), b: &([f32; 3], [f32; 3])
     m
 }
 
+/// Fields of a triangle tile: coordinate `k` of corner `c` is field `3c + k`, then the closed
+/// box: min x, y, z (fields 9-11), max x, y, z (fields 12-14).
+const TRI_FIELDS: usize = 15;
+/// Entries of a group's union box (min xyz, max xyz), after its tile.
+const UNION_FIELDS: usize = 6;
+
 /// Triangles in structure-of-arrays form: a [`Tile`] of fifteen fields (coordinate `k` of
 /// corner `c` is field `3c + k`, then the closed box: min x, y, z, max x, y, z) and a tile of
 /// their three corner indices (used by the self pairings only), from entry `offset` on.
+///
+/// A *group* is how a caller caches one leaf's triangles: the tile of `stride` slots, then
+/// the union of its boxes (six entries), written by [`fill_group_with`] and read by
+/// [`TriSoa::from_group`]; [`TriSoa::group_len`] is its length. The layout is defined here
+/// only.
 /// Padding past the tested count is allowed. Optionally a box known to hold every
 /// triangle's closed box ([`TriSoa::with_bounds`]), which spares the kernels computing it.
 #[derive(Clone, Copy, Debug)]
@@ -162,7 +173,7 @@ impl<'a> TriSoa<'a> {
     #[inline]
     pub fn new(tile: Tile<'a>, vertex: &'a [u32]) -> Self {
         assert!(
-            tile.has_fields(15) && vertex.len() == 3 * tile.stride(),
+            tile.has_fields(TRI_FIELDS) && vertex.len() == 3 * tile.stride(),
             "TriSoa: 9 corner coordinates and 6 box bounds, 3 corner indices"
         );
         Self {
@@ -171,6 +182,24 @@ impl<'a> TriSoa<'a> {
             offset: 0,
             bounds: None,
         }
+    }
+
+    /// Entries of a group of `stride` slots: the tile, then the union box.
+    #[inline]
+    pub const fn group_len(stride: usize) -> usize {
+        TRI_FIELDS * stride + UNION_FIELDS
+    }
+
+    /// The triangles of a group written by [`fill_group_with`], with its union box as
+    /// their bounds. `vertex` is the group's corner-index tile (as given to the fill).
+    #[inline]
+    pub fn from_group(group: &'a [f32], stride: usize, vertex: &'a [u32]) -> Self {
+        let (tile, union) = group.split_at(TRI_FIELDS * stride);
+        let bounds = (
+            [union[0], union[1], union[2]],
+            [union[3], union[4], union[5]],
+        );
+        TriSoa::new(Tile::new(tile, stride), vertex).with_bounds(bounds)
     }
 
     /// The same triangles with `bounds`, a box that contains the closed box of every
@@ -326,6 +355,73 @@ fn side(a: &[f32; 3], n: &[f32; 3], m: &[f32; 3], d: &[f32; 3]) -> i32 {
     let l = e[0].abs() + e[1].abs() + e[2].abs();
     let bound = PLANE_ERR * p + PLANE_TINY * (l + 2.0);
     i32::from(s > bound) - i32::from(s < 0.0 - bound)
+}
+
+/// Writes the group (see [`TriSoa`]) of `n` triangles over `stride` slots: the tile (row
+/// `3c + k` holds axis `k` of corner `c`, rows 9-11 the boxes' minima, rows 12-14 their
+/// maxima), then the union of the boxes (min xyz, max xyz), which the narrow kernel would
+/// otherwise compute for every leaf pair. Corner `c` of triangle `i` is point
+/// `vertices[c * stride + i]` of `p`. `rounded`: the points are the nearest `f32`s of `f64`
+/// coordinates, so each box is widened to the next `f32` outward, which holds the exact
+/// corners.
+///
+/// PERF: one gather loop per corner and axis, then the box rows from the corner rows. The
+/// per-triangle form (gather three points, write fifteen scattered entries) took ~190
+/// instructions a triangle and 10-13% of an n-body step.
+pub fn fill_group_with<S: Simd>(
+    simd: S,
+    group: &mut [f32],
+    stride: usize,
+    n: usize,
+    vertices: &[u32],
+    p: Soa3,
+    rounded: bool,
+) {
+    assert!(
+        group.len() == TriSoa::group_len(stride) && n <= stride && vertices.len() == 3 * stride,
+        "fill_group_with: a group of {stride} slots, 3 corner-index rows"
+    );
+    let (tile, union) = group.split_at_mut(TRI_FIELDS * stride);
+    let (corners, boxes) = tile.split_at_mut(9 * stride);
+    let axes = [p.x, p.y, p.z];
+    for c in 0..3 {
+        let ids = &vertices[c * stride..][..n];
+        for (k, axis) in axes.iter().enumerate() {
+            let row = &mut corners[(3 * c + k) * stride..][..n];
+            for (x, &v) in row.iter_mut().zip(ids) {
+                *x = axis[v as usize];
+            }
+        }
+    }
+    let (lo, hi) = boxes.split_at_mut(3 * stride);
+    for k in 0..3 {
+        let corner = |c: usize| &corners[(3 * c + k) * stride..][..n];
+        let (a, b, c) = (corner(0), corner(1), corner(2));
+        let lo = &mut lo[k * stride..][..n];
+        let hi = &mut hi[k * stride..][..n];
+        for i in 0..n {
+            lo[i] = a[i].min(b[i]).min(c[i]);
+            hi[i] = a[i].max(b[i]).max(c[i]);
+        }
+        if rounded {
+            for x in lo.iter_mut() {
+                *x = x.next_down();
+            }
+            for x in hi.iter_mut() {
+                *x = x.next_up();
+            }
+        }
+    }
+    // The union of the boxes: the minima's least, the maxima's greatest (the SIMD bounds
+    // reduction; a single `min` chain per axis waits on each one's latency).
+    union[..3].copy_from_slice(&refit::bounds_with(simd, three_rows(lo, stride, n)).0);
+    union[3..].copy_from_slice(&refit::bounds_with(simd, three_rows(hi, stride, n)).1);
+}
+
+/// The first `n` entries of three consecutive rows of `stride` slots, as x, y and z.
+fn three_rows(rows: &[f32], stride: usize, n: usize) -> Soa3<'_> {
+    let row = |k: usize| &rows[k * stride..][..n];
+    Soa3::new(row(0), row(1), row(2))
 }
 
 /// A triangle's closed box, as the callers' leaf tiles store it.

@@ -189,11 +189,6 @@ impl RegionTree {
         g * BLOCK..(g + 1) * BLOCK
     }
 
-    /// Number of slots of the padded triangle layout.
-    pub(crate) fn tri_slot_count(&self) -> usize {
-        *self.leaf_slot.last().unwrap_or(&0) as usize
-    }
-
     /// The triangle slots of the leaf of rank `r` (its triangles first, in order, then
     /// padding; a multiple of [`BLOCK`]).
     #[inline]
