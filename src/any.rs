@@ -42,6 +42,7 @@ macro_rules! pairwise {
 }
 
 impl AnyHierarchy {
+    /// A hierarchy of `method` over `mesh` (its positions are the rest pose); see [`Hierarchy::new`].
     pub fn new(method: Method, mesh: &Mesh, options: Options) -> Result<Self> {
         let tree = Arc::new(RegionTree::build(mesh, options.shape())?);
         Self::with_tree(method, tree, mesh, options)
@@ -72,22 +73,27 @@ impl AnyHierarchy {
         each!(self, h => h.precision())
     }
 
+    /// See [`Hierarchy::validate`].
     pub fn validate(&self) -> std::result::Result<usize, InvariantError> {
         each!(self, h => h.validate())
     }
 
+    /// See [`Hierarchy::bytes_per_node`].
     pub fn bytes_per_node(&self) -> usize {
         each!(self, h => h.bytes_per_node())
     }
 
+    /// See [`Hierarchy::bv_bytes`].
     pub fn bv_bytes(&self) -> usize {
         each!(self, h => h.bv_bytes())
     }
 
+    /// See [`Hierarchy::node_count`].
     pub fn node_count(&self) -> usize {
         each!(self, h => h.node_count())
     }
 
+    /// The region tree (shareable with hierarchies of the other methods).
     pub fn tree(&self) -> &Arc<RegionTree> {
         each!(self, h => h.tree())
     }

@@ -12,60 +12,119 @@ use crate::precision::Precision;
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum Error {
+    /// A mesh without vertices.
     #[error("mesh has no vertices")]
     NoVertices,
+    /// A mesh without triangles.
     #[error("mesh has no triangles")]
     NoTriangles,
+    /// More vertices than a `u32` index can name (the count given).
     #[error("mesh has {0} vertices; at most {max} are supported", max = u32::MAX - 1)]
     TooManyVertices(usize),
+    /// More triangles than a `u32` index can name (the count given).
     #[error("mesh has {0} triangles; at most {max} are supported", max = u32::MAX - 1)]
     TooManyTriangles(usize),
+    /// A triangle names a vertex the mesh does not have.
     #[error(
         "triangle {triangle} uses vertex {index}, but the mesh has only {vertex_count} vertices"
     )]
     IndexOutOfRange {
+        /// The triangle (index in the input).
         triangle: usize,
+        /// The vertex index it uses.
         index: u32,
+        /// The mesh's number of vertices.
         vertex_count: usize,
     },
+    /// A triangle names one vertex twice.
     #[error("triangle {triangle} repeats vertex {index} ({corners:?})")]
     RepeatedIndex {
+        /// The triangle (index in the input).
         triangle: usize,
+        /// The repeated vertex index.
         index: u32,
+        /// Its three corners.
         corners: [u32; 3],
     },
+    /// A NaN or infinite coordinate.
     #[error("vertex {vertex} has a non-finite coordinate {position:?}")]
-    NonFinite { vertex: usize, position: [f64; 3] },
+    NonFinite {
+        /// The vertex (index in the input).
+        vertex: usize,
+        /// Its coordinates.
+        position: [f64; 3],
+    },
     /// An `f64` coordinate too large to round to a finite `f32` (bounding volumes are `f32`).
     #[error("vertex {vertex} has a coordinate beyond the f32 range {position:?} (|x| must be below about 3.4e38)")]
-    OutOfRange { vertex: usize, position: [f64; 3] },
+    OutOfRange {
+        /// The vertex (index in the input).
+        vertex: usize,
+        /// Its coordinates.
+        position: [f64; 3],
+    },
     /// Positions of one precision given to a mesh or hierarchy of the other: an `f32`
     /// update of an `f64` hierarchy would silently round it.
     #[error("positions are {got}, but the mesh or hierarchy is {expected}")]
-    PrecisionMismatch { expected: Precision, got: Precision },
+    PrecisionMismatch {
+        /// The precision of the mesh or hierarchy.
+        expected: Precision,
+        /// The precision of the positions given.
+        got: Precision,
+    },
+    /// A position update whose length is not the mesh's vertex count.
     #[error("position update has {got} vertices, but the mesh has {expected}")]
-    WrongVertexCount { expected: usize, got: usize },
+    WrongVertexCount {
+        /// The mesh's number of vertices.
+        expected: usize,
+        /// The number given.
+        got: usize,
+    },
     /// A region tree depth outside `1..=max` ([`tree::MAX_LEVELS`](crate::tree::MAX_LEVELS)).
     #[error("levels must be between 1 and {max}, got {got}")]
-    InvalidLevels { got: usize, max: usize },
+    InvalidLevels {
+        /// The depth given.
+        got: usize,
+        /// The largest depth accepted.
+        max: usize,
+    },
     /// A leaf size outside `1..=max` ([`tree::MAX_LEAF_SIZE`](crate::tree::MAX_LEAF_SIZE)).
     #[error("leaf size must be between 1 and {max}, got {got}")]
-    InvalidLeafSize { got: usize, max: usize },
+    InvalidLeafSize {
+        /// The leaf size given.
+        got: usize,
+        /// The largest leaf size accepted.
+        max: usize,
+    },
     /// Two hierarchies of different methods, by name ([`Method::name`](crate::Method::name)).
     #[error("cannot collide a {a} hierarchy with a {b} hierarchy")]
-    MethodMismatch { a: &'static str, b: &'static str },
+    MethodMismatch {
+        /// The first hierarchy's method.
+        a: &'static str,
+        /// The second hierarchy's method.
+        b: &'static str,
+    },
+    /// An object id that is not (or no longer) in the scene.
     #[error("no object with id {0} in the scene")]
     UnknownObject(u64),
+    /// An object id given twice in one update.
     #[error("object {0} is given more than once in one update")]
     RepeatedObject(u64),
     /// A method name that is none of `expected` (the names of
     /// [`Method::ALL`](crate::Method::ALL), comma-separated).
     #[error("unknown method {got:?} (expected one of {expected})")]
-    UnknownMethod { got: String, expected: String },
+    UnknownMethod {
+        /// The name given.
+        got: String,
+        /// The names accepted.
+        expected: String,
+    },
+    /// A refit mode name that is none of `lazy`, `eager`, `bottom-up`.
     #[error("unknown refit mode {0:?} (expected lazy, eager or bottom-up)")]
     UnknownRefit(String),
+    /// A central vertex name that is none of `rest-centroid`, `min-radius`.
     #[error("unknown central vertex {0:?} (expected rest-centroid or min-radius)")]
     UnknownCentral(String),
+    /// A precision name that is none of `f32`, `f64`.
     #[error("unknown precision {0:?} (expected f32 or f64)")]
     UnknownPrecision(String),
     /// A query distance that is negative, NaN or infinite.
@@ -73,30 +132,47 @@ pub enum Error {
     InvalidDistance(f64),
     /// A node id (e.g. given to `refit_nodes`) beyond the hierarchy's nodes.
     #[error("node {node} out of range (the hierarchy has {node_count} nodes)")]
-    NodeOutOfRange { node: u32, node_count: usize },
+    NodeOutOfRange {
+        /// The node id given.
+        node: u32,
+        /// The hierarchy's number of nodes.
+        node_count: usize,
+    },
     /// A node id given where a leaf is needed (`narrow_phase`) names an internal node.
     #[error("node {node} is not a leaf")]
-    NotALeaf { node: u32 },
+    NotALeaf {
+        /// The node id given.
+        node: u32,
+    },
     /// A region tree shared with a mesh it was not built for.
     #[error(
         "region tree of {tree_vertices} vertices / {tree_triangles} triangles does not fit a mesh of {mesh_vertices} / {mesh_triangles}"
     )]
     TreeMismatch {
+        /// The tree's number of vertices.
         tree_vertices: usize,
+        /// The tree's number of triangles.
         tree_triangles: usize,
+        /// The mesh's number of vertices.
         mesh_vertices: usize,
+        /// The mesh's number of triangles.
         mesh_triangles: usize,
     },
     /// A contact names a triangle index the mesh does not have.
     #[error("contact names triangle {triangle}, but the mesh has only {triangle_count} triangles")]
     TriangleOutOfRange {
+        /// The triangle index given.
         triangle: u64,
+        /// The mesh's number of triangles.
         triangle_count: usize,
     },
     /// A contact whose triangles do not intersect in the current pose (contact segments asked
     /// for contacts of an earlier pose).
     #[error("triangles {pair:?} do not intersect in the current pose (stale contacts?)")]
-    StaleContact { pair: [u32; 2] },
+    StaleContact {
+        /// The pair given.
+        pair: [u32; 2],
+    },
     /// A thread count above `max` ([`Par::MAX_THREADS`](crate::Par::MAX_THREADS)); `cores`
     /// is [`Par::max_threads`](crate::Par::max_threads).
     #[error(
@@ -104,8 +180,11 @@ pub enum Error {
          thread) or up to {max} (at most {cores} are used on this machine)"
     )]
     InvalidThreads {
+        /// The count given.
         got: usize,
+        /// The largest count accepted.
         max: usize,
+        /// The most threads used on this machine.
         cores: usize,
     },
     /// A CCD time limit outside [0, 1] (or NaN).
@@ -117,23 +196,45 @@ pub enum Error {
     /// A CCD query point with a NaN or infinite coordinate (`point` 0-3 at t = 0, 4-7 at
     /// t = 1, in the order of the query).
     #[error("CCD point {point} has a non-finite coordinate {position:?}")]
-    NonFiniteCcdPoint { point: usize, position: [f64; 3] },
+    NonFiniteCcdPoint {
+        /// The point (0-3 at t = 0, 4-7 at t = 1).
+        point: usize,
+        /// Its coordinates.
+        position: [f64; 3],
+    },
+    /// A file that cannot be read (or written), with the system's message.
     #[error("{}: {}", escaped_path(.path), escaped(.message))]
-    Io { path: PathBuf, message: String },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A mesh file larger than [`io::Limits::max_file_bytes`](crate::io::Limits::max_file_bytes).
     #[error(
         "{}: the file is larger than the limit of {limit} bytes for mesh files (raise it \
          with --max-file-bytes, or io::Limits in the library)",
         escaped_path(.path)
     )]
-    FileTooLarge { path: PathBuf, limit: u64 },
+    FileTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// The limit in bytes.
+        limit: u64,
+    },
+    /// A malformed mesh file: the line (1-based; 0 for binary files) and what is wrong.
     #[error("{}:{line}: {}", escaped_path(.path), escaped(.message))]
     Parse {
+        /// The file.
         path: PathBuf,
+        /// The line (1-based; 0 for binary files).
         line: usize,
+        /// What is wrong.
         message: String,
     },
 }
 
+/// `Result` with this crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// `text` with every control character (newlines and NUL included) and line separator

@@ -20,9 +20,13 @@ use pulp::Simd;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{method} node {node} does not enclose vertex {vertex} (original index) of its region: {record}")]
 pub struct InvariantError {
+    /// The hierarchy's method.
     pub method: Method,
+    /// The node whose volume fails.
     pub node: usize,
+    /// A vertex of its region outside it (the caller's index).
     pub vertex: u32,
+    /// The node's record, printed.
     pub record: String,
 }
 
@@ -387,6 +391,7 @@ impl<K: BoundingVolume> Hierarchy<K> {
         K::record(&self.nodes, &self.tree, n)
     }
 
+    /// The region tree (shareable with hierarchies of the other methods: [`Hierarchy::with_tree`]).
     pub fn tree(&self) -> &Arc<RegionTree> {
         &self.tree
     }
@@ -433,14 +438,17 @@ impl<K: BoundingVolume> Hierarchy<K> {
         }
     }
 
+    /// When the volumes follow a deformation ([`Options::refit`]).
     pub fn refit_mode(&self) -> Refit {
         self.refit
     }
 
+    /// Number of nodes of the region tree.
     pub fn node_count(&self) -> usize {
         self.tree.node_count()
     }
 
+    /// The method, `K::METHOD`.
     pub fn method(&self) -> Method {
         K::METHOD
     }

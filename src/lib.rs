@@ -32,6 +32,7 @@
 //! paper's experiment and its simulator (`dhcd-cli`) and the Python package are crates of
 //! their own on top of it.
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod any;
 pub mod bv;

@@ -121,14 +121,17 @@ impl Mesh {
         }
     }
 
+    /// The triangles, as the caller's vertex indices.
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
     }
 
+    /// Number of vertices.
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
     }
 
+    /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }

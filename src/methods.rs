@@ -158,13 +158,14 @@ impl std::str::FromStr for Method {
     }
 }
 
-/// Defines `$vis enum $name` with one variant per method, each holding `$wrap<Method>` (a type
-/// alias or type with one parameter), plus `From<$wrap<Method>>` and `method()`.
+/// Defines `$vis enum $name` with one variant per method, each holding `$wrap<K>` for the method's type
+/// `K` (`$wrap` a type alias or type with one parameter), plus `From<$wrap<K>>` and `method()`.
 macro_rules! method_enum {
     ({ $(#[$attr:meta])* $vis:vis enum $name:ident($wrap:ident) } $(($kind:ident, $($rest:tt)*))*) => {
         $(#[$attr])*
         $vis enum $name {
-            $($kind($wrap<crate::bv::$kind>),)*
+            $(#[doc = concat!("A [`", stringify!($kind), "`](crate::bv::", stringify!($kind), ") hierarchy.")]
+            $kind($wrap<crate::bv::$kind>),)*
         }
 
         $(impl From<$wrap<crate::bv::$kind>> for $name {

@@ -100,6 +100,7 @@ pub struct Options {
     pub levels: Option<usize>,
     /// Largest number of triangles in a leaf of an adaptive tree (ignored with `levels`).
     pub leaf_size: usize,
+    /// When bounding volumes follow a deformation (default [`Refit::Lazy`]).
     pub refit: Refit,
     /// The DH central vertex of every node (ignored by the other methods).
     pub central: CentralVertex,

@@ -55,8 +55,11 @@ impl std::fmt::Display for ObjectId {
 /// The work of one object pair (or one object's self-collision when `a == b`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PairCounters {
+    /// The first object.
     pub a: ObjectId,
+    /// The second object (`a` itself for a self query).
     pub b: ObjectId,
+    /// The pair's counted work.
     pub counters: Counters,
 }
 
@@ -81,7 +84,9 @@ pub struct SceneContacts {
 /// edges of `a` first, see [`Proximity`]), or of one object with itself (`a == b`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PairProximity {
+    /// The first object.
     pub a: ObjectId,
+    /// The second object (`a` itself for a self query).
     pub b: ObjectId,
     /// Each object's original vertex, triangle and edge indices.
     pub proximity: Proximity,
@@ -104,7 +109,9 @@ pub struct SceneProximity {
 /// with itself (`a == b`, as in [`crate::self_ccd`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PairImpacts {
+    /// The first object.
     pub a: ObjectId,
+    /// The second object (`a` itself for a self query).
     pub b: ObjectId,
     /// Each object's original vertex, triangle and edge indices.
     pub impacts: Impacts,
@@ -215,10 +222,12 @@ impl Scene {
         }
     }
 
+    /// The method of every object's hierarchy.
     pub fn method(&self) -> Method {
         self.objects.method()
     }
 
+    /// The build options of every object's hierarchy.
     pub fn options(&self) -> Options {
         self.options
     }
@@ -228,6 +237,7 @@ impl Scene {
         each!(&self.objects, v => v.len())
     }
 
+    /// Whether the scene has no objects.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -237,6 +247,7 @@ impl Scene {
         each!(&self.objects, v => v.iter().map(|o| ObjectId(o.id)).collect())
     }
 
+    /// Whether `id` names an object of the scene.
     pub fn contains(&self, id: ObjectId) -> bool {
         self.index(id).is_ok()
     }
@@ -334,6 +345,7 @@ impl Scene {
         Ok(())
     }
 
+    /// Whether object `id`'s self-collision is on.
     pub fn self_collision(&self, id: ObjectId) -> Result<bool> {
         let i = self.index(id)?;
         Ok(each!(&self.objects, v => v[i].self_collision))

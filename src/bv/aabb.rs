@@ -12,7 +12,9 @@ use pulp::Simd;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct AabbNode {
+    /// Least corner.
     pub min: [f32; 3],
+    /// Greatest corner.
     pub max: [f32; 3],
 }
 const _: () = assert!(std::mem::size_of::<AabbNode>() == 24);
@@ -24,6 +26,7 @@ pub struct AabbNodes {
     fitted: Bounds<6>,
 }
 
+/// Axis-aligned bounding boxes (AABB), 24-byte records.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Aabb;
 impl sealed::Sealed for Aabb {}

@@ -16,7 +16,9 @@ use pulp::Simd;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct DhNode {
+    /// Central vertex (internal index): the sphere's centre is its current position.
     pub vertex: u32,
+    /// Radius around the central vertex.
     pub radius: f32,
 }
 const _: () = assert!(std::mem::size_of::<DhNode>() == 8);
@@ -31,11 +33,13 @@ const _: () = assert!(std::mem::size_of::<DhNode>() == 8);
 /// the sphere test on the same `f32` values.
 #[derive(Clone, Debug)]
 pub struct DhNodes {
+    /// Each node's central vertex (internal index).
     pub vertex: Vec<u32>,
     /// `[cx, cy, cz, radius]` per node.
     fitted: Bounds<4>,
 }
 
+/// The Distance Hierarchy (DH): 8-byte records, a central vertex and a radius.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Dh;
 impl sealed::Sealed for Dh {}

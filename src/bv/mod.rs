@@ -69,6 +69,7 @@ pub(crate) fn exact_radius(p: &Points, center: [f32; 3], radius: f32) -> f32 {
 }
 
 mod sealed {
+    /// Only the methods of this crate implement [`super::BoundingVolume`].
     pub trait Sealed {}
 }
 
@@ -84,6 +85,7 @@ mod sealed {
 pub trait BoundingVolume:
     sealed::Sealed + Copy + Default + Send + Sync + std::fmt::Debug + 'static
 {
+    /// The method's row in the table of methods.
     const METHOD: Method;
     /// One node as a plain record (`#[repr(C)]`, Pod; size pinned at compile time).
     type Record: bytemuck::Pod + std::fmt::Debug + PartialEq + Send + Sync;

@@ -14,7 +14,9 @@ use pulp::Simd;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SphereNode {
+    /// Centre.
     pub center: [f32; 3],
+    /// Radius.
     pub radius: f32,
 }
 const _: () = assert!(std::mem::size_of::<SphereNode>() == 16);
@@ -26,6 +28,7 @@ pub struct SphereNodes {
     fitted: Bounds<4>,
 }
 
+/// Bounding spheres (SBV), 16-byte records.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Sphere;
 impl sealed::Sealed for Sphere {}

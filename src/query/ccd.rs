@@ -49,11 +49,14 @@ use dhcd_kernels::overlap::{BoxRows, MAX_BOX_ROW};
 /// asks).
 #[derive(Clone, Copy, Debug)]
 pub struct Motion<'a> {
+    /// Positions at the start of the step (t = 0).
     pub x0: &'a [[f64; 3]],
+    /// Positions at the end of the step (t = 1).
     pub x1: &'a [[f64; 3]],
 }
 
 impl<'a> Motion<'a> {
+    /// The step from `x0` to `x1` (checked by the query: same length as the mesh, finite).
     pub fn new(x0: &'a [[f64; 3]], x1: &'a [[f64; 3]]) -> Self {
         Self { x0, x1 }
     }
@@ -72,7 +75,9 @@ pub enum CcdMode {
 /// A CCD query: the narrow-phase options (time limit, minimum distance) and the mode.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CcdQuery {
+    /// Time limit and minimum distance.
     pub options: CcdOptions,
+    /// All pairs, or the earliest time.
     pub mode: CcdMode,
 }
 
@@ -108,7 +113,9 @@ impl CcdQuery {
 /// query, a vertex and a triangle not containing it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VertexImpact {
+    /// The vertex (original index).
     pub vertex: u32,
+    /// The triangle (original index).
     pub triangle: u32,
     /// Time of impact in `[0, t_max]`: never after the first contact, at most
     /// [`TOI_TOLERANCE`] before it.
@@ -119,8 +126,11 @@ pub struct VertexImpact {
 /// queries only).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaceImpact {
+    /// The triangle of the first mesh (original index).
     pub triangle: u32,
+    /// The vertex of the second mesh (original index).
     pub vertex: u32,
+    /// Time of impact, as in [`VertexImpact::toi`].
     pub toi: f64,
 }
 
@@ -129,8 +139,11 @@ pub struct FaceImpact {
 /// edge is its two vertices' original indices, smaller first.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EdgeImpact {
+    /// The edge of the first mesh (or the first edge of a self pair).
     pub a: [u32; 2],
+    /// The edge of the second mesh (or the second edge of a self pair).
     pub b: [u32; 2],
+    /// Time of impact, as in [`VertexImpact::toi`].
     pub toi: f64,
 }
 

@@ -22,7 +22,9 @@ use dhcd_kernels::narrow::{Row, MAX_ROW};
 /// triangle indices, sorted ascending, and the counted work.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Contacts {
+    /// `[triangle of A, triangle of B]` (`a < b` in a self query), sorted ascending.
     pub pairs: Vec<[u32; 2]>,
+    /// The counted work.
     pub counters: Counters,
 }
 

@@ -53,7 +53,9 @@ pub struct FaceVertex {
     pub triangle: u32,
     /// The vertex of the second hierarchy (original index).
     pub vertex: u32,
+    /// Squared distance of the closed features (exact decision, rounded value).
     pub distance_sq: f64,
+    /// Which sub-features are closest (IPC's point-triangle distance type).
     pub kind: PointTriangle,
 }
 
@@ -63,9 +65,13 @@ pub struct FaceVertex {
 /// in that order (`EA0` is `a[0]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EdgePair {
+    /// The edge of the first hierarchy (or the first edge of a self pair).
     pub a: [u32; 2],
+    /// The edge of the second hierarchy (or the second edge of a self pair).
     pub b: [u32; 2],
+    /// Squared distance of the closed segments (exact decision, rounded value).
     pub distance_sq: f64,
+    /// Which sub-features are closest (IPC's edge-edge distance type).
     pub kind: EdgeEdge,
 }
 

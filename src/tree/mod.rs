@@ -48,7 +48,10 @@ const _: () = assert!(MAX_CHILDREN <= BLOCK, "a sibling group fits one block");
 pub enum TreeShape {
     /// Split every node holding more than `leaf_size` triangles (the default: the depth
     /// follows the mesh).
-    Adaptive { leaf_size: usize },
+    Adaptive {
+        /// Most triangles in a leaf.
+        leaf_size: usize,
+    },
     /// The paper's fixed depth: split every node of two or more triangles above the last
     /// of this many levels (root = level 0).
     Levels(usize),
@@ -210,6 +213,7 @@ impl RegionTree {
         (0..self.node_count()).filter(|&n| self.is_leaf(n))
     }
 
+    /// Number of nodes.
     pub fn node_count(&self) -> usize {
         self.first_child.len()
     }
@@ -311,10 +315,12 @@ impl RegionTree {
         &self.vert_slot
     }
 
+    /// Number of vertices (those no triangle uses included).
     pub fn vertex_total(&self) -> usize {
         self.vert_order.len()
     }
 
+    /// Number of triangles.
     pub fn triangle_total(&self) -> usize {
         self.tris.len()
     }

@@ -7,7 +7,9 @@ use crate::mesh::Mesh;
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("region tree invariant violated at node {node}: {what}")]
 pub struct TreeError {
+    /// The node where the invariant fails.
     pub node: usize,
+    /// Which invariant.
     pub what: String,
 }
 
