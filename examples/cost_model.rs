@@ -2,8 +2,8 @@
 //! returns: `N_V` BV pairs tested, `N_P` triangle pairs tested, `N_U` BVs refitted. A small
 //! waving sphere moves from the centre of a large waving sphere out through its shell; every
 //! step hands both hierarchies their new positions and times `collide` (whose lazy refit
-//! happens inside) for the three kinds: DH, sphere, AABB. The constants `C_V`, `C_P`, `C_U`
-//! are then fitted per kind by least squares on these same steps, so "model ms" is a fit, not
+//! happens inside) for the three methods: DH, sphere, AABB. The constants `C_V`, `C_P`, `C_U`
+//! are then fitted per method by least squares on these same steps, so "model ms" is a fit, not
 //! a prediction: it shows how much of the measured time the three counts explain ("worst
 //! step": the largest relative miss on one step). Fitted on whole queries, each constant also
 //! absorbs the overheads that grow with its count, and timings vary from run to run; the
@@ -14,7 +14,7 @@
 
 use std::time::Instant;
 
-use dhcd::bv::{Aabb, BvKind, Dh, Sphere};
+use dhcd::bv::{Aabb, BoundingVolume, Dh, Sphere};
 use dhcd::shapes::{icosphere, wave};
 use dhcd::{collide, Counters, Hierarchy, Mesh, Options};
 
@@ -25,8 +25,8 @@ const REPS: usize = 5;
 /// One timed query: its counters and its time in ms.
 type Row = (Counters, f64);
 
-/// Every step's two timed queries for kind `K`: `[step, again]`.
-fn measure<K: BvKind>(a: &Mesh, b: &Mesh) -> dhcd::Result<Vec<[Row; 2]>> {
+/// Every step's two timed queries for method `K`: `[step, again]`.
+fn measure<K: BoundingVolume>(a: &Mesh, b: &Mesh) -> dhcd::Result<Vec<[Row; 2]>> {
     // The paper's fixed 5-level tree, as in docs/RESULTS.md, so the constants compare.
     let mut ha = Hierarchy::<K>::new(a, Options::paper())?;
     let mut hb = Hierarchy::<K>::new(b, Options::paper())?;
@@ -95,16 +95,16 @@ fn main() -> dhcd::Result<()> {
     let n = a.triangle_count() + b.triangle_count();
     println!("{n} triangles, {STEPS} steps (least of {REPS} replays), C fitted on the same steps");
     println!(
-        "kind          N_V       N_P      N_U  contacts  measured ms  model ms  \
+        "method        N_V       N_P      N_U  contacts  measured ms  model ms  \
          worst step  C_V ns  C_P ns  C_U ns"
     );
     type Measure = fn(&Mesh, &Mesh) -> dhcd::Result<Vec<[Row; 2]>>;
-    let kinds: [(&str, Measure); 3] = [
+    let methods: [(&str, Measure); 3] = [
         ("DH", measure::<Dh>),
         ("sphere", measure::<Sphere>),
         ("AABB", measure::<Aabb>),
     ];
-    for (name, measure) in kinds {
+    for (name, measure) in methods {
         let steps = measure(&a, &b)?;
         let c = fit(&steps.concat());
         let model = |(n, _): &Row| (0..3).map(|k| counts(n)[k] * c[k]).sum::<f64>();

@@ -11,7 +11,8 @@
 //!
 //! Examples (in `examples/`, each run in CI): `deforming_step` (the step loop on a real
 //! frame pair, with the counters), `scene` (several objects), `cloth_proximity_ccd`
-//! (self-contacts, proximity and CCD of a folding sheet in `f64`).
+//! (self-contacts, proximity and CCD of a folding sheet in `f64`), `cost_model` (the
+//! counters of each step and the cost constants fitted to them).
 //!
 //! ```
 //! use dhcd::{bv::Dh, collide, Hierarchy, Mesh, Options};
