@@ -1,5 +1,5 @@
 //! The C ABI from Rust: results equal the Rust API, bad arguments are error codes (null,
-//! mismatched lengths, wrong kind, unknown ids), and `include/dhcd.h` declares exactly the
+//! mismatched lengths, wrong method, unknown ids), and `include/dhcd.h` declares exactly the
 //! exported functions and constants.
 
 use std::ffi::CStr;
@@ -700,7 +700,7 @@ fn bad_arguments_are_error_codes() {
             DHCD_ERR_INVALID_ARGUMENT
         );
         assert!(h.is_null() && s.is_null());
-        // Wrong kind; the same handle twice.
+        // Wrong method; the same handle twice.
         assert_eq!(dhcd_collide(a, b, 1, &mut c), DHCD_ERR_WRONG_KIND);
         assert!(last_error().contains("dh") && last_error().contains("aabb"));
         assert_eq!(
@@ -756,8 +756,8 @@ fn last_error_is_per_thread() {
 fn header_is_generated() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut config = cbindgen::Config::from_file(root.join("cbindgen.toml")).unwrap();
-    // The kinds' numbers, from the library's table of kinds.
-    let mut kinds = String::from("\n/**\n * Hierarchy kinds (`method` arguments).\n */");
+    // The methods' numbers, from the library's table of methods.
+    let mut kinds = String::from("\n/**\n * Hierarchy methods (`method` arguments).\n */");
     for m in Method::ALL {
         let name = m.name().to_uppercase();
         kinds += &format!("\n#define DHCD_METHOD_{name} {}", m.code());
