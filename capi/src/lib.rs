@@ -28,6 +28,7 @@
 //! `threads` arguments: `1` runs on the calling thread, `0` on rayon's global pool (all
 //! cores), `n` on a pool of `n` threads but never more than the machine's cores; above
 //! `dhcd::Par::MAX_THREADS` (1024) is `DHCD_ERR_INVALID_ARGUMENT`. Results never depend on it.
+#![warn(missing_docs)]
 
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CString};

@@ -24,6 +24,7 @@
 //! (The `dhcd` crate rejects non-finite input before it reaches a kernel, so this only
 //! matters to direct users of this crate.)
 #![deny(unsafe_op_in_unsafe_fn)]
+#![warn(missing_docs)]
 // Kernels index several parallel arrays (lanes x fields, axes) with one counter; the
 // iterator forms clippy suggests hide that layout.
 #![allow(clippy::needless_range_loop)]
