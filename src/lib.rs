@@ -20,14 +20,19 @@
 //!     vec![[dx, 0.0, 0.0], [dx + 1.0, 0.0, 0.0], [dx, 1.0, 0.0]],
 //!     vec![[0, 1, 2]],
 //! ).unwrap();
-//! let mut a = Hierarchy::<Dh>::new(&tri(0.0), Options::default())?;
+//! let a = Hierarchy::<Dh>::new(&tri(0.0), Options::default())?;
 //! let mut b = Hierarchy::<Dh>::new(&tri(0.5), Options::default())?;
-//! assert_eq!(collide(&mut a, &mut b).pairs, vec![[0, 0]]);
+//! assert_eq!(collide(&a, &b).pairs, vec![[0, 0]]);
 //! // Deform: move B away; the lazy refit follows.
 //! b.update_positions(&[[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, 1.0, 0.0]])?;
-//! assert!(collide(&mut a, &mut b).pairs.is_empty());
+//! assert!(collide(&a, &b).pairs.is_empty());
 //! # Ok::<(), dhcd::Error>(())
 //! ```
+//!
+//! Where things are: the hierarchies, queries, results, [`Scene`] and errors at the root;
+//! the methods as types in [`bv`]; loading meshes in [`io`]; one feature pair at a time in
+//! [`distance`] and [`ccd`]; the cost-model hooks in [`calibration`]. What is public and
+//! stable: `docs/ARCHITECTURE.md`, "The public API".
 //!
 //! This crate is the kernel library only; the C ABI (`dhcd-capi`), the command line with the
 //! paper's experiment and its simulator (`dhcd-cli`) and the Python package are crates of

@@ -1,4 +1,4 @@
-//! Contact detail (opt-in): the intersection segment of each contact, for simulations that
+//! Contact segments (opt-in): the intersection segment of each contact, for simulations that
 //! need contact points rather than triangle pairs. The queries never compute it; call these
 //! on their results, in the same pose.
 
@@ -45,7 +45,7 @@ impl<'h, K: BoundingVolume> OriginalCorners<'h, K> {
 /// from an earlier pose).
 ///
 /// ```
-/// use dhcd::{bv::Aabb, collide, detail::contact_segments, Hierarchy, Mesh, Options};
+/// use dhcd::{bv::Aabb, collide, contact_segments, Hierarchy, Mesh, Options};
 /// let a = Mesh::new(vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]], vec![[0, 1, 2]])?;
 /// let b = Mesh::new(vec![[0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [0.2, 0.8, 0.0]], vec![[0, 1, 2]])?;
 /// let (mut ha, mut hb) = (Hierarchy::<Aabb>::new(&a, Options::default())?, Hierarchy::<Aabb>::new(&b, Options::default())?);
