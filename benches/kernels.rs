@@ -342,37 +342,37 @@ fn refit_benches(c: &mut Criterion) {
     bench_refit(
         c,
         "max_dist_sq",
-        &|p, _| [reference::max_dist_sq_scalar(p, ctr); 6],
+        &|p, _| [reference::max_dist_sq_scalar_lanes(p, ctr, 1); 6],
         &dispatched(Reduction::MaxDistSq, ctr),
     );
     bench_refit(
         c,
         "max_dist_sq_indexed",
-        &|p, i| [reference::max_dist_sq_indexed_scalar(p, i, ctr); 6],
+        &|p, i| [reference::max_dist_sq_indexed_scalar_lanes(p, i, ctr, 1); 6],
         &dispatched(Reduction::MaxDistSqIndexed, ctr),
     );
     bench_refit(
         c,
         "sum",
-        &|p, _| s3(reference::sum_scalar(p)),
+        &|p, _| s3(reference::sum_scalar_lanes(p, 1)),
         &dispatched(Reduction::Sum, ctr),
     );
     bench_refit(
         c,
         "sum_indexed",
-        &|p, i| s3(reference::sum_indexed_scalar(p, i)),
+        &|p, i| s3(reference::sum_indexed_scalar_lanes(p, i, 1)),
         &dispatched(Reduction::SumIndexed, ctr),
     );
     bench_refit(
         c,
         "bounds",
-        &|p, _| flat(reference::bounds_scalar(p)),
+        &|p, _| flat(reference::bounds_scalar_lanes(p, 1)),
         &dispatched(Reduction::Bounds, ctr),
     );
     bench_refit(
         c,
         "bounds_indexed",
-        &|p, i| flat(reference::bounds_indexed_scalar(p, i)),
+        &|p, i| flat(reference::bounds_indexed_scalar_lanes(p, i, 1)),
         &dispatched(Reduction::BoundsIndexed, ctr),
     );
 }

@@ -54,7 +54,7 @@ def visit(i,path):
                 ci=idx.get(str(c))
                 if ci and ci.get('visibility')=='public' and not hidden(ci):
                     counts['method']+=1; names.append(('method',p+'::'+ci['name']))
-visit(root,'dhcd')
+visit(root, idx[str(root)]['name'])
 print(sum(counts.values()), dict(counts))
 if '--list' in sys.argv[2:]:
     for k,p in sorted(names,key=lambda x:x[1]): print(k,p)

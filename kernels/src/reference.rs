@@ -11,7 +11,7 @@
 //!   [`plane_separated`]; bit-identical rows on every backend.
 //! - Refit ([`crate::refit`]): `*_scalar_lanes(.., lanes)` reduce in the order of a
 //!   `lanes`-wide SIMD body (equal bit for bit to `*_with` on a backend of `lanes` lanes);
-//!   `*_scalar` is the sequential (1-lane) order. [`f32_lanes`] is the lane count of the
+//!   `lanes = 1` is the sequential order. [`f32_lanes`] is the lane count of the
 //!   dispatched backend, the one [`crate::refit::bounds`] runs on.
 
 use crate::lanes::{fold_max, fold_min, fold_sum};
@@ -323,21 +323,10 @@ fn indexed<'a>(p: Soa3<'a>, idx: &'a [u32]) -> impl Iterator<Item = [f32; 3]> + 
     idx.iter().map(move |&i| p.get(i as usize))
 }
 
-/// Scalar reference of [`crate::refit::max_dist_sq_with`] (sequential: [`max_dist_sq_scalar_lanes`]
-/// with 1 lane).
-pub fn max_dist_sq_scalar(p: Soa3, c: [f32; 3]) -> f32 {
-    max_dist_sq_scalar_lanes(p, c, 1)
-}
-
 /// Reference of [`crate::refit::max_dist_sq_with`] in the order of a `lanes`-wide SIMD body (see
 /// the [`crate::refit`] module doc).
 pub fn max_dist_sq_scalar_lanes(p: Soa3, c: [f32; 3], lanes: usize) -> f32 {
     max_dist_sq_ref(run(p), c, lanes)
-}
-
-/// Scalar reference of [`crate::refit::max_dist_sq_indexed_with`] (sequential).
-pub fn max_dist_sq_indexed_scalar(p: Soa3, idx: &[u32], c: [f32; 3]) -> f32 {
-    max_dist_sq_indexed_scalar_lanes(p, idx, c, 1)
 }
 
 /// Reference of [`crate::refit::max_dist_sq_indexed_with`] in the order of a `lanes`-wide SIMD
@@ -346,19 +335,9 @@ pub fn max_dist_sq_indexed_scalar_lanes(p: Soa3, idx: &[u32], c: [f32; 3], lanes
     max_dist_sq_ref(indexed(p, idx), c, lanes)
 }
 
-/// Scalar reference of [`crate::refit::sum_with`] (sequential).
-pub fn sum_scalar(p: Soa3) -> [f32; 3] {
-    sum_scalar_lanes(p, 1)
-}
-
 /// Reference of [`crate::refit::sum_with`] in the order of a `lanes`-wide SIMD body.
 pub fn sum_scalar_lanes(p: Soa3, lanes: usize) -> [f32; 3] {
     sum_ref(run(p), lanes)
-}
-
-/// Scalar reference of [`crate::refit::sum_indexed_with`] (sequential).
-pub fn sum_indexed_scalar(p: Soa3, idx: &[u32]) -> [f32; 3] {
-    sum_indexed_scalar_lanes(p, idx, 1)
 }
 
 /// Reference of [`crate::refit::sum_indexed_with`] in the order of a `lanes`-wide SIMD body.
@@ -366,19 +345,9 @@ pub fn sum_indexed_scalar_lanes(p: Soa3, idx: &[u32], lanes: usize) -> [f32; 3] 
     sum_ref(indexed(p, idx), lanes)
 }
 
-/// Scalar reference of [`crate::refit::bounds_with`] (sequential).
-pub fn bounds_scalar(p: Soa3) -> ([f32; 3], [f32; 3]) {
-    bounds_scalar_lanes(p, 1)
-}
-
 /// Reference of [`crate::refit::bounds_with`] in the order of a `lanes`-wide SIMD body.
 pub fn bounds_scalar_lanes(p: Soa3, lanes: usize) -> ([f32; 3], [f32; 3]) {
     bounds_ref(run(p), lanes)
-}
-
-/// Scalar reference of [`crate::refit::bounds_indexed_with`] (sequential).
-pub fn bounds_indexed_scalar(p: Soa3, idx: &[u32]) -> ([f32; 3], [f32; 3]) {
-    bounds_indexed_scalar_lanes(p, idx, 1)
 }
 
 /// Reference of [`crate::refit::bounds_indexed_with`] in the order of a `lanes`-wide SIMD body.

@@ -209,7 +209,7 @@ impl WithSimd for Sum<'_> {
 
 /// Component-wise sum of the points (for the sphere centre, the mean), on the backend
 /// `simd`: `S::F32_LANES` interleaved partial sums, so it may differ from the sequential
-/// [`crate::reference::sum_scalar`] by rounding.
+/// [`crate::reference::sum_scalar_lanes`] with one lane by rounding.
 pub fn sum_with<S: Simd>(simd: S, p: Soa3) -> [f32; 3] {
     simd.vectorize(Sum { p, idx: None })
 }

@@ -1204,20 +1204,20 @@ fn check_refit<S: Simd>(simd: S) {
                 // The sequential references are the 1-lane case.
                 assert_eq!(
                     bits3(refit::sum_with(simd, p)),
-                    bits3(reference::sum_scalar(p))
+                    bits3(reference::sum_scalar_lanes(p, 1))
                 );
                 assert_eq!(
                     bits_box(refit::bounds_with(simd, p)),
-                    bits_box(reference::bounds_scalar(p))
+                    bits_box(reference::bounds_scalar_lanes(p, 1))
                 );
             }
             // Max/min do not depend on the order except for +-0 ties; compare values.
             let (lo, hi) = refit::bounds_with(simd, p);
-            let (slo, shi) = reference::bounds_scalar(p);
+            let (slo, shi) = reference::bounds_scalar_lanes(p, 1);
             assert_eq!((lo, hi), (slo, shi));
             assert_eq!(
                 refit::max_dist_sq_with(simd, p, [0.5; 3]),
-                reference::max_dist_sq_scalar(p, [0.5; 3])
+                reference::max_dist_sq_scalar_lanes(p, [0.5; 3], 1)
             );
         }
     }
@@ -1408,7 +1408,7 @@ fn lane_references_agree_with_sequential_on_exact_data() {
     // Small integers sum exactly in any order, so every lane count gives the same sum.
     let x: Vec<f32> = (0..1000).map(|i| (i % 17) as f32).collect();
     let p = Soa3::new(&x, &x, &x);
-    let want = reference::sum_scalar(p);
+    let want = reference::sum_scalar_lanes(p, 1);
     assert_eq!(want[0], (0..1000).map(|i| (i % 17) as f32).sum::<f32>());
     for lanes in [1, 2, 4, 8, 16, 64] {
         assert_eq!(reference::sum_scalar_lanes(p, lanes), want);
