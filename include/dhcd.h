@@ -152,9 +152,22 @@ typedef struct DhcdScene DhcdScene;
  * Counted work of a query (the cost model's `N_V`, `N_P`, `N_U`, and the contacts).
  */
 typedef struct DhcdCounters {
+  /**
+   * `N_V`: bounding-volume pairs tested for overlap (CCD: node pairs tested over the step).
+   */
   uint64_t bv_tests;
+  /**
+   * `N_P`: pairs given to the exact test (triangle pairs; feature pairs for proximity and
+   * CCD).
+   */
   uint64_t prim_tests;
+  /**
+   * `N_U`: bounding volumes refitted (CCD: bounds fitted over the step).
+   */
   uint64_t bv_updates;
+  /**
+   * Pairs reported: intersecting triangle pairs, or the rows of a proximity or CCD result.
+   */
   uint64_t contacts;
 } DhcdCounters;
 
@@ -163,8 +176,18 @@ typedef struct DhcdCounters {
  * `pairs[2k+1]` (original triangle indices), sorted. `pairs` is null when `count == 0`.
  */
 typedef struct DhcdContacts {
+  /**
+   * Row-major `[count][2]` array of `[tri of a, tri of b]` (self: `[ti, tj]`, `ti < tj`);
+   * freed by `dhcd_contacts_free`.
+   */
   uint32_t *pairs;
+  /**
+   * Number of rows of `pairs`.
+   */
   size_t count;
+  /**
+   * Work counted by the query.
+   */
   struct DhcdCounters counters;
 } DhcdContacts;
 
@@ -186,18 +209,66 @@ typedef struct DhcdContacts {
  * `counters.contacts` the rows of the three lists.
  */
 typedef struct DhcdProximity {
+  /**
+   * Row-major `[vf_count][2]` array of `[vertex of a, triangle of b]`; freed by
+   * `dhcd_proximity_free`.
+   */
   uint32_t *vertex_face;
+  /**
+   * Squared distance of each `vertex_face` row (`vf_count` doubles); freed by
+   * `dhcd_proximity_free`.
+   */
   double *vf_distance_sq;
+  /**
+   * `DHCD_PT_*` distance type of each `vertex_face` row (`vf_count` bytes); freed by
+   * `dhcd_proximity_free`.
+   */
   uint8_t *vf_type;
+  /**
+   * Number of rows of `vertex_face`.
+   */
   size_t vf_count;
+  /**
+   * Row-major `[fv_count][2]` array of `[triangle of a, vertex of b]` (empty for self); freed
+   * by `dhcd_proximity_free`.
+   */
   uint32_t *face_vertex;
+  /**
+   * Squared distance of each `face_vertex` row (`fv_count` doubles); freed by
+   * `dhcd_proximity_free`.
+   */
   double *fv_distance_sq;
+  /**
+   * `DHCD_PT_*` distance type of each `face_vertex` row (`fv_count` bytes); freed by
+   * `dhcd_proximity_free`.
+   */
   uint8_t *fv_type;
+  /**
+   * Number of rows of `face_vertex`.
+   */
   size_t fv_count;
+  /**
+   * Row-major `[ee_count][4]` array of `[a0, a1, b0, b1]`, an edge of `a` and one of `b`;
+   * freed by `dhcd_proximity_free`.
+   */
   uint32_t *edge_edge;
+  /**
+   * Squared distance of each `edge_edge` row (`ee_count` doubles); freed by
+   * `dhcd_proximity_free`.
+   */
   double *ee_distance_sq;
+  /**
+   * `DHCD_EE_*` distance type of each `edge_edge` row (`ee_count` bytes); freed by
+   * `dhcd_proximity_free`.
+   */
   uint8_t *ee_type;
+  /**
+   * Number of rows of `edge_edge`.
+   */
   size_t ee_count;
+  /**
+   * Work counted by the query.
+   */
   struct DhcdCounters counters;
 } DhcdProximity;
 
@@ -223,16 +294,55 @@ typedef struct DhcdProximity {
  * `contacts` the rows of the three lists.
  */
 typedef struct DhcdImpacts {
+  /**
+   * Row-major `[vf_count][2]` array of `[vertex of a, triangle of b]`; freed by
+   * `dhcd_impacts_free`.
+   */
   uint32_t *vertex_face;
+  /**
+   * Time of impact of each `vertex_face` row, in `[0, t_max]` (`vf_count` doubles); freed
+   * by `dhcd_impacts_free`.
+   */
   double *vf_toi;
+  /**
+   * Number of rows of `vertex_face`.
+   */
   size_t vf_count;
+  /**
+   * Row-major `[fv_count][2]` array of `[triangle of a, vertex of b]` (empty for self); freed
+   * by `dhcd_impacts_free`.
+   */
   uint32_t *face_vertex;
+  /**
+   * Time of impact of each `face_vertex` row, in `[0, t_max]` (`fv_count` doubles); freed
+   * by `dhcd_impacts_free`.
+   */
   double *fv_toi;
+  /**
+   * Number of rows of `face_vertex`.
+   */
   size_t fv_count;
+  /**
+   * Row-major `[ee_count][4]` array of `[a0, a1, b0, b1]`, an edge of `a` and one of `b`;
+   * freed by `dhcd_impacts_free`.
+   */
   uint32_t *edge_edge;
+  /**
+   * Time of impact of each `edge_edge` row, in `[0, t_max]` (`ee_count` doubles); freed
+   * by `dhcd_impacts_free`.
+   */
   double *ee_toi;
+  /**
+   * Number of rows of `edge_edge`.
+   */
   size_t ee_count;
+  /**
+   * Earliest time of impact of the step, in `[0, t_max]`; `+inf` when nothing collides.
+   */
   double toi;
+  /**
+   * Work counted over the step.
+   */
   struct DhcdCounters counters;
 } DhcdImpacts;
 
@@ -241,8 +351,19 @@ typedef struct DhcdImpacts {
  * tri_b]` at `pairs[4k..4k+4]`, sorted. `pairs` is null when `count == 0`.
  */
 typedef struct DhcdSceneContacts {
+  /**
+   * Row-major `[count][4]` array of `[object_a, tri_a, object_b, tri_b]`: `object_a <
+   * object_b`, or `object_a == object_b` and `tri_a < tri_b` for a self-contact; freed by
+   * `dhcd_scene_contacts_free`.
+   */
   uint64_t *pairs;
+  /**
+   * Number of rows of `pairs`.
+   */
   size_t count;
+  /**
+   * Work counted by the query, summed over the object pairs queried.
+   */
   struct DhcdCounters counters;
 } DhcdSceneContacts;
 
@@ -258,18 +379,66 @@ typedef struct DhcdSceneContacts {
  * `counters` are the totals over the object pairs.
  */
 typedef struct DhcdSceneProximity {
+  /**
+   * Row-major `[vf_count][4]` array of `[object_a, vertex, object_b, triangle]`; freed by
+   * `dhcd_scene_proximity_free`.
+   */
   uint64_t *vertex_face;
+  /**
+   * Squared distance of each `vertex_face` row (`vf_count` doubles); freed by
+   * `dhcd_scene_proximity_free`.
+   */
   double *vf_distance_sq;
+  /**
+   * `DHCD_PT_*` distance type of each `vertex_face` row (`vf_count` bytes); freed by
+   * `dhcd_scene_proximity_free`.
+   */
   uint8_t *vf_type;
+  /**
+   * Number of rows of `vertex_face`.
+   */
   size_t vf_count;
+  /**
+   * Row-major `[fv_count][4]` array of `[object_a, triangle, object_b, vertex]` (between two
+   * objects only); freed by `dhcd_scene_proximity_free`.
+   */
   uint64_t *face_vertex;
+  /**
+   * Squared distance of each `face_vertex` row (`fv_count` doubles); freed by
+   * `dhcd_scene_proximity_free`.
+   */
   double *fv_distance_sq;
+  /**
+   * `DHCD_PT_*` distance type of each `face_vertex` row (`fv_count` bytes); freed by
+   * `dhcd_scene_proximity_free`.
+   */
   uint8_t *fv_type;
+  /**
+   * Number of rows of `face_vertex`.
+   */
   size_t fv_count;
+  /**
+   * Row-major `[ee_count][6]` array of `[object_a, a0, a1, object_b, b0, b1]`; freed by
+   * `dhcd_scene_proximity_free`.
+   */
   uint64_t *edge_edge;
+  /**
+   * Squared distance of each `edge_edge` row (`ee_count` doubles); freed by
+   * `dhcd_scene_proximity_free`.
+   */
   double *ee_distance_sq;
+  /**
+   * `DHCD_EE_*` distance type of each `edge_edge` row (`ee_count` bytes); freed by
+   * `dhcd_scene_proximity_free`.
+   */
   uint8_t *ee_type;
+  /**
+   * Number of rows of `edge_edge`.
+   */
   size_t ee_count;
+  /**
+   * Work counted by the query, summed over the object pairs queried.
+   */
   struct DhcdCounters counters;
 } DhcdSceneProximity;
 
@@ -286,16 +455,55 @@ typedef struct DhcdSceneProximity {
  * `counters` are the totals over the object pairs.
  */
 typedef struct DhcdSceneImpacts {
+  /**
+   * Row-major `[vf_count][4]` array of `[object_a, vertex, object_b, triangle]`; freed by
+   * `dhcd_scene_impacts_free`.
+   */
   uint64_t *vertex_face;
+  /**
+   * Time of impact of each `vertex_face` row, in `[0, t_max]` (`vf_count` doubles); freed
+   * by `dhcd_scene_impacts_free`.
+   */
   double *vf_toi;
+  /**
+   * Number of rows of `vertex_face`.
+   */
   size_t vf_count;
+  /**
+   * Row-major `[fv_count][4]` array of `[object_a, triangle, object_b, vertex]` (between two
+   * objects only); freed by `dhcd_scene_impacts_free`.
+   */
   uint64_t *face_vertex;
+  /**
+   * Time of impact of each `face_vertex` row, in `[0, t_max]` (`fv_count` doubles); freed
+   * by `dhcd_scene_impacts_free`.
+   */
   double *fv_toi;
+  /**
+   * Number of rows of `face_vertex`.
+   */
   size_t fv_count;
+  /**
+   * Row-major `[ee_count][6]` array of `[object_a, a0, a1, object_b, b0, b1]`; freed by
+   * `dhcd_scene_impacts_free`.
+   */
   uint64_t *edge_edge;
+  /**
+   * Time of impact of each `edge_edge` row, in `[0, t_max]` (`ee_count` doubles); freed
+   * by `dhcd_scene_impacts_free`.
+   */
   double *ee_toi;
+  /**
+   * Number of rows of `edge_edge`.
+   */
   size_t ee_count;
+  /**
+   * Earliest time of impact over the scene, in `[0, t_max]`; `+inf` when nothing collides.
+   */
   double toi;
+  /**
+   * Work counted over the step, summed over the object pairs queried.
+   */
   struct DhcdCounters counters;
 } DhcdSceneImpacts;
 

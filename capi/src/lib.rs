@@ -96,9 +96,14 @@ pub const DHCD_PRECISION_F64: c_int = 64;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct DhcdCounters {
+    /// `N_V`: bounding-volume pairs tested for overlap (CCD: node pairs tested over the step).
     pub bv_tests: u64,
+    /// `N_P`: pairs given to the exact test (triangle pairs; feature pairs for proximity and
+    /// CCD).
     pub prim_tests: u64,
+    /// `N_U`: bounding volumes refitted (CCD: bounds fitted over the step).
     pub bv_updates: u64,
+    /// Pairs reported: intersecting triangle pairs, or the rows of a proximity or CCD result.
     pub contacts: u64,
 }
 
@@ -118,8 +123,12 @@ impl From<Counters> for DhcdCounters {
 #[repr(C)]
 #[derive(Debug)]
 pub struct DhcdContacts {
+    /// Row-major `[count][2]` array of `[tri of a, tri of b]` (self: `[ti, tj]`, `ti < tj`);
+    /// freed by `dhcd_contacts_free`.
     pub pairs: *mut u32,
+    /// Number of rows of `pairs`.
     pub count: usize,
+    /// Work counted by the query.
     pub counters: DhcdCounters,
 }
 
@@ -128,8 +137,13 @@ pub struct DhcdContacts {
 #[repr(C)]
 #[derive(Debug)]
 pub struct DhcdSceneContacts {
+    /// Row-major `[count][4]` array of `[object_a, tri_a, object_b, tri_b]`: `object_a <
+    /// object_b`, or `object_a == object_b` and `tri_a < tri_b` for a self-contact; freed by
+    /// `dhcd_scene_contacts_free`.
     pub pairs: *mut u64,
+    /// Number of rows of `pairs`.
     pub count: usize,
+    /// Work counted by the query, summed over the object pairs queried.
     pub counters: DhcdCounters,
 }
 
@@ -151,18 +165,40 @@ pub struct DhcdSceneContacts {
 #[repr(C)]
 #[derive(Debug)]
 pub struct DhcdProximity {
+    /// Row-major `[vf_count][2]` array of `[vertex of a, triangle of b]`; freed by
+    /// `dhcd_proximity_free`.
     pub vertex_face: *mut u32,
+    /// Squared distance of each `vertex_face` row (`vf_count` doubles); freed by
+    /// `dhcd_proximity_free`.
     pub vf_distance_sq: *mut f64,
+    /// `DHCD_PT_*` distance type of each `vertex_face` row (`vf_count` bytes); freed by
+    /// `dhcd_proximity_free`.
     pub vf_type: *mut u8,
+    /// Number of rows of `vertex_face`.
     pub vf_count: usize,
+    /// Row-major `[fv_count][2]` array of `[triangle of a, vertex of b]` (empty for self); freed
+    /// by `dhcd_proximity_free`.
     pub face_vertex: *mut u32,
+    /// Squared distance of each `face_vertex` row (`fv_count` doubles); freed by
+    /// `dhcd_proximity_free`.
     pub fv_distance_sq: *mut f64,
+    /// `DHCD_PT_*` distance type of each `face_vertex` row (`fv_count` bytes); freed by
+    /// `dhcd_proximity_free`.
     pub fv_type: *mut u8,
+    /// Number of rows of `face_vertex`.
     pub fv_count: usize,
+    /// Row-major `[ee_count][4]` array of `[a0, a1, b0, b1]`, an edge of `a` and one of `b`;
+    /// freed by `dhcd_proximity_free`.
     pub edge_edge: *mut u32,
+    /// Squared distance of each `edge_edge` row (`ee_count` doubles); freed by
+    /// `dhcd_proximity_free`.
     pub ee_distance_sq: *mut f64,
+    /// `DHCD_EE_*` distance type of each `edge_edge` row (`ee_count` bytes); freed by
+    /// `dhcd_proximity_free`.
     pub ee_type: *mut u8,
+    /// Number of rows of `edge_edge`.
     pub ee_count: usize,
+    /// Work counted by the query.
     pub counters: DhcdCounters,
 }
 
@@ -178,18 +214,40 @@ pub struct DhcdProximity {
 #[repr(C)]
 #[derive(Debug)]
 pub struct DhcdSceneProximity {
+    /// Row-major `[vf_count][4]` array of `[object_a, vertex, object_b, triangle]`; freed by
+    /// `dhcd_scene_proximity_free`.
     pub vertex_face: *mut u64,
+    /// Squared distance of each `vertex_face` row (`vf_count` doubles); freed by
+    /// `dhcd_scene_proximity_free`.
     pub vf_distance_sq: *mut f64,
+    /// `DHCD_PT_*` distance type of each `vertex_face` row (`vf_count` bytes); freed by
+    /// `dhcd_scene_proximity_free`.
     pub vf_type: *mut u8,
+    /// Number of rows of `vertex_face`.
     pub vf_count: usize,
+    /// Row-major `[fv_count][4]` array of `[object_a, triangle, object_b, vertex]` (between two
+    /// objects only); freed by `dhcd_scene_proximity_free`.
     pub face_vertex: *mut u64,
+    /// Squared distance of each `face_vertex` row (`fv_count` doubles); freed by
+    /// `dhcd_scene_proximity_free`.
     pub fv_distance_sq: *mut f64,
+    /// `DHCD_PT_*` distance type of each `face_vertex` row (`fv_count` bytes); freed by
+    /// `dhcd_scene_proximity_free`.
     pub fv_type: *mut u8,
+    /// Number of rows of `face_vertex`.
     pub fv_count: usize,
+    /// Row-major `[ee_count][6]` array of `[object_a, a0, a1, object_b, b0, b1]`; freed by
+    /// `dhcd_scene_proximity_free`.
     pub edge_edge: *mut u64,
+    /// Squared distance of each `edge_edge` row (`ee_count` doubles); freed by
+    /// `dhcd_scene_proximity_free`.
     pub ee_distance_sq: *mut f64,
+    /// `DHCD_EE_*` distance type of each `edge_edge` row (`ee_count` bytes); freed by
+    /// `dhcd_scene_proximity_free`.
     pub ee_type: *mut u8,
+    /// Number of rows of `edge_edge`.
     pub ee_count: usize,
+    /// Work counted by the query, summed over the object pairs queried.
     pub counters: DhcdCounters,
 }
 
@@ -215,16 +273,33 @@ pub struct DhcdSceneProximity {
 #[repr(C)]
 #[derive(Debug)]
 pub struct DhcdImpacts {
+    /// Row-major `[vf_count][2]` array of `[vertex of a, triangle of b]`; freed by
+    /// `dhcd_impacts_free`.
     pub vertex_face: *mut u32,
+    /// Time of impact of each `vertex_face` row, in `[0, t_max]` (`vf_count` doubles); freed
+    /// by `dhcd_impacts_free`.
     pub vf_toi: *mut f64,
+    /// Number of rows of `vertex_face`.
     pub vf_count: usize,
+    /// Row-major `[fv_count][2]` array of `[triangle of a, vertex of b]` (empty for self); freed
+    /// by `dhcd_impacts_free`.
     pub face_vertex: *mut u32,
+    /// Time of impact of each `face_vertex` row, in `[0, t_max]` (`fv_count` doubles); freed
+    /// by `dhcd_impacts_free`.
     pub fv_toi: *mut f64,
+    /// Number of rows of `face_vertex`.
     pub fv_count: usize,
+    /// Row-major `[ee_count][4]` array of `[a0, a1, b0, b1]`, an edge of `a` and one of `b`;
+    /// freed by `dhcd_impacts_free`.
     pub edge_edge: *mut u32,
+    /// Time of impact of each `edge_edge` row, in `[0, t_max]` (`ee_count` doubles); freed
+    /// by `dhcd_impacts_free`.
     pub ee_toi: *mut f64,
+    /// Number of rows of `edge_edge`.
     pub ee_count: usize,
+    /// Earliest time of impact of the step, in `[0, t_max]`; `+inf` when nothing collides.
     pub toi: f64,
+    /// Work counted over the step.
     pub counters: DhcdCounters,
 }
 
@@ -241,16 +316,33 @@ pub struct DhcdImpacts {
 #[repr(C)]
 #[derive(Debug)]
 pub struct DhcdSceneImpacts {
+    /// Row-major `[vf_count][4]` array of `[object_a, vertex, object_b, triangle]`; freed by
+    /// `dhcd_scene_impacts_free`.
     pub vertex_face: *mut u64,
+    /// Time of impact of each `vertex_face` row, in `[0, t_max]` (`vf_count` doubles); freed
+    /// by `dhcd_scene_impacts_free`.
     pub vf_toi: *mut f64,
+    /// Number of rows of `vertex_face`.
     pub vf_count: usize,
+    /// Row-major `[fv_count][4]` array of `[object_a, triangle, object_b, vertex]` (between two
+    /// objects only); freed by `dhcd_scene_impacts_free`.
     pub face_vertex: *mut u64,
+    /// Time of impact of each `face_vertex` row, in `[0, t_max]` (`fv_count` doubles); freed
+    /// by `dhcd_scene_impacts_free`.
     pub fv_toi: *mut f64,
+    /// Number of rows of `face_vertex`.
     pub fv_count: usize,
+    /// Row-major `[ee_count][6]` array of `[object_a, a0, a1, object_b, b0, b1]`; freed by
+    /// `dhcd_scene_impacts_free`.
     pub edge_edge: *mut u64,
+    /// Time of impact of each `edge_edge` row, in `[0, t_max]` (`ee_count` doubles); freed
+    /// by `dhcd_scene_impacts_free`.
     pub ee_toi: *mut f64,
+    /// Number of rows of `edge_edge`.
     pub ee_count: usize,
+    /// Earliest time of impact over the scene, in `[0, t_max]`; `+inf` when nothing collides.
     pub toi: f64,
+    /// Work counted over the step, summed over the object pairs queried.
     pub counters: DhcdCounters,
 }
 

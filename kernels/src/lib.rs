@@ -327,12 +327,16 @@ impl<'a> Tile<'a> {
 /// Points (or centres) in structure-of-arrays form: `x[i], y[i], z[i]` is point `i`.
 #[derive(Clone, Copy, Debug)]
 pub struct Soa3<'a> {
+    /// The x coordinate of every point.
     pub x: &'a [f32],
+    /// The y coordinate of every point.
     pub y: &'a [f32],
+    /// The z coordinate of every point.
     pub z: &'a [f32],
 }
 
 impl<'a> Soa3<'a> {
+    /// The points of the three coordinate arrays; panics unless they have the same length.
     #[inline]
     pub fn new(x: &'a [f32], y: &'a [f32], z: &'a [f32]) -> Self {
         assert!(
@@ -342,16 +346,19 @@ impl<'a> Soa3<'a> {
         Self { x, y, z }
     }
 
+    /// Number of points.
     #[inline]
     pub fn len(&self) -> usize {
         self.x.len()
     }
 
+    /// Whether there are no points.
     #[inline]
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
     }
 
+    /// Point `i` as `[x, y, z]`; panics if `i >= len()`.
     #[inline]
     pub fn get(&self, i: usize) -> [f32; 3] {
         [self.x[i], self.y[i], self.z[i]]

@@ -244,6 +244,7 @@ impl<'a> TriSoa<'a> {
         self.tile.stride() - self.offset
     }
 
+    /// Whether no triangle remains from the offset on.
     #[inline(always)]
     pub fn is_empty(&self) -> bool {
         self.len() == 0

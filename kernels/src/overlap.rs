@@ -36,18 +36,22 @@ impl<'a> SphereSoa<'a> {
         Self { tile }
     }
 
+    /// Centre x of every sphere.
     #[inline(always)]
     pub fn cx(&self) -> &'a [f32] {
         self.tile.field(0)
     }
+    /// Centre y of every sphere.
     #[inline(always)]
     pub fn cy(&self) -> &'a [f32] {
         self.tile.field(1)
     }
+    /// Centre z of every sphere.
     #[inline(always)]
     pub fn cz(&self) -> &'a [f32] {
         self.tile.field(2)
     }
+    /// Radius of every sphere.
     #[inline(always)]
     pub fn r(&self) -> &'a [f32] {
         self.tile.field(3)
@@ -59,6 +63,7 @@ impl<'a> SphereSoa<'a> {
         self.tile.stride()
     }
 
+    /// Whether there are no entries.
     #[inline(always)]
     pub fn is_empty(&self) -> bool {
         self.len() == 0
@@ -102,6 +107,7 @@ impl<'a> AabbSoa<'a> {
         self.tile.stride()
     }
 
+    /// Whether there are no entries.
     #[inline(always)]
     pub fn is_empty(&self) -> bool {
         self.len() == 0
@@ -325,9 +331,13 @@ pub fn boxes_meet_with<S: Simd>(
 /// inequality on `(1 - t)(v0 - c0) + t (v1 - c1)`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MovingSphere {
+    /// Centre at `t = 0`.
     pub c0: [f64; 3],
+    /// Radius at `t = 0`.
     pub r0: f64,
+    /// Centre at `t = 1`.
     pub c1: [f64; 3],
+    /// Radius at `t = 1`.
     pub r1: f64,
 }
 
@@ -366,6 +376,7 @@ impl<'a> MovingSphereSoa<'a> {
         self.stride
     }
 
+    /// Whether there are no entries.
     #[inline(always)]
     pub fn is_empty(&self) -> bool {
         self.stride == 0
