@@ -21,7 +21,7 @@ use crate::walk::Workspace;
 
 methods!(crate::methods::method_enum {
     /// A hierarchy of a method chosen at run time: one variant per row of the table of methods
-    /// ([`crate::methods`]).
+    /// (`src/methods.rs`).
     #[derive(Clone, Debug)]
     #[non_exhaustive]
     pub enum AnyHierarchy(Hierarchy)

@@ -33,7 +33,7 @@ use crate::walk::Workspace;
 pub use crate::query::contacts::BroadPhase;
 
 /// The parts of a query and the refit, one at a time: implemented by
-/// [`Hierarchy`](crate::Hierarchy) and [`AnyHierarchy`](crate::AnyHierarchy).
+/// [`Hierarchy`] and [`AnyHierarchy`](crate::AnyHierarchy).
 pub trait Calibration {
     /// Marks every bounding volume stale without moving anything (the next query refits
     /// what it tests), to repeat a step's refit work.

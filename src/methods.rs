@@ -62,8 +62,8 @@ macro_rules! __for_each_method_arms {
 
 macro_rules! define_method {
     ({} $(($kind:ident, $code:literal, $name:literal, [$($alias:literal),*], $label:literal))*) => {
-        /// A method chosen at run time: one variant per row of the table of
-        /// methods (see [`crate::methods`]).
+        /// A method (one of the bounding-volume hierarchies the paper compares), chosen at
+        /// run time: one variant per row of the table of methods (`src/methods.rs`).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
         #[non_exhaustive]
         pub enum Method {

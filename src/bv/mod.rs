@@ -4,7 +4,7 @@
 //! The method is a compile-time policy ([`BoundingVolume`]); node data lives in structure-of-arrays
 //! buffers (one array per record field) whose sibling groups are contiguous, so one SIMD
 //! load covers the children of a node. [`Method`] names a method where it is chosen at run
-//! time; every method is a row of the table in [`crate::methods`].
+//! time; every method is a row of the table in `src/methods.rs`.
 
 mod aabb;
 mod bounds;
@@ -73,13 +73,13 @@ mod sealed {
     pub trait Sealed {}
 }
 
-/// A bounding-volume kind: its node record, its SoA buffers, how to fit a node to the
-/// current pose, and the wide overlap test. Sealed: the methods are the rows of the table in
-/// [`crate::methods`], the set the library compares; everything generic over them is
+/// A method as a type: its node record, its SoA buffers, how to fit a node to the current
+/// pose, and the wide overlap test. Sealed: the methods are the rows of the table in
+/// `src/methods.rs`, the set the library compares; everything generic over them is
 /// monomorphised (no per-node dispatch).
 ///
 /// Node bounds live in `LazyTiles` buffers grouped by *sibling group* (the children of one
-/// node, [`RegionTree::group_nodes`]): a group is fitted as a whole, just before its first
+/// node): a group is fitted as a whole, just before its first
 /// test in a step, by whichever thread needs it first. A wide test reads one node of a
 /// fitted group against a block of another fitted group.
 pub trait BoundingVolume:
