@@ -1,7 +1,7 @@
 //! Per-query CCD cost on the sample queries of `../shared/data/ccd/sample-queries`
-//! (Wang et al. 2021): all queries, and per folder and method.
+//! (Wang et al. 2021): all queries, and per folder and query kind.
 //!
-//! Run: `cargo bench --bench ccd`. Before criterion's groups (`ccd/<folder>/<method>`, one
+//! Run: `cargo bench --bench ccd`. Before criterion's groups (`ccd/<folder>/<vertex-face|edge-edge>`, one
 //! iteration = every query of the set once, so time / queries = mean per query), it prints
 //! a table of per-query times: each query timed alone (best of 15 runs of 8 calls), then
 //! the median, mean and max over the queries of each set. `CCD_BENCH_TABLE_ONLY=1` skips

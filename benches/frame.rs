@@ -329,7 +329,7 @@ fn check(scene: &Scene) {
             }
             let n: usize = got[0].iter().map(Vec::len).sum();
             eprintln!(
-                "[{}] frame {f}: exact contacts {n} (== brute force, all 3 kinds); parry GJK {} (missed {missed}, extra {extra})",
+                "[{}] frame {f}: exact contacts {n} (== brute force, all 3 methods); parry GJK {} (missed {missed}, extra {extra})",
                 scene.name,
                 gjk.iter().map(BTreeSet::len).sum::<usize>()
             );
@@ -352,7 +352,7 @@ fn check(scene: &Scene) {
     );
 }
 
-fn bench_kind<K: BoundingVolume>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
+fn bench_method<K: BoundingVolume>(c: &mut Criterion, scene: &Scene, id: &str, par: Par) {
     let mut w = DhcdWorld::<K>::new(scene);
     let mut f = 0;
     c.bench_function(&format!("frame/{}/{id}", scene.name), |b| {
@@ -394,9 +394,9 @@ fn frame(c: &mut Criterion) {
         if checks {
             check(scene);
         }
-        bench_kind::<Dh>(c, scene, "dhcd-dh", Par::Seq);
-        bench_kind::<Sphere>(c, scene, "dhcd-sphere", Par::Seq);
-        bench_kind::<Aabb>(c, scene, "dhcd-aabb", Par::Seq);
+        bench_method::<Dh>(c, scene, "dhcd-dh", Par::Seq);
+        bench_method::<Sphere>(c, scene, "dhcd-sphere", Par::Seq);
+        bench_method::<Aabb>(c, scene, "dhcd-aabb", Par::Seq);
         let mut p = ParryWorld::new(scene);
         let mut f = 0;
         c.bench_function(&format!("frame/{}/parry3d", scene.name), |b| {

@@ -563,7 +563,7 @@ int dhcd_hierarchy_new_f64(int method,
 void dhcd_hierarchy_free(struct DhcdHierarchy *h);
 
 /**
- * The kind of a hierarchy (`DHCD_METHOD_*`) into `*out`.
+ * The method of a hierarchy (`DHCD_METHOD_*`) into `*out`.
  *
  * # Safety
  * `h` null or a live handle; `out` null or valid for a write.

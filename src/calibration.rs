@@ -58,7 +58,8 @@ pub trait Calibration {
     /// The lazy refit and traversal of [`collide_with`](crate::collide_with) down to the
     /// overlapping leaf pairs; no triangle is tested. The counters hold `bv_tests`,
     /// `bv_updates`, and `prim_tests` as [`narrow_phase`](Self::narrow_phase) will count
-    /// the leaf pairs. An error only if the two hierarchies are of different methods.
+    /// the leaf pairs. An error only if the two hierarchies are of different methods (so
+    /// never for [`Hierarchy`]).
     fn broad_phase(&self, other: &Self, ws: &mut Workspace, par: Par) -> Result<BroadPhase>;
 
     /// [`broad_phase`](Self::broad_phase) of one object against itself: what a self query

@@ -12,7 +12,7 @@ use crate::bv::BoundingVolume;
 use crate::error::Error;
 
 /// `methods!(path::to::callback { args })` calls `callback! { { args } rows }` with one row
-/// `(Kind, number, "name", [aliases], "label")` per kind: `Kind` is the kind's type in [`crate::bv`] and its [`Method`] variant;
+/// `(Type, number, "name", [aliases], "label")` per method: `Type` is the method's type in [`crate::bv`] and its [`Method`] variant;
 /// `number` its stable number in the C ABI (`DHCD_METHOD_*`); `"name"` its name on the
 /// command line, in Python and in JSON reports; `aliases` other names accepted when parsing;
 /// `"label"` its name in human-readable reports.
@@ -31,7 +31,7 @@ macro_rules! __methods {
 }
 pub(crate) use crate::__methods as methods;
 
-/// Runs `expr` once per kind of the table, in table order, with the type `K` naming the kind:
+/// Runs `expr` once per method of the table, in table order, with the type `K` naming the method:
 /// generic code (tests, benchmarks) covers every method, a method added later included.
 ///
 /// ```
@@ -175,7 +175,7 @@ macro_rules! method_enum {
         })*
 
         impl $name {
-            /// The kind of the hierarchies inside.
+            /// The method of the hierarchies inside.
             $vis fn method(&self) -> crate::methods::Method {
                 match self { $($name::$kind(_) => crate::methods::Method::$kind,)* }
             }

@@ -7,8 +7,8 @@ use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::narrow::intersection_segment;
 
-/// An intersection segment `[p, q]` (`p == q` for a single point); see
-/// [`intersection_segment`].
+/// The intersection of two closed triangles as a segment `[p, q]` (`p == q` for a single
+/// point), in `f32`.
 pub type Segment = [[f32; 3]; 2];
 
 /// Corners of triangles by the caller's original index, in a hierarchy's current pose.

@@ -85,7 +85,7 @@ pub fn load(path: &Path) -> Vec<Query> {
         .collect()
 }
 
-/// Every (folder, method, queries) of the sample set.
+/// Every (folder, kind (vertex-face or edge-edge), queries) of the sample set.
 pub fn all_samples() -> Vec<(String, &'static str, Vec<Query>)> {
     let root = samples_root();
     let mut folders: Vec<_> = std::fs::read_dir(&root)

@@ -47,7 +47,7 @@ impl Rng {
 }
 
 /// Text worth splicing into mesh files: numbers at the edges, keywords of every format,
-/// line ends of every method, control bytes, header lines that declare huge counts.
+/// line ends of every kind (LF, CRLF, CR), control bytes, header lines that declare huge counts.
 pub const TOKENS: &[&str] = &[
     "-1",
     "0",

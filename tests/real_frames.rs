@@ -78,7 +78,7 @@ fn validate_all(h: &mut AnyHierarchy, what: &str) {
     assert_eq!(checked, h.node_count(), "{what}: every node checked");
 }
 
-/// Both frames of a pair, every kind: build on `first`, query, refit to `second`, query;
+/// Both frames of a pair, every method: build on `first`, query, refit to `second`, query;
 /// then build on `second`, query, refit to `first`, query. Every count is the README's, the
 /// three methods' pair lists are identical, two threads equal one on every frame (on the
 /// refit path), and the invariants hold after the build and after every query.

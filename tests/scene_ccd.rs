@@ -214,7 +214,7 @@ fn tunnelling_is_found_and_far_objects_are_culled() {
 /// with self-collision off the sheet's self job is gone. Both modes, 1 and 2 threads,
 /// minimum distances 0 and 0.01.
 #[test]
-fn scene_equals_direct_calls_every_kind_mode_and_thread_count() {
+fn scene_equals_direct_calls_every_method_mode_and_thread_count() {
     let bodies = bodies();
     for method in Method::ALL {
         let (mut scene, ids) = scene_of(method, &bodies);

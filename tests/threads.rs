@@ -24,6 +24,9 @@ fn out_of_range_thread_counts_are_typed_one_line_errors() {
         );
     }
     assert_eq!(Par::threads(0).unwrap(), Par::Ambient);
+    // A pool of no threads is the calling thread, not a magic value.
+    assert_eq!(Par::Rayon(0).effective(), Par::Seq);
+    assert_eq!(Par::Rayon(1).effective(), Par::Seq);
     assert_eq!(Par::threads(1).unwrap(), Par::Seq);
     assert_eq!(
         Par::threads(Par::MAX_THREADS).unwrap(),

@@ -74,7 +74,7 @@ fn outliers_do_not_push_a_cluster_into_one_leaf() {
     // Counted work, not time: a flat grid's leaves each overlap a bounded number of
     // neighbouring leaves (and the outliers' ancestors a few more), so the node pairs tested
     // and the triangle pairs tested grow linearly with n, the latter times the leaf size
-    // (measured for DH, the loosest kind: 0.53 n and 7.5 * 64 n at leaf size 64; 1.2 n and
+    // (measured for DH, the loosest method: 0.53 n and 7.5 * 64 n at leaf size 64; 1.2 n and
     // 6.5 * 32 n at 32; 4.2 n and 4.8 * 12 n at 12). With the cluster in one leaf the
     // triangle pairs were n^2 / 2 = 5e9.
     for method in Method::ALL {

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""Least step time per real frame, kind and leaf size, for one or more dhcd binaries.
+"""Least step time per real frame, method and leaf size, for one or more dhcd binaries.
 
     benches/scripts/leaf-size-sweep.py ROUNDS SIZES BIN... [--frames DIR]
 
 e.g. `benches/scripts/leaf-size-sweep.py 4 32,48,64,80 target/release/dhcd`. Each round runs
 `BIN bench self N.ply N+1.ply --method all --json --repeat 3 --leaf-size L` for every frame
 pair, binary and size back to back (interleaved, so a noisy minute hits every size alike),
-and keeps the least step per (frame, kind, binary, size). Prints one line per frame, kind
+and keeps the least step per (frame, method, binary, size). Prints one line per frame, method
 and binary: each size's least step in ms and its ratio to the line's best. How the default
 leaf size was chosen (docs/notes/performance-history.md, section "default leaf size 64").
 """
@@ -23,7 +23,7 @@ FRAMES = [
     ("n-body-simulation-18", "n-body-simulation-19"),
     ("armadillo-rollers-326", "armadillo-rollers-327"),
 ]
-KINDS = ["dh", "sphere", "aabb"]
+METHODS = ["dh", "sphere", "aabb"]
 
 
 def main():
@@ -56,7 +56,7 @@ def main():
         print(f"round {r + 1} of {a.rounds} done", file=sys.stderr)
 
     for first, _ in FRAMES:
-        for m in KINDS:
+        for m in METHODS:
             for b in a.bins:
                 row = [best[(first, m, b, s)] for s in sizes]
                 lo = min(row)

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Self-proximity on the real frames at IPC's default distance (dhat = 1e-3 x the bounding-box
 # diagonal), f64, one thread: the IPC Toolkit's NormalCollisions.build (LBVH broad phase;
-# `../shared/peers/ipctk/proximity.py`, best of 3) and `dhcd bench proximity` (each kind,
+# `../shared/peers/ipctk/proximity.py`, best of 3) and `dhcd bench proximity` (each method,
 # least of 5 steps per frame) in one run. From the project root:
 #
 #   benches/scripts/proximity-vs-ipctk.sh > proximity-vs-ipctk.log 2>&1

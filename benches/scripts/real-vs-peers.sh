@@ -1,7 +1,7 @@
 #!/bin/sh
 # One run of everything docs/PERFORMANCE.md quotes for the real frames, so that the ratios
 # come from one sitting: CGAL's self_intersections, the criterion `real/*` bench (dhcd's three
-# kinds and parry3d), and `dhcd bench` on 1 and 2 threads. From the project root:
+# methods and parry3d), and `dhcd bench` on 1 and 2 threads. From the project root:
 #
 #   benches/scripts/real-vs-peers.sh > real-vs-peers.log 2>&1
 #

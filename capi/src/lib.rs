@@ -956,7 +956,7 @@ pub unsafe extern "C" fn dhcd_hierarchy_free(h: *mut DhcdHierarchy) {
     });
 }
 
-/// The kind of a hierarchy (`DHCD_METHOD_*`) into `*out`.
+/// The method of a hierarchy (`DHCD_METHOD_*`) into `*out`.
 ///
 /// # Safety
 /// `h` null or a live handle; `out` null or valid for a write.

@@ -1207,7 +1207,7 @@ fn proximity_meshes(f64_positions: bool) -> [Mesh; 4] {
 }
 
 /// `dhcd_proximity` and `dhcd_self_proximity` equal the Rust API, every field (indices,
-/// distances to the bit, types, counters), for every kind, both precisions (and a pair of
+/// distances to the bit, types, counters), for every method, both precisions (and a pair of
 /// one of each), after an update, on 1 and 2 threads.
 #[test]
 fn proximity_equals_the_rust_api() {
@@ -1344,7 +1344,7 @@ fn flattened(p: &dhcd::SceneProximity) -> SceneRows {
 }
 
 /// `dhcd_scene_proximity` equals the Rust scene's, flattened: objects of both precisions, one
-/// with self-collision on, one far away; every kind, 1 and 2 threads.
+/// with self-collision on, one far away; every method, 1 and 2 threads.
 #[test]
 fn scene_proximity_equals_the_rust_scene() {
     let d = 0.06;
@@ -1722,7 +1722,7 @@ fn bad_distances_are_invalid_arguments() {
     }
 }
 
-/// Null handles or outputs, the same handle twice, kinds that differ, misaligned or null
+/// Null handles or outputs, the same handle twice, methods that differ, misaligned or null
 /// `double` arrays, thread counts out of range: error codes, and outputs left empty.
 #[test]
 fn proximity_and_f64_bad_arguments() {
@@ -2221,7 +2221,7 @@ fn new_ccd_h(method: i32, mesh: &Mesh, f32_hierarchy: bool) -> *mut DhcdHierarch
 }
 
 /// `dhcd_self_ccd` equals the brute force over every pair (`dhcd::narrow::brute_force_self_ccd`)
-/// on a tunnelling case the discrete test misses at both ends: every kind, hierarchies of
+/// on a tunnelling case the discrete test misses at both ends: every method, hierarchies of
 /// both precisions (the positions are `double` either way), 1 and 2 threads, both modes.
 #[test]
 fn self_ccd_equals_the_brute_force() {
@@ -2293,7 +2293,7 @@ fn tunnelling_balls() -> (Mesh, Mesh, [Vec<[f64; 3]>; 4]) {
 }
 
 /// `dhcd_ccd` equals `dhcd::narrow::brute_force_ccd` (all three lists) and the Rust API:
-/// every kind, mixed precisions, 1 and 2 threads, both modes, a time limit.
+/// every method, mixed precisions, 1 and 2 threads, both modes, a time limit.
 #[test]
 fn pair_ccd_equals_the_brute_force() {
     let (a, b, [a0, a1, b0, b1]) = tunnelling_balls();

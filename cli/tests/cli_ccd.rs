@@ -1,5 +1,5 @@
 //! `dhcd ccd` and `dhcd bench ccd`: the JSON equals the brute force over every pair (the
-//! exact tests of `dhcd::ccd`) for every kind, thread count, mode and minimum distance; bad
+//! exact tests of `dhcd::ccd`) for every method, thread count, mode and minimum distance; bad
 //! input is one line on stderr.
 
 use std::path::{Path, PathBuf};
@@ -237,7 +237,7 @@ fn bench_ccd_counts_each_steps_pairs() {
         assert_eq!(code, 0, "{err}");
         let runs = json(&out);
         let runs = runs.as_array().unwrap();
-        assert_eq!(runs.len(), 3, "one run per kind");
+        assert_eq!(runs.len(), 3, "one run per method");
         for r in runs {
             assert_eq!(r["precision"], "f64");
             assert_eq!(r["earliest"], earliest);

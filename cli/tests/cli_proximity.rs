@@ -259,7 +259,7 @@ fn bench_proximity_reports_pairs_distance_and_precision() {
         for (k, f) in r["frames"].as_array().unwrap().iter().enumerate() {
             assert_eq!(
                 f["contacts"], runs[0]["frames"][k]["contacts"],
-                "kinds agree"
+                "methods agree"
             );
             assert!(f["contacts"].as_u64().unwrap() > 0);
         }

@@ -187,7 +187,7 @@ fn central_vertex_changes_dh_work_not_contacts() {
             .collect()
     };
     assert_eq!(contacts(&paper), contacts(&tight));
-    // The other kinds ignore it.
+    // The other methods ignore it.
     let (p, t) = (counters(&paper), counters(&tight));
     assert_eq!(p[1..], t[1..]);
 }

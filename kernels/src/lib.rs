@@ -3,7 +3,8 @@
 //! [`narrow`]) and refit reductions ([`refit`]) over structure-of-arrays slices. No tree
 //! knowledge lives here: slices in, bit masks and values out.
 //!
-//! Every kernel has a scalar reference (`*_scalar`) with the same operation order, in
+//! Every kernel has a scalar reference (`*_scalar`; `*_scalar_lanes` for the refit
+//! reductions) with the same operation order, in
 //! [`mod@reference`]: the oracles of the tests and the baselines of the benchmarks.
 //!
 //! The kernels are SIMD bodies generic over a pulp backend, public as `*_with(simd, ..)`

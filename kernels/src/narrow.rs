@@ -150,13 +150,13 @@ const UNION_FIELDS: usize = 6;
 /// Triangles in structure-of-arrays form: a [`Tile`] of fifteen fields (coordinate `k` of
 /// corner `c` is field `3c + k`, then the closed box: min x, y, z, max x, y, z) and a tile of
 /// their three corner indices (used by the self pairings only), from entry `offset` on.
+/// Padding past the tested count is allowed. Optionally a box known to hold every
+/// triangle's closed box ([`TriSoa::with_bounds`]), which spares the kernels computing it.
 ///
 /// A *group* is how a caller caches one leaf's triangles: the tile of `stride` slots, then
 /// the union of its boxes (six entries), written by [`fill_group_with`] and read by
 /// [`TriSoa::from_group`]; [`TriSoa::group_len`] is its length. The layout is defined here
 /// only.
-/// Padding past the tested count is allowed. Optionally a box known to hold every
-/// triangle's closed box ([`TriSoa::with_bounds`]), which spares the kernels computing it.
 #[derive(Clone, Copy, Debug)]
 pub struct TriSoa<'a> {
     tile: Tile<'a>,

@@ -7,8 +7,8 @@
 //! end. The references in [`crate::reference`], `*_scalar_lanes(.., lanes)`, do exactly
 //! that, so `x_with(simd, ..)` equals `x_scalar_lanes(.., S::F32_LANES)` bit for bit, and the
 //! one dispatching entry, [`bounds`] (for callers outside a dispatched body), equals
-//! `bounds_scalar_lanes(.., reference::f32_lanes())`. `*_scalar` is the sequential (1-lane)
-//! version. For max/min only ties between `+0` and `-0` can tell orders apart; for sums
+//! `bounds_scalar_lanes(.., reference::f32_lanes())`. `*_scalar_lanes(.., 1)` is the sequential
+//! order. For max/min only ties between `+0` and `-0` can tell orders apart; for sums
 //! rounding can.
 //!
 //! Max/min policy: a value replaces the accumulator only if it is strictly greater (max) or

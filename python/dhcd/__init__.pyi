@@ -82,7 +82,7 @@ EDGE_EDGE_TYPES: List[str]
 Precision = Literal["f32", "f64"]
 
 Method = Literal["dh", "sphere", "aabb", "sbv"]
-"""Bounding-volume kind: ``"dh"`` (Distance Hierarchy, 8-byte nodes), ``"sphere"`` (16
+"""Method (bounding-volume hierarchy): ``"dh"`` (Distance Hierarchy, 8-byte nodes), ``"sphere"`` (16
 bytes; alias ``"sbv"``), ``"aabb"`` (24 bytes). Case-insensitive."""
 
 Vertices = npt.ArrayLike

@@ -1,4 +1,4 @@
-//! The lazily fitted node bounds of every kind: one buffer, one tile per sibling group.
+//! The lazily fitted node bounds of every method: one buffer, one tile per sibling group.
 //! (A `pub` type in a private module: it appears in the sealed [`super::BoundingVolume`]'s
 //! associated types, and is not nameable outside the crate.)
 

@@ -263,7 +263,7 @@ impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features {
 
 impl Features {
     /// The own vertices of leaf `lv` against the triangles of leaf `lt`: `emit(vertex,
-    /// triangle, distance_sq, method)` for each pair within the distance (original indices).
+    /// triangle, distance_sq, type)` for each pair within the distance (original indices).
     #[inline(always)]
     fn vertices_vs_triangles<S: Simd, K: BoundingVolume>(
         &self,

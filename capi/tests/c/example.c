@@ -132,7 +132,7 @@ int main(void) {
   OK(dhcd_contact_segments(a, b, c.pairs, c.count, NULL)); /* empty: nothing to write */
   dhcd_contacts_free(&c);
 
-  /* Errors: null, wrong length, same handle twice, wrong kind. */
+  /* Errors: null, wrong length, same handle twice, wrong method. */
   CHECK(dhcd_collide(a, NULL, 1, &c) == DHCD_ERR_NULL);
   printf("expected error: %s\n", dhcd_last_error_message());
   CHECK(dhcd_hierarchy_update_positions(b, far, 2) == DHCD_ERR_LENGTH_MISMATCH);
@@ -149,8 +149,8 @@ int main(void) {
   dhcd_hierarchy_free(a);
   dhcd_hierarchy_free(b);
 
-  /* 2. Two grids, the second folded up through the first: contacts for every kind, the
-   * same set for every kind and thread count. */
+  /* 2. Two grids, the second folded up through the first: contacts for every method, the
+   * same set for every method and thread count. */
   enum { N = 12 };
   const size_t nv = (N + 1) * (N + 1), nt = 2 * N * N;
   float *g = malloc(3 * nv * sizeof(float)), *h = malloc(3 * nv * sizeof(float));

@@ -83,7 +83,7 @@ pub fn run() -> i32 {
     }
 }
 
-/// Parses a hierarchy kind: the names (and aliases) of the library's table of kinds, which
+/// Parses a method: the names (and aliases) of the library's table of methods, which
 /// `--help` lists.
 pub fn method_parser() -> impl clap::builder::TypedValueParser<Value = dhcd::Method> {
     use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};

@@ -144,7 +144,7 @@ fn per(t: f64, n: u64) -> Option<f64> {
 pub struct FrameSamples {
     pub frame: usize,
     pub counters: Counters,
-    /// Per method (`C_V`, `C_P`, `C_U`, fixed): the time of every repetition (ns).
+    /// Per constant (`C_V`, `C_P`, `C_U`, fixed): the time of every repetition (ns).
     pub times: [Vec<f64>; 4],
 }
 
@@ -230,7 +230,7 @@ pub(super) fn calibrate_frame(
     })
 }
 
-/// The constants from the samples of all calibration frames: per method,
+/// The constants from the samples of all calibration frames: per constant,
 /// `sum_f min_rep(t_f) / sum_f N_f`, and the spread of every single sample `t / N`.
 pub(super) fn combine(frames: &[FrameSamples]) -> Costs {
     let mut pooled = [(0.0, 0u64); 4];
