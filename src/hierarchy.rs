@@ -136,7 +136,7 @@ impl TriCache {
 struct RefitGroups<'a, K: BoundingVolume> {
     h: &'a Hierarchy<K>,
     groups: &'a [usize],
-    par: crate::par::Par,
+    par: Par,
 }
 
 impl<K: BoundingVolume> pulp::WithSimd for RefitGroups<'_, K> {

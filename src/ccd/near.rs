@@ -176,10 +176,7 @@ fn apart(vf: bool, pts: &[V3<Iv>; 4], delta: f64) -> bool {
             && segment_apart(p, c, a, dd)
     } else {
         let [a0, a1, b0, b1] = pts;
-        let (u, v) = (ring::sub3(a1, a0), ring::sub3(b1, b0));
-        let w = ring::cross(&u, &v);
-        let w2 = ring::dot(&w, &w);
-        let r = ring::sub3(b0, a0);
+        let EdgeLines { u, v, w, w2, r } = EdgeLines::new(pts);
         // The lines' distance is |r . w| / |w|.
         if w2.pos() && excess(ring::dot(&r, &w), w2, dd).pos() {
             return true;
@@ -217,10 +214,7 @@ fn within(vf: bool, pts: &[V3<Iv>; 4], delta: f64) -> bool {
             || segment_within(p, c, a, dd)
     } else {
         let [a0, a1, b0, b1] = pts;
-        let (u, v) = (ring::sub3(a1, a0), ring::sub3(b1, b0));
-        let w = ring::cross(&u, &v);
-        let w2 = ring::dot(&w, &w);
-        let r = ring::sub3(b0, a0);
+        let EdgeLines { u, v, w, w2, r } = EdgeLines::new(pts);
         let (s, t) = lines_closest(&r, &u, &v, &w);
         let on = |x: Iv| nonnegative(x) && nonnegative(w2.sub(&x));
         (w2.pos() && on(s) && on(t) && nonpositive(excess(ring::dot(&r, &w), w2, dd)))
@@ -251,6 +245,26 @@ fn nonnegative(x: Iv) -> bool {
 #[inline(always)]
 fn excess(q: Iv, len2: Iv, dd: Iv) -> Iv {
     q.mul(&q).sub(&dd.mul(&len2))
+}
+
+/// The lines of edges `[a0, a1]` and `[b0, b1]`: directions `u = a1 - a0`, `v = b1 - b0`,
+/// their cross product `w` and `|w|^2`, and `r = b0 - a0`.
+struct EdgeLines {
+    u: V3<Iv>,
+    v: V3<Iv>,
+    w: V3<Iv>,
+    w2: Iv,
+    r: V3<Iv>,
+}
+
+impl EdgeLines {
+    fn new([a0, a1, b0, b1]: &[V3<Iv>; 4]) -> Self {
+        let (u, v) = (ring::sub3(a1, a0), ring::sub3(b1, b0));
+        let w = ring::cross(&u, &v);
+        let w2 = ring::dot(&w, &w);
+        let r = ring::sub3(b0, a0);
+        EdgeLines { u, v, w, w2, r }
+    }
 }
 
 /// The parameters of the closest points `a0 + s u`, `b0 + t v` of two lines (`r = b0 - a0`,
