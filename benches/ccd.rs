@@ -1,4 +1,4 @@
-//! Per-query CCD cost on the sample queries of `../shared/data/ccd/sample-queries`
+//! Per-query CCD cost on the sample queries of `tests/data/ccd-sample-queries`
 //! (Wang et al. 2021): all queries, and per folder and query kind.
 //!
 //! Run: `cargo bench --bench ccd`. Before criterion's groups (`ccd/<folder>/<vertex-face|edge-edge>`, one
@@ -20,7 +20,7 @@ use num_traits::ToPrimitive;
 type Query = ([[f64; 3]; 4], [[f64; 3]; 4], bool);
 
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/ccd/sample-queries")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/ccd-sample-queries")
 }
 
 /// num/den as f64, checked exact.

@@ -146,12 +146,13 @@ struct Object<K: BoundingVolume> {
 }
 
 impl<K: BoundingVolume> Object<K> {
-    /// The root box from the referenced vertices (finite: `update_positions` checks).
+    /// The root box of every vertex, free points included (finite: `update_positions`
+    /// checks).
     ///
     /// PERF: the SIMD bounds kernel; a scalar `min`/`max` chain per axis waited on each
     /// operation's latency and was 15% of a pawns8 scene step.
     fn refresh_bounds(&mut self) {
-        let n = self.h.tree().referenced_vertices();
+        let n = self.h.tree().vertex_total();
         let (lo, hi) = dhcd_kernels::refit::bounds(self.h.points().soa().slice(0..n));
         self.bounds = if self.h.points().is_rounded() {
             // Rounded f64 positions: the next f32 outward holds the exact ones.

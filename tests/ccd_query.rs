@@ -255,7 +255,10 @@ fn bad_input_is_a_typed_error() {
 /// also runs every method and 1 thread against 2.
 #[test]
 fn frame_truth_through_the_pipeline() {
-    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    let Some(data) = crate::support::shared_data("ccd_query::frame_truth_through_the_pipeline", "")
+    else {
+        return;
+    };
     for (name, next) in [
         ("rod-twist-3036", "rod-twist-3037"),
         ("armadillo-rollers-326", "armadillo-rollers-327"),

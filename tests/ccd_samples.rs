@@ -1,4 +1,4 @@
-//! Every labelled query of `../shared/data/ccd/sample-queries` (Wang et al. 2021; ground
+//! Every labelled query of `tests/data/ccd-sample-queries` (Wang et al. 2021; ground
 //! truth from Mathematica): the CCD result equals the label, through the filtered entry and
 //! through the exact path alone, and the two times of impact agree within the tolerance.
 
@@ -11,8 +11,9 @@ use num_traits::{One, Signed, ToPrimitive, Zero};
 
 pub type Query = ([[f64; 3]; 4], [[f64; 3]; 4], bool);
 
+/// The sample queries, which travel with the repository (`tests/data/README.md`).
 pub fn samples_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/ccd/sample-queries")
+    crate::support::repo_data("ccd-sample-queries")
 }
 
 /// The f64 equal to `num/den`; panics unless the rational is exactly an f64.

@@ -113,12 +113,12 @@ fn every_region_gets_the_brute_force_argmin() {
 /// shared data folder is there.
 #[test]
 fn real_frame_regions_get_the_brute_force_argmin() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/real-frames/armadillo-rollers-326.ply");
-    if !path.exists() {
-        eprintln!("skipped: {} is absent", path.display());
+    let Some(path) = crate::support::shared_data(
+        "central::real_frame_regions_get_the_brute_force_argmin",
+        "real-frames/armadillo-rollers-326.ply",
+    ) else {
         return;
-    }
+    };
     let mesh = dhcd::io::load(&path).unwrap();
     let options = Options {
         central: CentralVertex::MinRadius,

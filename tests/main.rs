@@ -9,6 +9,7 @@ mod ccd_samples;
 mod central;
 mod distance;
 mod fixtures;
+mod free_points;
 mod fuzz;
 mod hierarchies;
 mod io;

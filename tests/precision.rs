@@ -130,13 +130,14 @@ fn obj_decimals_are_read_at_full_precision_when_asked() {
 /// `f64`, the doubles come out unrounded and the floats exactly.
 #[test]
 fn real_frames_read_as_f64_keep_their_doubles() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
+    let Some(dir) = crate::support::shared_data(
+        "precision::real_frames_read_as_f64_keep_their_doubles",
+        "real-frames",
+    ) else {
+        return;
+    };
     let limits = Limits::default();
     let arm = dir.join("armadillo-rollers-326.ply");
-    if !arm.exists() {
-        eprintln!("skipping: {} not found", arm.display());
-        return;
-    }
     let m64 = io::load_as(&arm, &limits, Precision::F64).unwrap();
     let m32 = io::load(&arm).unwrap();
     assert_eq!(m64.triangles(), m32.triangles());
@@ -320,12 +321,13 @@ fn f64_contacts_are_exact_for_every_kind() {
 /// a slab of the rod (the whole frame would take minutes of brute force), for every method.
 #[test]
 fn f64_hierarchy_bounds_hold_on_a_real_frame() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
-    let path = dir.join("rod-twist-3036.ply");
-    if !path.exists() {
-        eprintln!("skipping: {} not found", path.display());
+    let Some(dir) = crate::support::shared_data(
+        "precision::f64_hierarchy_bounds_hold_on_a_real_frame",
+        "real-frames",
+    ) else {
         return;
-    }
+    };
+    let path = dir.join("rod-twist-3036.ply");
     let m = io::load_as(&path, &Limits::default(), Precision::F64).unwrap();
     let next = io::load_as(
         &dir.join("rod-twist-3037.ply"),

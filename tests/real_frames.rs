@@ -7,7 +7,7 @@
 //! CGAL). When the folder is absent the tests print why and pass.
 
 use dhcd::calibration::Calibration;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use dhcd::{AnyHierarchy, Contacts, Mesh, Method, Options, Par, RegionTree, Workspace};
@@ -26,15 +26,7 @@ const EXPECTED: [(&str, usize); 8] = [
 
 /// The data folder, or `None` (with a message saying what is skipped) when it is absent.
 fn frames_dir(test: &str) -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    eprintln!(
-        "SKIPPED real_frames::{test}: no data folder at {} (CI has it beside the checkout)",
-        dir.display()
-    );
-    None
+    crate::support::shared_data(&format!("real_frames::{test}"), "real-frames")
 }
 
 fn expected(frame: &str) -> usize {

@@ -59,3 +59,41 @@ pub fn peak_bytes<R>(f: impl FnOnce() -> R) -> (R, usize) {
     let peak = PEAK.with(|p| p.get()) - start;
     (r, peak.max(0) as usize)
 }
+
+/// The folder `data/<rel>` of the project's shared data (`../shared/data` beside the
+/// checkout, or the folder named by `DHCD_SHARED_DATA`), or `None` after one line on stderr
+/// saying that `test` is skipped: a clone without the shared data passes.
+///
+/// The line is written to stderr directly, not through `eprintln!`, so the test harness
+/// does not swallow it. With `DHCD_REQUIRE_SHARED_DATA=1` a missing folder fails the test
+/// instead: CI, which has the data, sets it so that nothing is skipped there.
+pub fn shared_data(test: &str, rel: &str) -> Option<std::path::PathBuf> {
+    use std::io::Write;
+    let root = match std::env::var_os("DHCD_SHARED_DATA") {
+        Some(dir) => std::path::PathBuf::from(dir),
+        None => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
+    };
+    let dir = root.join(rel);
+    if dir.exists() {
+        return Some(dir);
+    }
+    let required = std::env::var_os("DHCD_REQUIRE_SHARED_DATA").is_some_and(|v| v == "1");
+    assert!(
+        !required,
+        "{test}: {} is missing and DHCD_REQUIRE_SHARED_DATA=1",
+        dir.display()
+    );
+    let _ = writeln!(
+        std::io::stderr(),
+        "SKIPPED {test}: no shared data at {}",
+        dir.display()
+    );
+    None
+}
+
+/// The folder `tests/data/<rel>`: data that travels with the repository (`tests/data/README.md`).
+pub fn repo_data(rel: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(rel)
+}

@@ -151,10 +151,6 @@ def _edge_pairs(pa, ea, pb, eb, d2, dbox, same):
     return out
 
 
-def _used(faces):
-    return sorted({int(v) for f in np.asarray(faces).tolist() for v in f})
-
-
 def proximity(va, fa, vb, fb, d):
     """The pairs of mesh A and mesh B within d: (vertex_face, face_vertex, edge_edge), each a
     sorted list of tuples (indices..., exact squared distance, type number)."""
@@ -162,8 +158,8 @@ def proximity(va, fa, vb, fb, d):
     fa, fb = np.asarray(fa).tolist(), np.asarray(fb).tolist()
     d2 = Fraction(d) ** 2
     dbox = float(d) * (1 + 1e-9) + 1e-300  # a box filter that never drops a pair
-    vf = _vertex_face(pa, _used(fa), pb, fb, d2, dbox, False)
-    fv = [(t, v, x, k) for v, t, x, k in _vertex_face(pb, _used(fb), pa, fa, d2, dbox, False)]
+    vf = _vertex_face(pa, range(len(pa)), pb, fb, d2, dbox, False)
+    fv = [(t, v, x, k) for v, t, x, k in _vertex_face(pb, range(len(pb)), pa, fa, d2, dbox, False)]
     ee = _edge_pairs(pa, edges(fa), pb, edges(fb), d2, dbox, False)
     return sorted(vf), sorted(fv), sorted(ee)
 
@@ -175,7 +171,7 @@ def self_proximity(v, f, d):
     f = np.asarray(f).tolist()
     d2 = Fraction(d) ** 2
     dbox = float(d) * (1 + 1e-9) + 1e-300
-    vf = _vertex_face(p, _used(f), p, f, d2, dbox, True)
+    vf = _vertex_face(p, range(len(p)), p, f, d2, dbox, True)
     e = edges(f)
     ee = _edge_pairs(p, e, p, e, d2, dbox, True)
     return sorted(vf), [], sorted(ee)

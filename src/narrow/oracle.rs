@@ -101,7 +101,7 @@ fn self_pairs<C: Coordinate>(m: &Mesh, t: &Tris<C>) -> Vec<[u32; 2]> {
 /// Brute-force proximity oracle: every vertex of `a` against every triangle of `b` and the
 /// other way, and every unique edge of `a` against every unique edge of `b`, through the
 /// exact tests of [`crate::distance`] at distance `d`; in the order and form of
-/// [`crate::query::proximity`]'s result (vertices and edges of triangles only; `counters`
+/// [`crate::query::proximity`]'s result (every vertex, free points included; `counters`
 /// zero but `contacts`). `O(|a| |b|)`.
 pub fn brute_force_proximity(a: &Mesh, b: &Mesh, d: f64) -> crate::query::Proximity {
     use crate::distance::{edge_edge_within, point_triangle_within};
@@ -109,7 +109,7 @@ pub fn brute_force_proximity(a: &Mesh, b: &Mesh, d: f64) -> crate::query::Proxim
     let (pa, pb) = (a.to_f64_positions(), b.to_f64_positions());
     let mut out = Proximity::default();
     let tri = |m: &Mesh, p: &[[f64; 3]], t: usize| m.triangles()[t].map(|v| p[v as usize]);
-    for v in used_vertices(a) {
+    for v in 0..a.vertex_count() as u32 {
         for t in 0..b.triangle_count() {
             if let Some((d2, kind)) = point_triangle_within(pa[v as usize], tri(b, &pb, t), d) {
                 out.vertex_face.push(VertexFace {
@@ -122,7 +122,7 @@ pub fn brute_force_proximity(a: &Mesh, b: &Mesh, d: f64) -> crate::query::Proxim
         }
     }
     for t in 0..a.triangle_count() {
-        for v in used_vertices(b) {
+        for v in 0..b.vertex_count() as u32 {
             if let Some((d2, kind)) = point_triangle_within(pb[v as usize], tri(a, &pa, t), d) {
                 out.face_vertex.push(FaceVertex {
                     triangle: t as u32,
@@ -161,7 +161,7 @@ pub fn brute_force_self_proximity(m: &Mesh, d: f64) -> crate::query::Proximity {
     use crate::query::{EdgePair, Proximity, VertexFace};
     let p = m.to_f64_positions();
     let mut out = Proximity::default();
-    for v in used_vertices(m) {
+    for v in 0..m.vertex_count() as u32 {
         for (t, corners) in m.triangles().iter().enumerate() {
             if corners.contains(&v) {
                 continue;
@@ -226,7 +226,7 @@ pub fn brute_force_ccd(
         ];
         vertex_face(&x0, &x1, options)
     };
-    for v in used_vertices(a) {
+    for v in 0..a.vertex_count() as u32 {
         for (t, &corners) in b.triangles().iter().enumerate() {
             if let Some(toi) = vf(&am, v, &bm, corners) {
                 out.vertex_face.push(VertexImpact {
@@ -238,7 +238,7 @@ pub fn brute_force_ccd(
         }
     }
     for (t, &corners) in a.triangles().iter().enumerate() {
-        for v in used_vertices(b) {
+        for v in 0..b.vertex_count() as u32 {
             if let Some(toi) = vf(&bm, v, &am, corners) {
                 out.face_vertex.push(FaceImpact {
                     triangle: t as u32,
@@ -282,7 +282,7 @@ pub fn brute_force_self_ccd(
     use crate::query::{EdgeImpact, Impacts, VertexImpact};
     let (x0, x1) = (motion.x0, motion.x1);
     let mut out = Impacts::default();
-    for v in used_vertices(m) {
+    for v in 0..m.vertex_count() as u32 {
         for (t, corners) in m.triangles().iter().enumerate() {
             if corners.contains(&v) {
                 continue;
@@ -330,19 +330,6 @@ fn finish_impacts(out: &mut crate::query::Impacts) {
         .reduce(f64::min);
     out.counters.contacts =
         (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
-}
-
-/// The vertices some triangle uses, ascending.
-fn used_vertices(m: &Mesh) -> Vec<u32> {
-    let mut used = vec![false; m.vertex_count()];
-    for t in m.triangles() {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
-    (0..m.vertex_count() as u32)
-        .filter(|&v| used[v as usize])
-        .collect()
 }
 
 /// The unique edges of the triangles, each as its vertices smaller first, ascending.

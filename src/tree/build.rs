@@ -100,14 +100,29 @@ impl RegionTree {
             }
         }
 
-        // Internal triangles and vertices: vertices numbered by first appearance.
+        // Internal triangles and vertices: vertices numbered by first appearance, and each
+        // vertex no triangle uses (a free point) right after the last triangle of the leaf
+        // it is given to, so that it is one of that leaf's own vertices.
         let vertex_count = mesh.vertex_count();
+        let free_points = free_points_by_leaf(
+            mesh,
+            &order,
+            (&tri_start, &tri_end),
+            (&first_child, &child_count),
+        );
         let mut vert_slot = vec![UNSET; vertex_count];
         let mut vert_order = Vec::with_capacity(vertex_count);
         let mut new_before = Vec::with_capacity(tri_count + 1);
         let mut tris = Vec::with_capacity(tri_count);
-        for &t in &order {
+        let mut free = free_points.iter().peekable();
+        for i in 0..=tri_count {
+            // The free points of the leaf ending before triangle `i`.
+            while let Some(&(_, v)) = free.next_if(|(end, _)| *end as usize == i) {
+                vert_slot[v as usize] = vert_order.len() as u32;
+                vert_order.push(v);
+            }
             new_before.push(vert_order.len() as u32);
+            let Some(&t) = order.get(i) else { break };
             let tri = mesh.triangles()[t as usize];
             tris.push(tri.map(|v| {
                 if vert_slot[v as usize] == UNSET {
@@ -117,14 +132,7 @@ impl RegionTree {
                 vert_slot[v as usize]
             }));
         }
-        new_before.push(vert_order.len() as u32);
-        let referenced_vertices = vert_order.len() as u32;
-        for (v, slot) in vert_slot.iter_mut().enumerate() {
-            if *slot == UNSET {
-                *slot = vert_order.len() as u32;
-                vert_order.push(v as u32);
-            }
-        }
+        debug_assert_eq!(vert_order.len(), vertex_count);
 
         let node_count = tri_start.len();
         let vert_start: Vec<u32> = tri_start.iter().map(|&s| new_before[s as usize]).collect();
@@ -204,13 +212,88 @@ impl RegionTree {
             tri_order: order,
             vert_order,
             vert_slot,
-            referenced_vertices,
             shared: OnceLock::new(),
             edges: OnceLock::new(),
         };
         debug_assert_eq!(tree.check_topology(mesh), Ok(()));
         Ok(tree)
     }
+}
+
+/// The vertices no triangle uses (free points), each given to the leaf whose rest box is
+/// nearest to it (descending from the root, the nearest child's box at each level; ties to
+/// the first child), as `(end of that leaf's triangle run, vertex)` sorted by both. A free
+/// point is then one of its leaf's own vertices: every bound of the leaf and its ancestors
+/// holds it, and the feature queries pair it with every triangle as a point.
+fn free_points_by_leaf(
+    mesh: &Mesh,
+    order: &[u32],
+    (tri_start, tri_end): (&[u32], &[u32]),
+    (first_child, child_count): (&[u32], &[u8]),
+) -> Vec<(u32, u32)> {
+    let mut used = vec![false; mesh.vertex_count()];
+    for t in mesh.triangles() {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    if used.iter().all(|&u| u) {
+        return Vec::new();
+    }
+    let p = mesh.positions();
+    let node_count = tri_start.len();
+    // Rest boxes, children after parents: filled from the triangles of the leaves, then
+    // merged upwards in reverse breadth-first order.
+    let mut boxes = vec![([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]); node_count];
+    for n in (0..node_count).rev() {
+        let b = if child_count[n] == 0 {
+            let mut b = boxes[n];
+            for &t in &order[tri_start[n] as usize..tri_end[n] as usize] {
+                for &v in &mesh.triangles()[t as usize] {
+                    for k in 0..3 {
+                        b.0[k] = b.0[k].min(p[v as usize][k]);
+                        b.1[k] = b.1[k].max(p[v as usize][k]);
+                    }
+                }
+            }
+            b
+        } else {
+            let children =
+                first_child[n] as usize..(first_child[n] + child_count[n] as u32) as usize;
+            children.fold(boxes[n], |b, c| {
+                (
+                    std::array::from_fn(|k| b.0[k].min(boxes[c].0[k])),
+                    std::array::from_fn(|k| b.1[k].max(boxes[c].1[k])),
+                )
+            })
+        };
+        boxes[n] = b;
+    }
+    let gap_sq = |b: &([f32; 3], [f32; 3]), q: [f32; 3]| -> f64 {
+        (0..3)
+            .map(|k| {
+                let (x, lo, hi) = (f64::from(q[k]), f64::from(b.0[k]), f64::from(b.1[k]));
+                let d = (lo - x).max(x - hi).max(0.0);
+                d * d
+            })
+            .sum()
+    };
+    let mut free: Vec<(u32, u32)> = (0..mesh.vertex_count())
+        .filter(|&v| !used[v])
+        .map(|v| {
+            let mut n = 0;
+            while child_count[n] > 0 {
+                let children =
+                    first_child[n] as usize..(first_child[n] + child_count[n] as u32) as usize;
+                n = children
+                    .min_by(|&a, &b| gap_sq(&boxes[a], p[v]).total_cmp(&gap_sq(&boxes[b], p[v])))
+                    .expect("an internal node has children");
+            }
+            (tri_end[n], v as u32)
+        })
+        .collect();
+    free.sort_unstable();
+    free
 }
 
 impl TreeShape {

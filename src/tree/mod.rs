@@ -10,6 +10,10 @@
 //! - vertices are reordered by first appearance in that triangle order, so a node's vertex
 //!   set (the vertices of its triangles) is one contiguous run `vert_run(n)` plus a few
 //!   `borrowed(n)` vertices that first appeared in an earlier subtree (region boundaries);
+//! - a vertex no triangle uses (a free point: a particle, a pinned marker) is given to the
+//!   leaf whose rest box is nearest and numbered right after that leaf's triangles' vertices,
+//!   so it is one of the leaf's own vertices: every bound holds it and the feature queries
+//!   (proximity, CCD) pair it with every triangle;
 //! - `tri_order`/`vert_order` map internal indices back to the caller's original ones.
 
 mod build;
@@ -123,7 +127,6 @@ pub struct RegionTree {
     tri_order: Vec<u32>,
     vert_order: Vec<u32>,
     vert_slot: Vec<u32>,
-    referenced_vertices: u32,
     /// The vertex-sharing triangle pairs of each leaf pair, built by the first self query
     /// (`None` inside: over its build budget).
     shared: OnceLock<Option<shared::SharedPairs>>,
@@ -302,8 +305,8 @@ impl RegionTree {
         &self.tri_order
     }
 
-    /// Internal vertex index -> the caller's vertex index (every vertex of the mesh; those no
-    /// triangle uses come last).
+    /// Internal vertex index -> the caller's vertex index (every vertex of the mesh, free
+    /// points included).
     #[inline]
     pub(crate) fn vert_order(&self) -> &[u32] {
         &self.vert_order
@@ -323,11 +326,6 @@ impl RegionTree {
     /// Number of triangles.
     pub fn triangle_total(&self) -> usize {
         self.tris.len()
-    }
-
-    /// Vertices used by at least one triangle (internal indices `0..referenced_vertices()`).
-    pub(crate) fn referenced_vertices(&self) -> usize {
-        self.referenced_vertices as usize
     }
 
     /// The triangle pairs of leaves `x` and `y` (node ids; `x == y`: unordered pairs of

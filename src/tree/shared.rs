@@ -33,7 +33,7 @@ impl SharedPairs {
     /// The table of `tree` (its triangles and leaves built), or `None` over the budget.
     pub(crate) fn build(tree: &RegionTree) -> Option<Self> {
         let tris = tree.triangles();
-        let vertices = tree.referenced_vertices();
+        let vertices = tree.vertex_total();
         // Triangles around each vertex (a mesh's corners are distinct).
         let mut around_start = vec![0u32; vertices + 1];
         for tri in tris {

@@ -24,8 +24,9 @@ impl RegionTree {
     /// Checks the topology against the mesh it was built from: levels contiguous and
     /// breadth-first, children nested and partitioning their parent's triangles, leaves
     /// covering every triangle exactly once, each node's vertex set (run + borrowed) equal
-    /// to the vertices of its triangles, and the permutations consistent with the mesh; and
-    /// the shared-pair table (which this builds if no self query has yet).
+    /// to the vertices of its triangles plus the free points (vertices in no triangle) of
+    /// its run, the root's holding every vertex, and the permutations consistent with the
+    /// mesh; and the shared-pair table (which this builds if no self query has yet).
     pub fn check_topology(&self, mesh: &Mesh) -> Result<(), TreeError> {
         let nodes = self.node_count();
         if self.tris.len() != mesh.triangle_count() || self.vert_order.len() != mesh.vertex_count()
@@ -36,6 +37,10 @@ impl RegionTree {
             if self.depth_count() > levels {
                 return fail(0, "deeper than the requested levels");
             }
+        }
+        let mut used = vec![false; self.vertex_total()];
+        for &v in self.tris.iter().flatten() {
+            used[v as usize] = true;
         }
         let mut leaves = 0;
         for g in 0..self.group_count() {
@@ -137,12 +142,18 @@ impl RegionTree {
                     .flatten()
                     .copied()
                     .collect();
+                // Free points (in no triangle) are their leaf's own vertices, so its
+                // ancestors' too.
+                expected.extend(self.vert_run(n).filter(|&v| !used[v]).map(|v| v as u32));
                 expected.sort_unstable();
                 expected.dedup();
                 let mut got: Vec<u32> = self.region_vertices(n).collect();
                 got.sort_unstable();
                 if got != expected {
                     return fail(n, "vertex set differs from the vertices of its triangles");
+                }
+                if n == 0 && got.len() != self.vertex_total() {
+                    return fail(n, "some vertex is in no region");
                 }
             }
         }
