@@ -122,8 +122,8 @@ pub struct PairImpacts {
 pub struct SceneImpacts {
     /// Every object pair whose boxes over the step came within the minimum distance (and
     /// every object with self-collision on), sorted by `(a, b)`, each with its impacts and
-    /// counters. In earliest mode only the pairs reaching `toi` keep their impacts; the
-    /// others are listed with none.
+    /// counters. In earliest mode only the pairs that tie with `toi` (within
+    /// [`crate::ccd::TOI_TOLERANCE`]) keep their impacts; the others are listed with none.
     pub per_pair: Vec<PairImpacts>,
     /// The earliest time of impact over every pair (`None`: nothing collides).
     pub toi: Option<f64>,
@@ -400,8 +400,8 @@ impl Scene {
     /// updates wait for the next query of the current pose).
     ///
     /// In earliest mode every job prunes with one shared bound (the earliest time found so
-    /// far by any job), and `toi` is the least over all jobs; only the jobs reaching it keep
-    /// their pairs. The impacts and `toi` do not depend on `par` (in all mode neither do the
+    /// far by any job), and `toi` is the least over all jobs; every job keeps the pairs that
+    /// tie with it (their own time within [`crate::ccd::TOI_TOLERANCE`] of it). The impacts and `toi` do not depend on `par` (in all mode neither do the
     /// counters; in earliest mode the work counters do, as for [`crate::ccd_pair`]).
     ///
     /// Everything is checked before any work; on error nothing is computed:

@@ -28,13 +28,14 @@ fn assert_same(got: &Impacts, want: &Impacts, what: &str) {
     assert!(got.counters.prim_tests >= got.counters.contacts, "{what}");
 }
 
-/// What earliest mode must return: the least time, and the pairs reaching it.
+/// What earliest mode must return: the least time, and every pair whose own time is within
+/// the tolerance of it.
 fn earliest_of(all: &Impacts) -> Impacts {
     let mut e = all.clone();
-    let t = all.toi.unwrap_or(f64::INFINITY);
-    e.vertex_face.retain(|x| x.toi == t);
-    e.face_vertex.retain(|x| x.toi == t);
-    e.edge_edge.retain(|x| x.toi == t);
+    let t = all.toi.unwrap_or(f64::INFINITY) + dhcd::ccd::TOI_TOLERANCE;
+    e.vertex_face.retain(|x| x.toi <= t);
+    e.face_vertex.retain(|x| x.toi <= t);
+    e.edge_edge.retain(|x| x.toi <= t);
     e.counters.contacts = (e.vertex_face.len() + e.face_vertex.len() + e.edge_edge.len()) as u64;
     e
 }
@@ -329,4 +330,91 @@ fn frame_truth_through_the_pipeline() {
             });
         }
     }
+}
+
+/// Planted ties: a 16 x 16 sheet (left half `x <= 1/2` flat, in the plane `z = 0`) and a
+/// vertical flap (the plane `x = 1`, `z` in `[-1/4, 1/4]`) that moves to `x = 0` over the
+/// step, so it reaches the line `x = 1/2`, the sheet's edge, at exactly `t = 1/2`; and a
+/// second layer over the sheet (`x` in `[1/64, 25/64]`, `z = 1/8`) falling to `z = -1/8`,
+/// which meets it at exactly `t = 1/2` too (and the flap only after `t = 0.6`). Hundreds of pairs first touch at `1/2`: vertices on edges, collinear edges,
+/// coplanar faces (exact path) and plain crossings (float filter). Earliest mode returns
+/// exactly the pairs of all mode whose time is `<= 1/2` (the next contacts are `1/32` later),
+/// for every method and thread count, self and pair queries.
+#[test]
+fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
+    let sheet = grid(8, 16, 1.0 / 16.0, [0.0; 3]);
+    let flap = grid(8, 16, 1.0 / 16.0, [0.0; 3]);
+    let layer = grid(6, 16, 1.0 / 16.0, [0.0; 3]);
+    // One mesh: the sheet, the flap (x, y, z) = (1, y, x - 1/4), the layer over the sheet.
+    let mut p0: Vec<[f64; 3]> = f64s(sheet.positions());
+    let mut tris: Vec<[u32; 3]> = sheet.triangles().to_vec();
+    let mut add = |m: &Mesh, at: &dyn Fn([f64; 3]) -> [f64; 3], p: &mut Vec<[f64; 3]>| {
+        let base = p.len() as u32;
+        p.extend(f64s(m.positions()).into_iter().map(at));
+        tris.extend(m.triangles().iter().map(|t| t.map(|v| v + base)));
+    };
+    let flap_at = |q: [f64; 3]| [1.0, q[1], q[0] - 0.25];
+    let layer_at = |q: [f64; 3]| [q[0] + 1.0 / 64.0, q[1] + 1.0 / 64.0, 0.125];
+    add(&flap, &flap_at, &mut p0);
+    let layer_start = p0.len();
+    add(&layer, &layer_at, &mut p0);
+    let flap_range = sheet.vertex_count()..layer_start;
+    let p1: Vec<[f64; 3]> = p0
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            if flap_range.contains(&i) {
+                [0.0, q[1], q[2]]
+            } else if i >= layer_start {
+                [q[0], q[1], -0.125]
+            } else {
+                *q
+            }
+        })
+        .collect();
+    let m = Mesh::new_f64(p0.clone(), tris).unwrap();
+    let all = brute_force_self_ccd(&m, Motion::new(&p0, &p1), &CcdOptions::default());
+    let want = earliest_of(&all);
+    let tied = want.counters.contacts;
+    assert!(tied > 500, "{tied} pairs tie at 1/2");
+    assert_eq!(
+        all.toi.map(|t| 0.5 - t <= dhcd::ccd::TOI_TOLERANCE),
+        Some(true)
+    );
+    let later = all
+        .vertex_face
+        .iter()
+        .map(|x| x.toi)
+        .chain(all.edge_edge.iter().map(|x| x.toi));
+    assert!(later
+        .filter(|&t| t > 0.5)
+        .all(|t| t >= 0.5 + 1.0 / 32.0 - 1e-12));
+    for_each_method!(K => {
+        let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
+        for par in [Par::Seq, Par::Rayon(2)] {
+            let got = self_ccd_with(
+                &h,
+                Motion::new(&p0, &p1),
+                &CcdQuery::earliest(),
+                &mut Workspace::default(),
+                par,
+            )
+            .unwrap();
+            assert_same(&got, &want, &format!("{:?} {par:?}", K::METHOD));
+        }
+    });
+    // The pair form: the sheet still, the flap and the layer as the second mesh.
+    let n = sheet.vertex_count();
+    let a = Mesh::new_f64(p0[..n].to_vec(), sheet.triangles().to_vec()).unwrap();
+    let b_tris: Vec<[u32; 3]> = m.triangles()[sheet.triangle_count()..]
+        .iter()
+        .map(|t| t.map(|v| v - n as u32))
+        .collect();
+    let b = Mesh::new_f64(p0[n..].to_vec(), b_tris).unwrap();
+    let (am, bm) = (
+        Motion::new(&p0[..n], &p1[..n]),
+        Motion::new(&p0[n..], &p1[n..]),
+    );
+    check_pair::<dhcd::bv::Dh>(&a, am, &b, bm, &[0.0], "tied sheet and flap");
+    check_pair::<dhcd::bv::Aabb>(&a, am, &b, bm, &[0.0], "tied sheet and flap");
 }

@@ -1297,8 +1297,8 @@ unsafe fn motion<'a>(
 /// `DHCD_ERR_INVALID_MESH`; another vertex count: `DHCD_ERR_LENGTH_MISMATCH`); the pairs
 /// found depend on `x0` and `x1` alone, and the hierarchy's pose is not changed. `t_max` in
 /// `[0, 1]`; pairs collide when they come within `min_distance` (finite, `>= 0`; 0: when
-/// they touch). `earliest` non-zero: only the earliest time of impact and the pairs
-/// reaching it (what a line search asks; pairs are tested only up to the best time found so
+/// they touch). `earliest` non-zero: only the earliest time of impact and every pair
+/// whose own time is within 1e-12 of it (what a line search asks; every exact tie is there; pairs are tested only up to the best time found so
 /// far), else every colliding pair. Decided exactly for the doubles; times of impact never
 /// later than the first contact and at most 1e-12 earlier. The result does not depend on
 /// `threads` (the work counters of earliest mode may).
@@ -1908,7 +1908,7 @@ pub unsafe extern "C" fn dhcd_scene_proximity_free(p: *mut DhcdSceneProximity) {
 /// come within `min_distance`, and every object with self-collision on, is queried as by
 /// `dhcd_ccd` / `dhcd_self_ccd`, into `*out` (see `DhcdSceneImpacts`; release with
 /// `dhcd_scene_impacts_free`). `earliest` non-zero: only the earliest time of impact over
-/// the scene and the pairs reaching it. Everything is checked before any work: an unknown
+/// the scene and every pair whose own time is within 1e-12 of it. Everything is checked before any work: an unknown
 /// id (`DHCD_ERR_UNKNOWN_OBJECT`), an id given twice (`DHCD_ERR_REPEATED_OBJECT`), a bad
 /// `t_max` or `min_distance` (`DHCD_ERR_INVALID_ARGUMENT`), a wrong vertex count
 /// (`DHCD_ERR_LENGTH_MISMATCH`), a non-finite coordinate (`DHCD_ERR_INVALID_MESH`). The

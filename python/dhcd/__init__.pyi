@@ -290,8 +290,8 @@ def ccd(
     no vertex) that comes within ``min_distance`` (``0``: touches) at some t in
     ``[0, t_max]``. ``x0``, ``x1``: float64 ``(n, 3)``, n the mesh's vertex count (finite,
     within float32's range), for a hierarchy of either precision (its own pose is not
-    used or changed). ``earliest=True``: only the earliest time of impact and the pairs
-    reaching it (what a line search asks). Exact for the doubles (see ``Impacts``); the
+    used or changed). ``earliest=True``: only the earliest time of impact and every pair
+    whose own time is within 1e-12 of it (what a line search asks; every exact tie is there). Exact for the doubles (see ``Impacts``); the
     result does not depend on ``threads`` (the work counters of earliest mode may)."""
 
 @overload
@@ -400,7 +400,7 @@ class Scene:
         read, and nothing in the scene changes); every other object stays at its stored
         pose. Objects whose boxes over the step do not come within ``min_distance`` cost one
         box test. Rows with object ids (see ``Impacts``); ``earliest=True``: the earliest
-        time over the whole scene and the pairs reaching it. Bad input (an unknown or
+        time over the whole scene and every pair whose own time is within 1e-12 of it. Bad input (an unknown or
         repeated id, a wrong shape, dtype or vertex count, a non-finite coordinate, a
         negative ``min_distance``) raises ``ValueError`` before any work. The result does not
         depend on ``threads`` (the work counters of earliest mode may)."""

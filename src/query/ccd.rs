@@ -15,12 +15,15 @@
 //! earlier.
 //!
 //! **Modes** ([`CcdMode`]). `All` reports every colliding pair with its time of impact.
-//! `Earliest` is what a line search asks: the walk keeps the earliest time found so far
-//! (shared by all threads) and tests each later pair only up to it (plus twice the
-//! tolerance), so most pairs stop early. Its answer does not depend on the order or the
-//! threads: the pairs found within the tolerance of the best are tested again over the
-//! whole interval, and the result is the least of those times with the pairs that reach it.
-//! (Its work counters do depend on the order.)
+//! `Earliest` is what a line search asks: the least time of impact `toi`, and every pair
+//! whose own time of impact is at most `toi + TOI_TOLERANCE`. That holds every pair whose
+//! exact first contact is the earliest one (ties included, however many), and no pair whose
+//! exact first contact is more than `2 * TOI_TOLERANCE` after it. The walk keeps the
+//! earliest time found so far (shared by all threads) and tests each later pair only up to
+//! it plus a slack, so most pairs stop early; the pairs found near the best are then tested
+//! again over the whole interval, so the answer does not depend on the order, the threads,
+//! the method or which path (float filter or exact) decided a pair. (Its work counters do
+//! depend on the order.)
 //!
 //! Results are in the caller's original indices, sorted, the same for every method and thread
 //! count. `prim_tests` counts the feature pairs given to the exact test, `contacts` the
@@ -68,7 +71,8 @@ pub enum CcdMode {
     /// Every colliding pair with its time of impact.
     #[default]
     All,
-    /// The earliest time of impact, with the pairs that reach it.
+    /// The earliest time of impact, with every pair whose time of impact is within
+    /// [`TOI_TOLERANCE`] of it (every pair whose exact first contact is the earliest).
     Earliest,
 }
 
@@ -330,8 +334,12 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
     }
 }
 
-/// Twice the time-of-impact tolerance: in earliest mode a pair is tested up to the best
-/// time so far plus this, so every pair that can reach the final answer is found.
+/// In earliest mode a pair is tested up to the best time so far plus this, so every pair
+/// that ties with the final answer is found. The best so far is some pair's time, at least
+/// `t*_min - TOI_TOLERANCE`; a pair that ties ([`ties_with`]) has `t* <= toi + TOI_TOLERANCE
+/// <= least + 2 TOI_TOLERANCE <= t*_min + 2 TOI_TOLERANCE`, below that bound plus `3
+/// TOI_TOLERANCE`, and its time found under the bound is within `3 TOI_TOLERANCE` of the
+/// least found, which `settle_earliest` keeps.
 const PRUNE_SLACK: f64 = 4.0 * TOI_TOLERANCE;
 
 /// The CCD walk: two hierarchies over a step, the exact test and the mode.
@@ -417,22 +425,37 @@ pub(crate) fn run<K: BoundingVolume>(
     (impacts, w.fitted)
 }
 
-/// Earliest mode over several walks that shared one bound: the least of their times, and
-/// each walk's pairs only if they reach it (the others are emptied, with `toi` `None`). A
-/// walk whose own answer is later may have been cut short by another's bound, so only the
-/// walks reaching the least time have an answer that does not depend on the order; theirs
-/// is the same as without the sharing (every pair within the tolerance of the least time is
-/// found whatever the bound, see [`PRUNE_SLACK`]).
+/// Earliest mode over several walks that shared one bound: `least`, the least of their
+/// times, and in each walk only the pairs that tie with it ([`ties_with`]); a walk left
+/// with none is emptied, with `toi` `None`. A walk whose own answer is later may have been
+/// cut short by another's bound, but every pair that ties with the least time is found
+/// whatever the bound (see [`PRUNE_SLACK`]), so the answer does not depend on the order.
 pub(crate) fn keep_earliest(walks: &mut [Impacts]) -> Option<f64> {
-    let least = walks.iter().filter_map(|w| w.toi).reduce(f64::min);
-    for w in walks.iter_mut().filter(|w| w.toi != least) {
-        w.vertex_face.clear();
-        w.face_vertex.clear();
-        w.edge_edge.clear();
-        w.toi = None;
-        w.counters.contacts = 0;
+    let least = walks.iter().filter_map(|w| w.toi).reduce(f64::min)?;
+    for w in walks.iter_mut() {
+        let tie = |toi: f64| ties_with(toi, least);
+        w.vertex_face.retain(|x| tie(x.toi));
+        w.face_vertex.retain(|x| tie(x.toi));
+        w.edge_edge.retain(|x| tie(x.toi));
+        w.counters.contacts =
+            (w.vertex_face.len() + w.face_vertex.len() + w.edge_edge.len()) as u64;
+        if w.counters.contacts == 0 {
+            w.toi = None;
+        }
     }
-    least
+    Some(least)
+}
+
+/// Earliest mode's rule: a pair whose time of impact is `toi` is reported with the least
+/// time `least` iff `toi <= least + TOI_TOLERANCE`. Every returned time is at most
+/// [`TOI_TOLERANCE`] below the pair's exact first contact `t*` and never above it, so every
+/// pair whose `t*` is the earliest exact contact is reported (its `toi <= t* = t*_min <=
+/// least + TOI_TOLERANCE`), and none whose `t*` is more than `2 * TOI_TOLERANCE` after it.
+/// The rule reads only each pair's own time over the whole interval, which does not depend
+/// on the path (float filter or exact) that computed it, the method or the threads.
+#[inline]
+pub(crate) fn ties_with(toi: f64, least: f64) -> bool {
+    toi <= least + TOI_TOLERANCE
 }
 
 impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
@@ -463,8 +486,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     }
 
     /// Earliest mode, after the walk: every pair found within [`PRUNE_SLACK`] of the best is
-    /// tested again over the whole interval; the least of those times and the pairs reaching
-    /// it are the answer (the same whatever the order of the walk).
+    /// tested again over the whole interval; the least of those times and the pairs that tie
+    /// with it ([`ties_with`]) are the answer (the same whatever the order of the walk).
     fn settle_earliest(&self, out: &mut ImpactOut) {
         let best = out.least_toi().unwrap_or(f64::INFINITY);
         let near = |toi: f64| toi <= best + PRUNE_SLACK;
@@ -509,9 +532,9 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             edge_edge,
         };
         let least = settled.least_toi().unwrap_or(f64::INFINITY);
-        settled.vertex_face.retain(|x| x.toi == least);
-        settled.face_vertex.retain(|x| x.toi == least);
-        settled.edge_edge.retain(|x| x.toi == least);
+        settled.vertex_face.retain(|x| ties_with(x.toi, least));
+        settled.face_vertex.retain(|x| ties_with(x.toi, least));
+        settled.edge_edge.retain(|x| ties_with(x.toi, least));
         *out = settled;
     }
 }

@@ -22,7 +22,7 @@ pub struct CcdArgs {
     /// Pairs collide when they come within this distance (IPC's minimum separation).
     #[arg(long, default_value_t = 0.0)]
     min_distance: f64,
-    /// Only the earliest time of impact, with the pairs that reach it.
+    /// Only the earliest time of impact, with every pair whose own time is within 1e-12 of it.
     #[arg(long)]
     earliest: bool,
     /// Threads (1: the calling thread; 0: all cores). The output does not depend on it.
