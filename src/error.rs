@@ -202,6 +202,28 @@ pub enum Error {
         /// Its coordinates.
         position: [f64; 3],
     },
+    /// A query would return more result pairs than its [`crate::Control::max_pairs`]: it
+    /// stopped when the count passed the limit (nothing is returned).
+    #[error(
+        "the query stopped at {reached} result pairs, over the limit of {limit} \
+         (Control::max_pairs; raise it, up to no limit, or ask a smaller distance or step)"
+    )]
+    OutputLimit {
+        /// Result pairs found when the query stopped (at least `limit + 1`).
+        reached: u64,
+        /// The limit.
+        limit: u64,
+    },
+    /// A result buffer could not grow: the allocator refused (nothing is returned).
+    #[error("out of memory: a result buffer of {bytes} bytes could not be allocated")]
+    OutOfMemory {
+        /// The size of the buffer asked for, in bytes.
+        bytes: u64,
+    },
+    /// The query was cancelled (its [`crate::Control`]'s flag was set, or its poll
+    /// function asked to stop): nothing is returned.
+    #[error("the query was cancelled")]
+    Cancelled,
     /// A file that cannot be read (or written), with the system's message.
     #[error("{}: {}", escaped_path(.path), escaped(.message))]
     Io {

@@ -44,6 +44,7 @@ mod any;
 pub mod bv;
 pub mod calibration;
 pub mod ccd;
+mod control;
 mod counters;
 pub mod distance;
 pub mod error;
@@ -67,6 +68,7 @@ mod walk;
 
 pub use any::AnyHierarchy;
 pub use bv::Method;
+pub use control::{Control, DEFAULT_MAX_PAIRS};
 pub use counters::Counters;
 pub use error::{Error, Result};
 pub use hierarchy::{Hierarchy, InvariantError};

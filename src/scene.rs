@@ -25,6 +25,7 @@ use rayon::prelude::*;
 
 use crate::bv::swept::{box_over_step, f32_up, Step};
 use crate::bv::{BoundingVolume, Method};
+use crate::control::{Budget, Control};
 use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
@@ -207,6 +208,8 @@ macro_rules! each {
 #[derive(Clone, Debug)]
 pub struct Scene {
     options: Options,
+    /// Limits and cancellation of the scene's proximity and CCD queries.
+    control: Control,
     next_id: u64,
     /// Sorted by id (ids only grow, so `add` appends).
     objects: Objects,
@@ -218,9 +221,22 @@ impl Scene {
         let objects = with_method!(method, K => Objs::<K>::new().into());
         Self {
             options,
+            control: Control::default(),
             next_id: 0,
             objects,
         }
+    }
+
+    /// Limits and cancellation of the scene's proximity and CCD queries (the most result
+    /// pairs over all object pairs together, a cancel flag, a poll function): see
+    /// [`Control`].
+    pub fn control(&self) -> &Control {
+        &self.control
+    }
+
+    /// Replaces the scene's [`Control`].
+    pub fn set_control(&mut self, control: Control) {
+        self.control = control;
     }
 
     /// The method of every object's hierarchy.
@@ -377,7 +393,8 @@ impl Scene {
     pub fn proximity(&mut self, d: f64, par: Par) -> Result<SceneProximity> {
         check_distance(d)?;
         let parallel = par.is_parallel();
-        Ok(each!(&mut self.objects, v => par.install(|| proximity_of(v, d, parallel))))
+        let budget = Budget::new(&self.control);
+        each!(&mut self.objects, v => par.install(|| proximity_of(v, d, &budget, parallel)))
     }
 
     /// Continuous collision detection over one step of the whole scene: every
@@ -440,7 +457,8 @@ impl Scene {
         let slot = self.slots(motions)?;
         query.options.validate()?;
         let parallel = par.is_parallel();
-        each!(&self.objects, v => par.install(|| ccd_of(v, &slot, query, parallel)))
+        let budget = Budget::new(&self.control);
+        each!(&self.objects, v => par.install(|| ccd_of(v, &slot, query, &budget, parallel)))
     }
 
     /// The object's current positions in its mesh's vertex order, as `f64` (the `f32`
@@ -492,11 +510,13 @@ impl Scene {
     }
 }
 
+/// [`Scene::proximity`] once the distance is checked: every job counted against `budget`.
 fn proximity_of<K: BoundingVolume>(
     objects: &mut [Object<K>],
     d: f64,
+    budget: &Budget<'_>,
     parallel: bool,
-) -> SceneProximity {
+) -> Result<SceneProximity> {
     let within = Within::distance(d);
     let boxes = objects.iter().map(|o| o.bounds);
     let (jobs, broad_phase_tests) = jobs_of(objects, boxes, within.margin);
@@ -509,10 +529,12 @@ fn proximity_of<K: BoundingVolume>(
                 None => Posed::single(a, within),
                 Some(b) => Posed::pair(a, b, within),
             };
-            proximity::run(posed, d, ws, par)
+            // A job stopped by the budget gives nothing; `finish` below says why.
+            proximity::run(posed, d, budget, ws, par).unwrap_or_default()
         },
         |p: &mut Proximity| &mut p.counters,
     );
+    budget.finish()?;
     let mut out = SceneProximity {
         broad_phase_tests,
         ..SceneProximity::default()
@@ -525,7 +547,7 @@ fn proximity_of<K: BoundingVolume>(
             proximity: p,
         });
     }
-    out
+    Ok(out)
 }
 
 /// Sweep-and-prune on the root boxes along x: the index pairs `(i, j)`, `i < j`, of objects
@@ -751,6 +773,7 @@ fn ccd_of<K: BoundingVolume>(
     objects: &[Object<K>],
     motions: &[Option<Motion<'_>>],
     query: &CcdQuery,
+    budget: &Budget<'_>,
     parallel: bool,
 ) -> Result<SceneImpacts> {
     // Each moving object's step (checked, in internal order) and box over the step; the first
@@ -794,16 +817,18 @@ fn ccd_of<K: BoundingVolume>(
         let a = a
             .as_ref()
             .expect("an object in a job has its bounds over the step");
-        match b {
-            None => ccd::run(a, a, true, query, best.as_ref(), ws, par),
-            Some(b) => {
-                let b = b
-                    .as_ref()
-                    .expect("an object in a job has its bounds over the step");
-                ccd::run(a, b, false, query, best.as_ref(), ws, par)
-            }
-        }
+        let (b, self_job) = match b {
+            None => (a, true),
+            Some(b) => (
+                b.as_ref()
+                    .expect("an object in a job has its bounds over the step"),
+                false,
+            ),
+        };
+        // A job stopped by the budget gives nothing; `finish` below says why.
+        ccd::run(a, b, self_job, query, best.as_ref(), budget, ws, par).unwrap_or_default()
     });
+    budget.finish()?;
     let mut impacts = credit_refits(
         results,
         &jobs,

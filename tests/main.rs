@@ -7,6 +7,7 @@ mod ccd_query;
 mod ccd_reference;
 mod ccd_samples;
 mod central;
+mod control;
 mod distance;
 mod fixtures;
 mod free_points;

@@ -9,6 +9,14 @@ struct CountingAllocator;
 thread_local! {
     static LIVE: std::cell::Cell<isize> = const { std::cell::Cell::new(0) };
     static PEAK: std::cell::Cell<isize> = const { std::cell::Cell::new(0) };
+    /// Allocations larger than this fail on this thread ([`refusing_above`]).
+    static REFUSE_ABOVE: std::cell::Cell<usize> = const { std::cell::Cell::new(usize::MAX) };
+}
+
+fn refused(layout: std::alloc::Layout) -> bool {
+    REFUSE_ABOVE
+        .try_with(|r| layout.size() > r.get())
+        .unwrap_or(false)
 }
 
 fn count(delta: isize) {
@@ -23,6 +31,9 @@ fn count(delta: isize) {
 // const-initialised thread-locals (no allocation, no destructor).
 unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        if refused(layout) {
+            return std::ptr::null_mut();
+        }
         count(layout.size() as isize);
         // SAFETY: the caller's contract is the system allocator's.
         unsafe { std::alloc::System.alloc(layout) }
@@ -35,12 +46,18 @@ unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
     }
 
     unsafe fn alloc_zeroed(&self, layout: std::alloc::Layout) -> *mut u8 {
+        if refused(layout) {
+            return std::ptr::null_mut();
+        }
         count(layout.size() as isize);
         // SAFETY: as above.
         unsafe { std::alloc::System.alloc_zeroed(layout) }
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new: usize) -> *mut u8 {
+        if new > layout.size() && REFUSE_ABOVE.try_with(|r| new > r.get()).unwrap_or(false) {
+            return std::ptr::null_mut();
+        }
         count(new as isize - layout.size() as isize);
         // SAFETY: as above.
         unsafe { std::alloc::System.realloc(ptr, layout, new) }
@@ -58,6 +75,15 @@ pub fn peak_bytes<R>(f: impl FnOnce() -> R) -> (R, usize) {
     let r = f();
     let peak = PEAK.with(|p| p.get()) - start;
     (r, peak.max(0) as usize)
+}
+
+/// Runs `f` with every allocation of more than `bytes` on this thread refused (the allocator
+/// returns null, as a system out of memory does).
+pub fn refusing_above<R>(bytes: usize, f: impl FnOnce() -> R) -> R {
+    let before = REFUSE_ABOVE.with(|r| r.replace(bytes));
+    let r = f();
+    REFUSE_ABOVE.with(|r| r.set(before));
+    r
 }
 
 /// The folder `data/<rel>` of the project's shared data (`../shared/data` beside the

@@ -38,6 +38,7 @@ use super::features::{grown, meet, meeting, ordered_edge, points_box_f64, union_
 use crate::bv::swept::{f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
+use crate::control::Budget;
 use crate::counters::Counters;
 use crate::error::Result;
 use crate::hierarchy::Hierarchy;
@@ -209,7 +210,9 @@ pub fn ccd_pair_with<K: BoundingVolume>(
     let sa = Swept::new(a, a_motion)?;
     let sb = Swept::new(b, b_motion)?;
     let best = earliest_bound(query);
-    Ok(run(&sa, &sb, false, query, best.as_ref(), ws, par).0)
+    let control = ws.control.clone();
+    let budget = Budget::new(&control);
+    Ok(run(&sa, &sb, false, query, best.as_ref(), &budget, ws, par)?.0)
 }
 
 /// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
@@ -233,7 +236,9 @@ pub fn self_ccd_with<K: BoundingVolume>(
     query.options.validate()?;
     let s = Swept::new(h, motion)?;
     let best = earliest_bound(query);
-    Ok(run(&s, &s, true, query, best.as_ref(), ws, par).0)
+    let control = ws.control.clone();
+    let budget = Budget::new(&control);
+    Ok(run(&s, &s, true, query, best.as_ref(), &budget, ws, par)?.0)
 }
 
 /// One hierarchy over a step: its positions at t0 and t1 (internal order), its node bounds
@@ -353,6 +358,8 @@ struct SweptQuery<'s, 'h, K: BoundingVolume> {
     /// Earliest mode: the least time of impact found so far, by this walk or any other
     /// sharing the bound ([`earliest_bound`]).
     best: Option<&'s AtomicU64>,
+    /// The result pairs so far, against the query's limit, and cancellation.
+    budget: &'s Budget<'s>,
 }
 
 #[derive(Default)]
@@ -363,6 +370,11 @@ struct ImpactOut {
 }
 
 impl ImpactOut {
+    /// Pairs held.
+    fn len(&self) -> usize {
+        self.vertex_face.len() + self.face_vertex.len() + self.edge_edge.len()
+    }
+
     /// The least time of impact of every pair held (`None`: no pair).
     fn least_toi(&self) -> Option<f64> {
         self.vertex_face
@@ -382,17 +394,20 @@ pub(crate) fn earliest_bound(query: &CcdQuery) -> Option<AtomicU64> {
     (query.mode == CcdMode::Earliest).then(|| AtomicU64::new(f64::INFINITY.to_bits()))
 }
 
-/// The CCD walk of `a` against `b` (options checked), pruned by `best` in earliest mode; also
-/// the bounds fitted on each side.
+/// The CCD walk of `a` against `b` (options checked), pruned by `best` in earliest mode and
+/// counted against `budget`; also the bounds fitted on each side. An error when the budget
+/// stopped the walk (this walk or another sharing the budget).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn run<K: BoundingVolume>(
     a: &Swept<'_, K>,
     b: &Swept<'_, K>,
     self_query: bool,
     query: &CcdQuery,
     best: Option<&AtomicU64>,
+    budget: &Budget<'_>,
     ws: &mut Workspace,
     par: Par,
-) -> (Impacts, [u64; 2]) {
+) -> Result<(Impacts, [u64; 2])> {
     let q = SweptQuery {
         a,
         b,
@@ -400,8 +415,10 @@ pub(crate) fn run<K: BoundingVolume>(
         options: query.options,
         margin: f32_up(query.options.min_distance),
         best,
+        budget,
     };
     let w = walk::walk(&q, ws, par);
+    budget.finish()?;
     let mut out = w.out;
     if query.mode == CcdMode::Earliest {
         q.settle_earliest(&mut out);
@@ -422,7 +439,7 @@ pub(crate) fn run<K: BoundingVolume>(
         toi,
         counters,
     };
-    (impacts, w.fitted)
+    Ok((impacts, w.fitted))
 }
 
 /// Earliest mode over several walks that shared one bound: `least`, the least of their
@@ -643,42 +660,63 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
         let (a, b, self_query) = (self.a, self.b, self.self_query);
         let tv = |s: &Swept<'_, K>, v: usize| s.tree().vert_order()[v];
         let tt = |s: &Swept<'_, K>, t: usize| s.tree().tri_order()[t];
+        let before = out.len();
+        let budget = self.budget;
         let ImpactOut {
             vertex_face,
             face_vertex,
             edge_edge,
         } = out;
         self.vertices_vs_triangles(simd, a, x, b, y, counters, |v, t, toi| {
-            vertex_face.push(VertexImpact {
-                vertex: tv(a, v),
-                triangle: tt(b, t),
-                toi,
-            })
+            budget.push(
+                vertex_face,
+                VertexImpact {
+                    vertex: tv(a, v),
+                    triangle: tt(b, t),
+                    toi,
+                },
+            )
         });
         if !(self_query && x == y) {
             self.vertices_vs_triangles(simd, b, y, a, x, counters, |v, t, toi| {
                 if self_query {
-                    vertex_face.push(VertexImpact {
-                        vertex: tv(b, v),
-                        triangle: tt(a, t),
-                        toi,
-                    })
+                    budget.push(
+                        vertex_face,
+                        VertexImpact {
+                            vertex: tv(b, v),
+                            triangle: tt(a, t),
+                            toi,
+                        },
+                    )
                 } else {
-                    face_vertex.push(FaceImpact {
-                        triangle: tt(a, t),
-                        vertex: tv(b, v),
-                        toi,
-                    })
+                    budget.push(
+                        face_vertex,
+                        FaceImpact {
+                            triangle: tt(a, t),
+                            vertex: tv(b, v),
+                            toi,
+                        },
+                    )
                 }
             });
         }
         self.edges_vs_edges(simd, x, y, counters, edge_edge);
+        budget.add(out.len() - before);
     }
 
     fn merge(&self, out: &mut ImpactOut, other: ImpactOut) {
-        out.vertex_face.extend_from_slice(&other.vertex_face);
-        out.face_vertex.extend_from_slice(&other.face_vertex);
-        out.edge_edge.extend_from_slice(&other.edge_edge);
+        self.budget.extend(&mut out.vertex_face, &other.vertex_face);
+        self.budget.extend(&mut out.face_vertex, &other.face_vertex);
+        self.budget.extend(&mut out.edge_edge, &other.edge_edge);
+    }
+
+    #[inline(always)]
+    fn stopped(&self, poll: bool) -> bool {
+        if poll {
+            self.budget.poll()
+        } else {
+            self.budget.stopped()
+        }
     }
 }
 
@@ -710,6 +748,10 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             let probe = grown(&vbox, self.margin);
             // PERF: mask loops, not closures (see `proximity.rs`).
             for base in (0..n).step_by(MAX_BOX_ROW) {
+                // A row may hold pairs that take the exact path: stop promptly when asked.
+                if self.budget.stopped() {
+                    return;
+                }
                 let mut bits = meeting(simd, &probe, &rows, base, n);
                 while bits != 0 {
                     let t = first + base + bits.trailing_zeros() as usize;
@@ -759,6 +801,9 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                 let pa = a_int.map(|v| sa.step_at(v as usize));
                 let from = if same { i + 1 } else { 0 };
                 for base in (from..eb.len()).step_by(MAX_BOX_ROW) {
+                    if self.budget.stopped() {
+                        return;
+                    }
                     let mut bits = meeting(simd, &probe, &rb, base, eb.len());
                     while bits != 0 {
                         let j = base + bits.trailing_zeros() as usize;
@@ -780,11 +825,14 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                         };
                         if let Some(toi) = edge_edge_toi(px, py, &self.options_now()) {
                             self.found(toi);
-                            out.push(EdgeImpact {
-                                a: ids_x,
-                                b: ids_y,
-                                toi,
-                            });
+                            self.budget.push(
+                                out,
+                                EdgeImpact {
+                                    a: ids_x,
+                                    b: ids_y,
+                                    toi,
+                                },
+                            );
                         }
                     }
                 }

@@ -149,6 +149,11 @@ pub(crate) trait LeafAction<'h, K: BoundingVolume>: Sync {
         out: &mut Self::Out,
     );
     fn merge(&self, out: &mut Self::Out, other: Self::Out);
+    /// See [`Query::stopped`].
+    #[inline(always)]
+    fn stopped(&self, _poll: bool) -> bool {
+        false
+    }
 }
 
 /// A query on the current pose: [`Posed`] plus a [`LeafAction`].
@@ -205,5 +210,10 @@ impl<'h, K: BoundingVolume, T: NodeTest, L: LeafAction<'h, K>> Query for PosedQu
 
     fn merge(&self, out: &mut L::Out, other: L::Out) {
         self.action.merge(out, other)
+    }
+
+    #[inline(always)]
+    fn stopped(&self, poll: bool) -> bool {
+        self.action.stopped(poll)
     }
 }

@@ -21,6 +21,7 @@ use pulp::Simd;
 use super::features::{grown, meet, meeting, ordered_edge, points_box, union_of};
 use super::{LeafAction, NodeTest, Posed, PosedQuery, Within};
 use crate::bv::BoundingVolume;
+use crate::control::Budget;
 use crate::counters::Counters;
 use crate::distance::{self, EdgeEdge, PointTriangle};
 use crate::error::{Error, Result};
@@ -119,7 +120,9 @@ pub fn proximity_with<K: BoundingVolume>(
     par: Par,
 ) -> Result<Proximity> {
     check_distance(d)?;
-    Ok(run(Posed::pair(a, b, Within::distance(d)), d, ws, par).0)
+    let control = ws.control.clone();
+    let budget = Budget::new(&control);
+    Ok(run(Posed::pair(a, b, Within::distance(d)), d, &budget, ws, par)?.0)
 }
 
 /// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
@@ -136,23 +139,28 @@ pub fn self_proximity_with<K: BoundingVolume>(
     par: Par,
 ) -> Result<Proximity> {
     check_distance(d)?;
-    Ok(run(Posed::single(h, Within::distance(d)), d, ws, par).0)
+    let control = ws.control.clone();
+    let budget = Budget::new(&control);
+    Ok(run(Posed::single(h, Within::distance(d)), d, &budget, ws, par)?.0)
 }
 
-/// The proximity query on `posed` (distance already checked); also the nodes fitted on each
-/// side (the scene credits them per object).
+/// The proximity query on `posed` (distance already checked), counted against `budget`; also
+/// the nodes fitted on each side (the scene credits them per object). An error when the
+/// budget stopped the walk (this walk or another sharing the budget).
 pub(crate) fn run<K: BoundingVolume>(
     posed: Posed<'_, K, Within>,
     d: f64,
+    budget: &Budget<'_>,
     ws: &mut Workspace,
     par: Par,
-) -> (Proximity, [u64; 2]) {
+) -> Result<(Proximity, [u64; 2])> {
     let margin = posed.node_test.margin;
     let q = PosedQuery {
         posed,
-        action: Features { d, margin },
+        action: Features { d, margin, budget },
     };
     let w = walk::walk(&q, ws, par);
+    budget.finish()?;
     let mut p = w.out.result;
     p.vertex_face
         .sort_unstable_by_key(|x| (u64::from(x.vertex) << 32) | u64::from(x.triangle));
@@ -161,14 +169,16 @@ pub(crate) fn run<K: BoundingVolume>(
     p.edge_edge.sort_unstable_by_key(|x| (x.a, x.b));
     p.counters = w.counters;
     p.counters.contacts = (p.vertex_face.len() + p.face_vertex.len() + p.edge_edge.len()) as u64;
-    (p, w.fitted)
+    Ok((p, w.fitted))
 }
 
 /// The leaf action: the feature pairs of a leaf pair.
-struct Features {
+struct Features<'b, 'c> {
     d: f64,
     /// `d` as an `f32` not below it: the boxes' growth.
     margin: f32,
+    /// The result pairs so far, against the query's limit.
+    budget: &'b Budget<'c>,
 }
 
 /// What a proximity walk task produces.
@@ -191,7 +201,7 @@ impl<'h, K: BoundingVolume> Leaf<'h, K> {
     }
 }
 
-impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features {
+impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features<'_, '_> {
     type Out = FeatureOut;
 
     fn out(&self) -> FeatureOut {
@@ -222,46 +232,68 @@ impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features {
         );
         let self_query = posed.self_query;
         let res = &mut out.result;
+        let budget = self.budget;
+        let before = res.vertex_face.len() + res.face_vertex.len() + res.edge_edge.len();
         // Vertices of x against triangles of y, and (but for a leaf with itself) the other way.
         self.vertices_vs_triangles(simd, lx, ly, self_query, counters, |v, t, d2, kind| {
-            res.vertex_face.push(VertexFace {
-                vertex: v,
-                triangle: t,
-                distance_sq: d2,
-                kind,
-            })
+            budget.push(
+                &mut res.vertex_face,
+                VertexFace {
+                    vertex: v,
+                    triangle: t,
+                    distance_sq: d2,
+                    kind,
+                },
+            )
         });
         if !(self_query && x == y) {
             self.vertices_vs_triangles(simd, ly, lx, self_query, counters, |v, t, d2, kind| {
                 if self_query {
-                    res.vertex_face.push(VertexFace {
-                        vertex: v,
-                        triangle: t,
-                        distance_sq: d2,
-                        kind,
-                    })
+                    budget.push(
+                        &mut res.vertex_face,
+                        VertexFace {
+                            vertex: v,
+                            triangle: t,
+                            distance_sq: d2,
+                            kind,
+                        },
+                    )
                 } else {
-                    res.face_vertex.push(FaceVertex {
-                        triangle: t,
-                        vertex: v,
-                        distance_sq: d2,
-                        kind,
-                    })
+                    budget.push(
+                        &mut res.face_vertex,
+                        FaceVertex {
+                            triangle: t,
+                            vertex: v,
+                            distance_sq: d2,
+                            kind,
+                        },
+                    )
                 }
             });
         }
         self.edges_vs_edges(simd, lx, ly, self_query, counters, &mut res.edge_edge);
+        let after = res.vertex_face.len() + res.face_vertex.len() + res.edge_edge.len();
+        budget.add(after - before);
     }
 
     fn merge(&self, out: &mut FeatureOut, other: FeatureOut) {
         let (r, o) = (&mut out.result, other.result);
-        r.vertex_face.extend_from_slice(&o.vertex_face);
-        r.face_vertex.extend_from_slice(&o.face_vertex);
-        r.edge_edge.extend_from_slice(&o.edge_edge);
+        self.budget.extend(&mut r.vertex_face, &o.vertex_face);
+        self.budget.extend(&mut r.face_vertex, &o.face_vertex);
+        self.budget.extend(&mut r.edge_edge, &o.edge_edge);
+    }
+
+    #[inline(always)]
+    fn stopped(&self, poll: bool) -> bool {
+        if poll {
+            self.budget.poll()
+        } else {
+            self.budget.stopped()
+        }
     }
 }
 
-impl Features {
+impl Features<'_, '_> {
     /// The own vertices of leaf `lv` against the triangles of leaf `lt`: `emit(vertex,
     /// triangle, distance_sq, type)` for each pair within the distance (original indices).
     #[inline(always)]
@@ -373,12 +405,15 @@ impl Features {
                         if let Some((d2, kind)) =
                             distance::edge_edge_within(px[0], px[1], py[0], py[1], self.d)
                         {
-                            out.push(EdgePair {
-                                a: x,
-                                b: y,
-                                distance_sq: d2,
-                                kind,
-                            });
+                            self.budget.push(
+                                out,
+                                EdgePair {
+                                    a: x,
+                                    b: y,
+                                    distance_sq: d2,
+                                    kind,
+                                },
+                            );
                         }
                     }
                 }

@@ -10,6 +10,7 @@
 use pulp::Simd;
 
 use super::{push_bits, Query, Side};
+use crate::control::POLL_EVERY;
 use crate::counters::Counters;
 
 /// The state of one walk task: the query, and the work counted so far.
@@ -58,11 +59,21 @@ impl<'q, Q: Query> Task<'q, Q> {
         stack: &mut Vec<[u32; 2]>,
         out: &mut Q::Out,
     ) {
+        let mut since_poll = 0;
         while let Some(pair) = stack.pop() {
             if !self.split(simd, pair, stack) {
                 let [x, y] = pair;
                 let q = self.query;
                 q.leaf_pair(simd, x as usize, y as usize, &mut self.counters, out);
+                since_poll += 1;
+                let poll = since_poll == POLL_EVERY;
+                if poll {
+                    since_poll = 0;
+                }
+                if q.stopped(poll) {
+                    stack.clear();
+                    return;
+                }
             }
         }
     }

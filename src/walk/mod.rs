@@ -37,6 +37,7 @@ pub(crate) use parallel::{leaf_pairs, walk};
 
 use pulp::Simd;
 
+use crate::control::Control;
 use crate::counters::Counters;
 use crate::tree::RegionTree;
 
@@ -82,6 +83,13 @@ pub(crate) trait Query: Sync {
     );
     /// Appends `other` (a later task's output) to `out`.
     fn merge(&self, out: &mut Self::Out, other: Self::Out);
+    /// Whether the walk must stop now (its budget spent, or cancelled); `poll`: ask the
+    /// control's poll function too. Checked after every leaf pair; queries without a budget
+    /// never stop.
+    #[inline(always)]
+    fn stopped(&self, _poll: bool) -> bool {
+        false
+    }
 }
 
 /// What a walk returns: the query's output and the work counted.
@@ -120,9 +128,12 @@ pub(crate) fn push_bits(
 
 /// Reusable scratch of a walk (its stack and starting pairs): keep one per thread to avoid
 /// allocating every step. Also holds the smallest number of starting pairs a parallel task
-/// takes (the *grain*; the result never depends on it).
+/// takes (the *grain*; the result never depends on it) and the [`Control`] of the queries
+/// run with it (the most result pairs, cancellation).
 #[derive(Clone, Debug)]
 pub struct Workspace {
+    /// Limits and cancellation of the queries run with this workspace (proximity, CCD).
+    pub control: Control,
     pub(crate) grain: usize,
     pub(crate) stack: Vec<[u32; 2]>,
     pub(crate) seeds: Vec<[u32; 2]>,
@@ -142,6 +153,7 @@ impl Workspace {
     /// 1). Larger grains cut scheduling overhead; the result never depends on it.
     pub fn with_grain(grain: usize) -> Self {
         Self {
+            control: Control::default(),
             grain: grain.max(1),
             stack: Vec::new(),
             seeds: Vec::new(),

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use super::engine::Task;
 use super::{Query, Walked, Workspace};
+use crate::control::POLL_EVERY;
 use crate::par::Par;
 
 /// Pairs the breadth-first start aims for, per thread, before the parallel walk.
@@ -187,6 +188,9 @@ impl<Q: Query> WithSimd for WalkOp<'_, '_, Q> {
             // PERF (compile time): the one place the walk engine (the split, the query's
             // group fetch, node test and leaf action inlined) is instantiated per backend.
             self.task.descend(simd, self.stack, self.out);
+            if self.task.query.stopped(false) {
+                return;
+            }
         }
     }
 }
@@ -203,7 +207,7 @@ impl<Q: Query> WithSimd for LeafOp<'_, '_, Q> {
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
         let q = self.task.query;
-        for &[x, y] in self.pairs {
+        for (k, &[x, y]) in self.pairs.iter().enumerate() {
             q.leaf_pair(
                 simd,
                 x as usize,
@@ -211,6 +215,9 @@ impl<Q: Query> WithSimd for LeafOp<'_, '_, Q> {
                 &mut self.task.counters,
                 self.out,
             );
+            if q.stopped((k + 1) % POLL_EVERY as usize == 0) {
+                return;
+            }
         }
     }
 }
