@@ -596,8 +596,11 @@ fn extreme_magnitudes_stay_exact() {
     assert!(!assert_exact(&fa, &fb, 3).is_empty());
 }
 
+/// Vertices no triangle uses (free points) change no contact (contacts are triangle pairs),
+/// and the bounds hold them: proximity and CCD pair them with triangles as points
+/// (`tests/free_points.rs`).
 #[test]
-fn unreferenced_vertices_are_ignored() {
+fn free_points_are_in_the_bounds_and_change_no_contact() {
     let mut positions = vec![[100.0, 100.0, 100.0]];
     positions.extend_from_slice(icosphere(1, 1.0, [0.0; 3]).positions());
     positions.push([-50.0, 0.0, 0.0]);
@@ -611,7 +614,7 @@ fn unreferenced_vertices_are_ignored() {
     assert!(!assert_exact(&a, &b, 4).is_empty());
     let mut h = Hierarchy::<Aabb>::new(&a, Options::default()).unwrap();
     h.refit_all();
-    // The root box is the sphere's, not stretched to the unreferenced vertices.
+    h.validate().unwrap();
     let root = h.record(0).unwrap();
-    assert!(root.max[0] < 2.0 && root.min[0] > -2.0);
+    assert!(root.max[0] >= 100.0 && root.min[0] <= -50.0);
 }

@@ -6,6 +6,7 @@ mod ccd_frames;
 mod ccd_query;
 mod ccd_reference;
 mod ccd_samples;
+mod ccd_wide;
 mod central;
 mod control;
 mod distance;

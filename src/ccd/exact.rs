@@ -349,11 +349,19 @@ impl Root {
     }
 }
 
+/// Asked between the steps of the exact path (`true`: stop now). A stopped solve returns
+/// [`Stopped`]; its caller discards the query.
+pub(crate) type Stop<'a> = &'a dyn Fn() -> bool;
+
+/// The exact path was stopped by its [`Stop`] before it finished.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Stopped;
+
 /// The distinct real roots of the nonzero `poly` in `[0, t_max]`, in increasing order.
-pub(crate) fn roots(poly: &Poly, t_max: &Dy) -> Vec<Root> {
+pub(crate) fn roots(poly: &Poly, t_max: &Dy, stop: Stop<'_>) -> Result<Vec<Root>, Stopped> {
     let mut out = Vec::new();
     if poly.0.len() <= 1 {
-        return out; // a nonzero constant (or zero, which the caller never passes)
+        return Ok(out); // a nonzero constant (or zero, which the caller never passes)
     }
     // Square-free part.
     let q = primitive(poly.0.clone());
@@ -366,7 +374,10 @@ pub(crate) fn roots(poly: &Poly, t_max: &Dy) -> Vec<Root> {
         p.remove(0); // p = t p', p'(0) != 0 (p is square-free)
     }
     if t_max.n.is_zero() {
-        return out;
+        return Ok(out);
+    }
+    if stop() {
+        return Err(Stopped);
     }
     let at_end = sign_at_dy(&p, t_max) == 0;
     if at_end {
@@ -377,12 +388,12 @@ pub(crate) fn roots(poly: &Poly, t_max: &Dy) -> Vec<Root> {
     if p.len() > 1 {
         let sturm = srs(&p, &deriv(&p));
         let p = std::rc::Rc::new(p);
-        isolate(&p, &sturm, zero, t_max.clone(), &mut out);
+        isolate(&p, &sturm, zero, t_max.clone(), &mut out, stop)?;
     }
     if at_end {
         out.push(Root::Exact(t_max.clone()));
     }
-    out
+    Ok(out)
 }
 
 /// Appends the roots of `p` in `(lo, hi)` (neither a root), in increasing order.
@@ -392,11 +403,15 @@ fn isolate(
     lo: Dy,
     hi: Dy,
     out: &mut Vec<Root>,
-) {
+    stop: Stop<'_>,
+) -> Result<(), Stopped> {
+    if stop() {
+        return Err(Stopped);
+    }
     let count = variations(sturm, &lo) - variations(sturm, &hi);
     debug_assert!(count >= 0);
     if count == 0 {
-        return;
+        return Ok(());
     }
     if count == 1 {
         out.push(Root::Isolated {
@@ -404,7 +419,7 @@ fn isolate(
             lo,
             hi,
         });
-        return;
+        return Ok(());
     }
     // Split at a point that is not a root: of 1/2, 3/8, 5/8, 1/4, 3/4, 1/8, 7/8, ... of the
     // way (more candidates than p has roots), the first that is not one.
@@ -429,8 +444,8 @@ fn isolate(
         }
     }
     let m = split.expect("a polynomial of degree < 11 has a non-root among 11 points");
-    isolate(p, sturm, lo, m.clone(), out);
-    isolate(p, sturm, m, hi, out);
+    isolate(p, sturm, lo, m.clone(), out, stop)?;
+    isolate(p, sturm, m, hi, out, stop)
 }
 
 /// The sign of `s` at the root.
@@ -457,17 +472,20 @@ fn sign_at(s: &Poly, root: &Root) -> i8 {
 }
 
 /// A lower bound of the root, at most `2^-tol_log2` below it (an exact root is itself).
-fn lower_bound(root: &Root, tol_log2: u64) -> Dy {
+fn lower_bound(root: &Root, tol_log2: u64, stop: Stop<'_>) -> Result<Dy, Stopped> {
     match root {
-        Root::Exact(x) => x.clone(),
+        Root::Exact(x) => Ok(x.clone()),
         Root::Isolated { p, lo, hi } => {
             let (mut lo, mut hi) = (lo.clone(), hi.clone());
             let s_lo = sign_at_dy(p, &lo);
             while !lo.within(&hi, tol_log2) {
+                if stop() {
+                    return Err(Stopped);
+                }
                 let m = lo.lerp(&hi, 1, 1);
                 let s = sign_at_dy(p, &m);
                 if s == 0 {
-                    return m;
+                    return Ok(m);
                 }
                 if s == s_lo {
                     lo = m;
@@ -475,7 +493,7 @@ fn lower_bound(root: &Root, tol_log2: u64) -> Dy {
                     hi = m;
                 }
             }
-            lo
+            Ok(lo)
         }
     }
 }
@@ -531,7 +549,11 @@ pub(crate) struct Formula {
 /// open, and is that clause's minimum. Open clauses therefore only need the candidate 0.
 /// (Coplanar motion is the case: with f identically 0, "strictly inside" and "properly
 /// crossing" are open, and the first contact is on an edge or at an endpoint.)
-pub(crate) fn earliest(formula: &Formula, t_max: &Dy) -> Option<Dy> {
+pub(crate) fn earliest(
+    formula: &Formula,
+    t_max: &Dy,
+    stop: Stop<'_>,
+) -> Result<Option<Dy>, Stopped> {
     let n = formula.polys.len();
     // Which candidate groups: Some(j) = the roots of polynomial j; None = the point 0.
     let mut groups: Vec<Option<usize>> = Vec::new();
@@ -568,27 +590,42 @@ pub(crate) fn earliest(formula: &Formula, t_max: &Dy) -> Option<Dy> {
     }
     let tol = super::TOI_TOL_LOG2 as u64;
     let mut best: Option<Dy> = None;
-    let holds_at = |root: &Root| -> bool {
+    let holds_at = |root: &Root| -> Result<bool, Stopped> {
         let mut signs: Vec<Option<i8>> = vec![None; n];
-        formula.clauses.iter().any(|clause| {
-            clause.iter().all(|&(j, c)| {
-                let s = *signs[j].get_or_insert_with(|| sign_at(&formula.polys[j], root));
-                c.holds(s)
-            })
-        })
+        let mut stopped = false;
+        let holds = formula.clauses.iter().any(|clause| {
+            !stopped
+                && clause.iter().all(|&(j, c)| {
+                    let s = *signs[j].get_or_insert_with(|| {
+                        // Each sign is a Sturm-Tarski query: ask between them.
+                        stopped = stopped || stop();
+                        if stopped {
+                            0
+                        } else {
+                            sign_at(&formula.polys[j], root)
+                        }
+                    });
+                    !stopped && c.holds(s)
+                })
+        });
+        if stopped {
+            Err(Stopped)
+        } else {
+            Ok(holds)
+        }
     };
     for g in groups {
         let cands = match g {
             None => vec![Root::Exact(Dy::zero())],
-            Some(j) => roots(&formula.polys[j], t_max),
+            Some(j) => roots(&formula.polys[j], t_max, stop)?,
         };
         for root in cands {
             // Candidates of one group come in increasing order: past the best, stop.
             if best.as_ref().is_some_and(|b| root.lower().cmp(b).is_ge()) {
                 break;
             }
-            if holds_at(&root) {
-                let lb = lower_bound(&root, tol);
+            if holds_at(&root)? {
+                let lb = lower_bound(&root, tol, stop)?;
                 if best.as_ref().is_none_or(|b| lb.cmp(b).is_lt()) {
                     best = Some(lb);
                 }
@@ -596,7 +633,7 @@ pub(crate) fn earliest(formula: &Formula, t_max: &Dy) -> Option<Dy> {
             }
         }
     }
-    best
+    Ok(best)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -848,7 +885,8 @@ pub(crate) fn solve(
     x1: &[[f64; 3]; 4],
     t_max: f64,
     min_distance: f64,
-) -> Option<f64> {
+    stop: Stop<'_>,
+) -> Result<Option<f64>, Stopped> {
     let (ints, extra) = to_integers(x0, x1, &[min_distance]);
     let pts = moving_points(&ints);
     let formula = if min_distance == 0.0 {
@@ -864,7 +902,7 @@ pub(crate) fn solve(
             Kind::EdgeEdge => edge_edge_near_formula(&pts, &dd),
         }
     };
-    earliest(&formula, &Dy::from_f64(t_max)).map(|t| t.round_down())
+    Ok(earliest(&formula, &Dy::from_f64(t_max), stop)?.map(|t| t.round_down()))
 }
 
 /// The coplanarity polynomial f of the query (the same as the filter's, up to a positive
@@ -879,7 +917,13 @@ fn coplanarity(pts: &[V3<Poly>; 4]) -> Poly {
 
 /// The only root of the coplanarity polynomial in `(s0, s1)`, where it changes sign
 /// (certified by the filter), as a lower bound at most 2^-40 below it.
-pub(crate) fn refine_root(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], s0: f64, s1: f64) -> f64 {
+pub(crate) fn refine_root(
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    s0: f64,
+    s1: f64,
+    stop: Stop<'_>,
+) -> Result<f64, Stopped> {
     let (ints, _) = to_integers(x0, x1, &[]);
     let f = coplanarity(&moving_points(&ints));
     let root = Root::Isolated {
@@ -891,5 +935,5 @@ pub(crate) fn refine_root(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], s0: f64, s1: f
         Root::Isolated { p, lo, hi } => sign_at_dy(p, lo) * sign_at_dy(p, hi) < 0,
         _ => false,
     });
-    lower_bound(&root, super::TOI_TOL_LOG2 as u64).round_down()
+    Ok(lower_bound(&root, super::TOI_TOL_LOG2 as u64, stop)?.round_down())
 }

@@ -149,20 +149,24 @@ fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Stage 1: the Bernstein coefficients of f on [0, 1] (the middle two times 3) and one
-/// bound `e` on the error of each, or None if the magnitudes are out of the filter's
-/// range.
+/// Stage 1: the Bernstein coefficients of f on [0, 1] (the middle two times 3) and a bound
+/// on the error of each, or None if the magnitudes are out of the filter's range.
 ///
-/// Error bound. The computed differences carry a relative error <= u = 2^-53; each
-/// determinant then takes a product of three of them and two roundings per product level,
-/// and a coefficient sums three determinants: the standard forward bound is
-/// `gamma_10 * (sum of |terms|) <= 10.1 u * 18 m^3 < 2^-45 m^3`, m the largest difference
-/// (at most `(1 + u) m` exactly). Underflow adds at most `24 (m + 1) 2^-1074` absolute
-/// (an underflowed product, amplified by one factor <= m), far below `(m + 1) 2^-1000`.
-/// The bound is itself computed with a relative slack of 2^-20, which covers its own
-/// rounding.
+/// Error bound, per coefficient. Each difference is rounded once (relative error <= u =
+/// 2^-53); a determinant `p . (q x r)` is six products of three such differences with two
+/// rounded multiplications each and five rounded additions, and a coefficient sums three
+/// determinants. The standard forward bound is `gamma_k * P` with `P` the coefficient's
+/// *permanent*, the same sums and products on absolute values (`|p| . (|q| x' |r|)` with the
+/// cross product's subtraction made an addition), `k <= 3 + 2 + 5 + 2 = 12` roundings on
+/// any term: `12.01 u P < 2^-49 P`. The permanent is computed in floats too (round to
+/// nearest, same operation count), so it is itself within `gamma_12` of the true one; the
+/// bound is taken with a relative slack of `2^-20`, which covers that. Underflow adds at
+/// most `24 (m + 1) 2^-1074` absolute (an underflowed product, amplified by one factor
+/// `<= m`, the largest difference), far below `(m + 1) 2^-1000`. A bound relative to each
+/// coefficient's own terms (rather than to `m^3`) certifies the sign of coefficients whose
+/// terms are far smaller than the largest coordinate cubed: coordinates of mixed magnitudes.
 #[inline(always)]
-fn bernstein(d: &Diffs) -> Option<([f64; 4], f64)> {
+fn bernstein(d: &Diffs) -> Option<([f64; 4], [f64; 4])> {
     let mut m = 0.0f64;
     for t in d {
         for v in t {
@@ -189,8 +193,30 @@ fn bernstein(d: &Diffs) -> Option<([f64; 4], f64)> {
     let d011 = dot(p0, &qr11);
     let d111 = dot(p1, &qr11);
     let b = [d000, d100 + d010 + d001, d110 + d101 + d011, d111];
-    let e = m * m * m * (2f64.powi(-45) * (1.0 + 2f64.powi(-20))) + (m + 1.0) * 2f64.powi(-1000);
+    // The permanents, on absolute values.
+    let [[p0, q0, r0], [p1, q1, r1]] = d.map(|t| t.map(|v| v.map(f64::abs)));
+    let (ar00, ar01) = (abs_cross(&q0, &r0), abs_cross(&q0, &r1));
+    let (ar10, ar11) = (abs_cross(&q1, &r0), abs_cross(&q1, &r1));
+    let perm = [
+        dot(&p0, &ar00),
+        dot(&p1, &ar00) + dot(&p0, &ar10) + dot(&p0, &ar01),
+        dot(&p1, &ar10) + dot(&p1, &ar01) + dot(&p0, &ar11),
+        dot(&p1, &ar11),
+    ];
+    let tiny = (m + 1.0) * 2f64.powi(-1000);
+    let e = perm.map(|p| p * (2f64.powi(-49) * (1.0 + 2f64.powi(-20))) + tiny);
     Some((b, e))
+}
+
+/// The cross product's pattern on absolute values: `|a| x' |b|` with every subtraction an
+/// addition (the permanent's inner part).
+#[inline(always)]
+fn abs_cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] + a[2] * b[1],
+        a[2] * b[0] + a[0] * b[2],
+        a[0] * b[1] + a[1] * b[0],
+    ]
 }
 
 /// Interval Bernstein coefficients over a dyadic piece of [0, 1].
@@ -327,7 +353,7 @@ fn decide(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], d: &Diffs, t_max: f64, test: S
     let Some((b, e)) = bernstein(d) else {
         return Verdict::Unknown;
     };
-    if b.iter().all(|&x| x > e) || b.iter().all(|&x| x < -e) {
+    if (0..4).all(|k| b[k] > e[k]) || (0..4).all(|k| b[k] < -e[k]) {
         return Verdict::Miss;
     }
     roots_and_test(x0, x1, b, e, t_max, test)
@@ -337,8 +363,8 @@ fn decide(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], d: &Diffs, t_max: f64, test: S
 /// bisection of a root: a point evaluation and its bound cost a fifth of the interval one.
 struct PointCubic {
     c: [f64; 4],
-    /// Bound on |f(s) - value at s| for every s in [0, 1]: the coefficients' error `e`
-    /// (de Casteljau combinations are convex, so they do not grow it), their rounding (the
+    /// Bound on |f(s) - value at s| for every s in [0, 1]: the coefficients' largest error
+    /// `e` (de Casteljau combinations are convex, so they do not grow it), their rounding (the
     /// division by 3) and the rounding of three levels of `a (1 - s) + b s` (each within
     /// `3u` of the largest magnitude `M`): `e + 2^-48 M` with an absolute `2^-1000` for
     /// underflow. `1 - s` is exact: `s` is a dyadic midpoint of at most 42 bits.
@@ -346,7 +372,8 @@ struct PointCubic {
 }
 
 impl PointCubic {
-    fn new(b: [f64; 4], e: f64) -> Self {
+    fn new(b: [f64; 4], e: [f64; 4]) -> Self {
+        let e = e.iter().fold(0.0f64, |m, &x| m.max(x));
         let c = [b[0], b[1] / 3.0, b[2] / 3.0, b[3]];
         let m = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let err = (e + m * 2f64.powi(-48)) * (1.0 + 2f64.powi(-20)) + 2f64.powi(-1000);
@@ -397,15 +424,15 @@ fn roots_and_test(
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],
     b: [f64; 4],
-    e: f64,
+    e: [f64; 4],
     t_max: f64,
     test: Static,
 ) -> Verdict {
     let c = [
-        Iv::around(b[0], e),
-        Iv::around(b[1], e).div3(),
-        Iv::around(b[2], e).div3(),
-        Iv::around(b[3], e),
+        Iv::around(b[0], e[0]),
+        Iv::around(b[1], e[1]).div3(),
+        Iv::around(b[2], e[2]).div3(),
+        Iv::around(b[3], e[3]),
     ];
     let mut found = [RootIv {
         s0: 0.0,

@@ -206,14 +206,59 @@ fn all_finite(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> bool {
 /// Assumes validated input ([`CcdOptions::new`], [`check_points`]); for invalid input it
 /// returns `None` (and panics in debug builds).
 pub fn vertex_face(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], options: &CcdOptions) -> Option<f64> {
-    query(exact::Kind::VertexFace, x0, x1, options)
+    query(exact::Kind::VertexFace, x0, x1, options, &|| false).unwrap_or(None)
 }
 
 /// Edge-edge CCD: `x0 = [a0, a1, b0, b1]` at t = 0 and `x1` at t = 1. `Some(toi)` iff the
 /// closed segments meet (or come within `min_distance`) at some t in `[0, t_max]`, with
 /// the same time bound as [`vertex_face`].
 pub fn edge_edge(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], options: &CcdOptions) -> Option<f64> {
-    query(exact::Kind::EdgeEdge, x0, x1, options)
+    query(exact::Kind::EdgeEdge, x0, x1, options, &|| false).unwrap_or(None)
+}
+
+/// [`try_vertex_face`] that can be stopped: `stop` is asked between the steps of the exact
+/// path (the rare queries it decides can take up to seconds, `docs/LIMITS.md` in the
+/// repository), and `true` ends the query with [`Error::Cancelled`].
+pub fn vertex_face_until(
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    stop: &dyn Fn() -> bool,
+) -> Result<Option<f64>> {
+    options.validate()?;
+    check_points(x0, x1)?;
+    query(exact::Kind::VertexFace, x0, x1, options, stop).map_err(|_| Error::Cancelled)
+}
+
+/// [`try_edge_edge`] that can be stopped, as [`vertex_face_until`].
+pub fn edge_edge_until(
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    stop: &dyn Fn() -> bool,
+) -> Result<Option<f64>> {
+    options.validate()?;
+    check_points(x0, x1)?;
+    query(exact::Kind::EdgeEdge, x0, x1, options, stop).map_err(|_| Error::Cancelled)
+}
+
+/// The query of one pair that the whole-mesh CCD walk runs: as [`vertex_face`] or
+/// [`edge_edge`], with `stop` asked between the steps of the exact path (`Err` once it
+/// said stop).
+#[inline(always)]
+pub(crate) fn pair_until(
+    vf: bool,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    stop: &dyn Fn() -> bool,
+) -> std::result::Result<Option<f64>, exact::Stopped> {
+    let kind = if vf {
+        exact::Kind::VertexFace
+    } else {
+        exact::Kind::EdgeEdge
+    };
+    query(kind, x0, x1, options, stop)
 }
 
 /// [`vertex_face`] with its input checked: a typed error instead of an assumption.
@@ -244,17 +289,25 @@ fn query(
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],
     options: &CcdOptions,
-) -> Option<f64> {
+    stop: exact::Stop<'_>,
+) -> std::result::Result<Option<f64>, exact::Stopped> {
     let valid = options.is_valid() && all_finite(x0, x1);
     debug_assert!(valid, "invalid CCD input: {options:?} {x0:?} {x1:?}");
     if !valid {
-        return None;
+        return Ok(None);
     }
-    let delta = options.min_distance;
+    // One power-of-two scaling (when it is exact) brings the largest coordinate near 1:
+    // contacts and times do not change, and the float filters never overflow or drown in
+    // their underflow terms.
+    let unit = to_unit_scale(x0, x1, options.min_distance);
+    let (x0, x1, delta) = match &unit {
+        Some((y0, y1, d)) => (y0, y1, *d),
+        None => (x0, x1, options.min_distance),
+    };
     // A time limit below 1 (the earliest-time mode's pruning): the boxes over [0, t_max]
     // first, which are far smaller than over the whole step when t_max is small.
     if options.t_max < 1.0 && filter::boxes_apart_until(kind, x0, x1, options.t_max, delta) {
-        return None;
+        return Ok(None);
     }
     if delta == 0.0 {
         let verdict = match kind {
@@ -262,10 +315,10 @@ fn query(
             exact::Kind::EdgeEdge => filter::edge_edge(x0, x1, options.t_max),
         };
         match verdict {
-            filter::Verdict::Miss => None,
-            filter::Verdict::Hit(t) => Some(t),
-            filter::Verdict::Refine(lo, hi) => Some(exact::refine_root(x0, x1, lo, hi)),
-            filter::Verdict::Unknown => exact::solve(kind, x0, x1, options.t_max, 0.0),
+            filter::Verdict::Miss => Ok(None),
+            filter::Verdict::Hit(t) => Ok(Some(t)),
+            filter::Verdict::Refine(lo, hi) => exact::refine_root(x0, x1, lo, hi, stop).map(Some),
+            filter::Verdict::Unknown => exact::solve(kind, x0, x1, options.t_max, 0.0, stop),
         }
     } else {
         let apart = match kind {
@@ -273,15 +326,63 @@ fn query(
             exact::Kind::EdgeEdge => filter::ee_boxes_apart(x0, x1, delta),
         };
         if apart {
-            return None;
+            return Ok(None);
         }
         let vf = kind == exact::Kind::VertexFace;
         match near::decide(vf, x0, x1, options.t_max, delta) {
-            filter::Verdict::Miss => None,
-            filter::Verdict::Hit(t) => Some(t),
-            _ => exact::solve(kind, x0, x1, options.t_max, delta),
+            filter::Verdict::Miss => Ok(None),
+            filter::Verdict::Hit(t) => Ok(Some(t)),
+            _ => exact::solve(kind, x0, x1, options.t_max, delta, stop),
         }
     }
+}
+
+/// `x` times `2^k`, computed in at most two exact steps, if the result is exact.
+fn scaled_exactly(x: f64, k: i32) -> Option<f64> {
+    let step = |x: f64, k: i32| x * f64::from_bits(((1023 + k) as u64) << 52);
+    let (k1, k2) = (k / 2, k - k / 2);
+    let y = step(step(x, k1), k2);
+    // Exact iff scaling back gives `x` (scaling up never loses bits short of overflow, which
+    // the range of `k` rules out; scaling down loses only bits shifted below 2^-1074).
+    (y.is_finite() && step(step(y, -k1), -k2) == x).then_some(y)
+}
+
+/// The query scaled by one power of two so that its largest coordinate magnitude is in
+/// `[1, 2)`, when every coordinate and `delta` scale exactly (none loses bits below the
+/// smallest subnormal); `None` when already there, all zero, or not exact.
+#[allow(clippy::type_complexity)]
+fn to_unit_scale(
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    delta: f64,
+) -> Option<([[f64; 3]; 4], [[f64; 3]; 4], f64)> {
+    let m = x0
+        .iter()
+        .chain(x1)
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    if m == 0.0 {
+        return None;
+    }
+    // The binary exponent of m (subnormals included).
+    let e = if m >= f64::MIN_POSITIVE {
+        ((m.to_bits() >> 52) as i32) - 1023
+    } else {
+        -1074 + (63 - m.to_bits().leading_zeros() as i32)
+    };
+    let k = -e;
+    if k == 0 {
+        return None;
+    }
+    let mut y0 = [[0.0; 3]; 4];
+    let mut y1 = [[0.0; 3]; 4];
+    for i in 0..4 {
+        for j in 0..3 {
+            y0[i][j] = scaled_exactly(x0[i][j], k)?;
+            y1[i][j] = scaled_exactly(x1[i][j], k)?;
+        }
+    }
+    Some((y0, y1, scaled_exactly(delta, k)?))
 }
 
 /// The exact path alone, without the float filter (slow; for tests and comparisons).
@@ -299,7 +400,9 @@ pub fn vertex_face_exact(
         x1,
         options.t_max,
         options.min_distance,
+        &|| false,
     )
+    .unwrap_or(None)
 }
 
 /// The exact path alone for edge-edge.
@@ -317,5 +420,7 @@ pub fn edge_edge_exact(
         x1,
         options.t_max,
         options.min_distance,
+        &|| false,
     )
+    .unwrap_or(None)
 }

@@ -123,7 +123,7 @@ pub(crate) fn decide(
                 let t = (lo + k as f64 * PROBE_STEP).min(t_max);
                 within(vf, &at(t), delta)
             });
-            return if within {
+            return if within || touches_by(vf, x0, x1, t_max, lo + TOUCH_SLACK) {
                 Verdict::Hit(lo)
             } else {
                 Verdict::Unknown
@@ -134,6 +134,29 @@ pub(crate) fn decide(
         n += 2;
     }
     Verdict::Miss
+}
+
+/// How far after the first piece not apart (`lo`) the delta-0 filter's contact time may lie
+/// for [`touches_by`] to place the earliest time within `delta` in `[lo, lo + 2^-40 +
+/// 2^-44]` (below [`super::TOI_TOLERANCE`]).
+const TOUCH_SLACK: f64 = 1.0 / (1u64 << 44) as f64;
+
+/// The features certainly touch (distance 0, so within any `delta`) at some time `<= by +
+/// 2^-40`: the delta-0 float filter finds a contact at a time it places at most `2^-40`
+/// before the true one, and no later than `by`. A `delta` too small to certify "within" in
+/// floats (`5e-324` next to unit coordinates) is then decided by the contact itself.
+fn touches_by(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64, by: f64) -> bool {
+    let verdict = if vf {
+        super::filter::vertex_face(x0, x1, t_max)
+    } else {
+        super::filter::edge_edge(x0, x1, t_max)
+    };
+    match verdict {
+        Verdict::Hit(t) => t <= by,
+        // A contact somewhere in (lo, hi).
+        Verdict::Refine(_, hi) => hi <= by + super::filter::ROOT_WIDTH,
+        _ => false,
+    }
 }
 
 /// The boxes of the two features (vertex | triangle, or edge | edge) over the piece, more

@@ -422,6 +422,7 @@ pub(crate) fn run<K: BoundingVolume>(
     let mut out = w.out;
     if query.mode == CcdMode::Earliest {
         q.settle_earliest(&mut out);
+        budget.finish()?;
     }
     out.vertex_face
         .sort_unstable_by_key(|x| (u64::from(x.vertex) << 32) | u64::from(x.triangle));
@@ -508,6 +509,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     fn settle_earliest(&self, out: &mut ImpactOut) {
         let best = out.least_toi().unwrap_or(f64::INFINITY);
         let near = |toi: f64| toi <= best + PRUNE_SLACK;
+        let stop = || self.budget.poll();
         let (a, b) = (self.a, self.b);
         let o = &self.options;
         // Original -> internal indices of each side.
@@ -520,7 +522,14 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             } else {
                 (b, a, vb, ta)
             };
-            vertex_face_toi(sv, iv[v as usize] as usize, st, it[t as usize] as usize, o)
+            vertex_face_toi(
+                sv,
+                iv[v as usize] as usize,
+                st,
+                it[t as usize] as usize,
+                o,
+                &stop,
+            )
         };
         let mut vertex_face: Vec<VertexImpact> = Vec::new();
         for x in out.vertex_face.iter().filter(|x| near(x.toi)) {
@@ -539,7 +548,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             // Pair queries: `a` is the first mesh's; self queries: both are one mesh's.
             let pa = x.a.map(|v| a.step_at(va[v as usize] as usize));
             let pb = x.b.map(|v| b.step_at(vb[v as usize] as usize));
-            if let Some(toi) = edge_edge_toi(pa, pb, o) {
+            if let Some(toi) = edge_edge_toi(pa, pb, o, &stop) {
                 edge_edge.push(EdgeImpact { toi, ..*x });
             }
         }
@@ -582,6 +591,7 @@ fn vertex_face_toi<K: BoundingVolume>(
     st: &Swept<'_, K>,
     t: usize,
     options: &CcdOptions,
+    stop: &dyn Fn() -> bool,
 ) -> Option<f64> {
     let c = st.tree().triangles()[t].map(|c| c as usize);
     let x0 = [
@@ -596,7 +606,8 @@ fn vertex_face_toi<K: BoundingVolume>(
         st.step.x1[c[1]],
         st.step.x1[c[2]],
     ];
-    ccd::vertex_face(&x0, &x1, options)
+    // Stopped: no answer; the budget has stopped the query, which returns the error.
+    ccd::pair_until(true, &x0, &x1, options, stop).unwrap_or(None)
 }
 
 /// The exact edge-edge test of two edges given as their endpoints at t0 and t1.
@@ -605,10 +616,11 @@ fn edge_edge_toi(
     a: [([f64; 3], [f64; 3]); 2],
     b: [([f64; 3], [f64; 3]); 2],
     options: &CcdOptions,
+    stop: &dyn Fn() -> bool,
 ) -> Option<f64> {
     let x0 = [a[0].0, a[1].0, b[0].0, b[1].0];
     let x1 = [a[0].1, a[1].1, b[0].1, b[1].1];
-    ccd::edge_edge(&x0, &x1, options)
+    ccd::pair_until(false, &x0, &x1, options, stop).unwrap_or(None)
 }
 
 impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
@@ -760,7 +772,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                         continue;
                     }
                     counters.prim_tests += 1;
-                    if let Some(toi) = vertex_face_toi(sv, v, st, t, &self.options_now()) {
+                    let stop = || self.budget.poll();
+                    if let Some(toi) = vertex_face_toi(sv, v, st, t, &self.options_now(), &stop) {
                         self.found(toi);
                         emit(v, t, toi);
                     }
@@ -823,7 +836,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                         } else {
                             (a_ids, b_ids, pa, pb)
                         };
-                        if let Some(toi) = edge_edge_toi(px, py, &self.options_now()) {
+                        let stop = || self.budget.poll();
+                        if let Some(toi) = edge_edge_toi(px, py, &self.options_now(), &stop) {
                             self.found(toi);
                             self.budget.push(
                                 out,
