@@ -56,7 +56,7 @@ fn gadget(state: &mut u64, values: &[f64]) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
 
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
-    let count = if quick { 200 } else { 2000 };
+    let count = if quick { 40 } else { 400 };
     println!(
         "{:<46} {:>11} {:>10} {:>7} {:>9} {:>9} {:>9}",
         "family", "kind", "delta", "hits", "median", "p99", "max"

@@ -129,6 +129,32 @@
 #define DHCD_ERR_PRECISION -10
 
 /**
+ * A query would return more result pairs than its limit (`dhcd_hierarchy_set_control`,
+ * `dhcd_scene_set_control`); the message names the count reached and the limit.
+ */
+#define DHCD_ERR_OUTPUT_LIMIT -11
+
+/**
+ * A result buffer could not be allocated.
+ */
+#define DHCD_ERR_OUT_OF_MEMORY -12
+
+/**
+ * The query was stopped by its cancel token or poll callback.
+ */
+#define DHCD_ERR_CANCELLED -13
+
+/**
+ * The default limit on the result pairs of one query (2^25).
+ */
+#define DHCD_DEFAULT_MAX_PAIRS (1 << 25)
+
+/**
+ * No limit on result pairs.
+ */
+#define DHCD_NO_LIMIT UINT64_MAX
+
+/**
  * `dhcd_hierarchy_precision` of a hierarchy built from `float` positions.
  */
 #define DHCD_PRECISION_F32 32
@@ -137,6 +163,13 @@
  * `dhcd_hierarchy_precision` of a hierarchy built from `double` positions.
  */
 #define DHCD_PRECISION_F64 64
+
+/**
+ * Opaque: a cancel token. `dhcd_cancel_set` (from any thread) stops every query of the
+ * hierarchies and scenes it is given to, which then return `DHCD_ERR_CANCELLED`, until
+ * `dhcd_cancel_reset`.
+ */
+typedef struct DhcdCancel DhcdCancel;
 
 /**
  * Opaque: one object's hierarchy (and its query scratch).
@@ -507,6 +540,14 @@ typedef struct DhcdSceneImpacts {
   struct DhcdCounters counters;
 } DhcdSceneImpacts;
 
+/**
+ * A poll callback: called by the threads doing a query's work, once every 64 leaf pairs
+ * each and between the steps of the exact CCD path; non-zero stops the query
+ * (`DHCD_ERR_CANCELLED`). It may be called from several threads at once when
+ * `threads != 1`, and must be cheap (read a clock first).
+ */
+typedef int (*DhcdPoll)(void *user);
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -702,8 +743,8 @@ void dhcd_proximity_free(struct DhcdProximity *p);
  * `DHCD_ERR_INVALID_MESH`; another vertex count: `DHCD_ERR_LENGTH_MISMATCH`); the pairs
  * found depend on `x0` and `x1` alone, and the hierarchy's pose is not changed. `t_max` in
  * `[0, 1]`; pairs collide when they come within `min_distance` (finite, `>= 0`; 0: when
- * they touch). `earliest` non-zero: only the earliest time of impact and the pairs
- * reaching it (what a line search asks; pairs are tested only up to the best time found so
+ * they touch). `earliest` non-zero: only the earliest time of impact and every pair
+ * whose own time is within 1e-12 of it (what a line search asks; every exact tie is there; pairs are tested only up to the best time found so
  * far), else every colliding pair. Decided exactly for the doubles; times of impact never
  * later than the first contact and at most 1e-12 earlier. The result does not depend on
  * `threads` (the work counters of earliest mode may).
@@ -975,7 +1016,7 @@ void dhcd_scene_proximity_free(struct DhcdSceneProximity *p);
  * come within `min_distance`, and every object with self-collision on, is queried as by
  * `dhcd_ccd` / `dhcd_self_ccd`, into `*out` (see `DhcdSceneImpacts`; release with
  * `dhcd_scene_impacts_free`). `earliest` non-zero: only the earliest time of impact over
- * the scene and the pairs reaching it. Everything is checked before any work: an unknown
+ * the scene and every pair whose own time is within 1e-12 of it. Everything is checked before any work: an unknown
  * id (`DHCD_ERR_UNKNOWN_OBJECT`), an id given twice (`DHCD_ERR_REPEATED_OBJECT`), a bad
  * `t_max` or `min_distance` (`DHCD_ERR_INVALID_ARGUMENT`), a wrong vertex count
  * (`DHCD_ERR_LENGTH_MISMATCH`), a non-finite coordinate (`DHCD_ERR_INVALID_MESH`). The
@@ -1007,6 +1048,70 @@ int dhcd_scene_ccd(struct DhcdScene *s,
  * `p` null or a `DhcdSceneImpacts` filled by this library and not modified since.
  */
 void dhcd_scene_impacts_free(struct DhcdSceneImpacts *p);
+
+/**
+ * A new cancel token, not set, into `*out` (release with `dhcd_cancel_free`).
+ *
+ * # Safety
+ * `out` null or valid for a write.
+ */
+int dhcd_cancel_new(struct DhcdCancel **out);
+
+/**
+ * Sets the token: the queries using it stop (from any thread, at any time).
+ *
+ * # Safety
+ * `c` null or a live token.
+ */
+int dhcd_cancel_set(const struct DhcdCancel *c);
+
+/**
+ * Clears the token: later queries run again.
+ *
+ * # Safety
+ * `c` null or a live token.
+ */
+int dhcd_cancel_reset(const struct DhcdCancel *c);
+
+/**
+ * Releases a token (the hierarchies and scenes given it keep their own reference). Null is
+ * a no-op.
+ *
+ * # Safety
+ * `c` null or a token from `dhcd_cancel_new` not yet released.
+ */
+void dhcd_cancel_free(struct DhcdCancel *c);
+
+/**
+ * Sets the limits and cancellation of the hierarchy's proximity and CCD queries (those
+ * with it first): at most `max_pairs` result pairs (`DHCD_DEFAULT_MAX_PAIRS` by default,
+ * `DHCD_NO_LIMIT` for none; more is `DHCD_ERR_OUTPUT_LIMIT`), stopped by `cancel` (null:
+ * none) or by `poll` returning non-zero (null: none; called with `user`, possibly from
+ * several threads at once: it must be thread-safe). A stopped query returns
+ * `DHCD_ERR_CANCELLED` and an empty result.
+ *
+ * # Safety
+ * `h` null or a live handle; `cancel` null or a live token; `poll` null or a function safe
+ * to call with `user` from any thread for as long as the hierarchy lives.
+ */
+int dhcd_hierarchy_set_control(struct DhcdHierarchy *h,
+                               uint64_t max_pairs,
+                               const struct DhcdCancel *cancel,
+                               DhcdPoll poll,
+                               void *user);
+
+/**
+ * `dhcd_hierarchy_set_control` for a scene's proximity and CCD queries (the limit counts
+ * the pairs of every object pair together).
+ *
+ * # Safety
+ * As `dhcd_hierarchy_set_control`, for a scene handle.
+ */
+int dhcd_scene_set_control(struct DhcdScene *s,
+                           uint64_t max_pairs,
+                           const struct DhcdCancel *cancel,
+                           DhcdPoll poll,
+                           void *user);
 
 #ifdef __cplusplus
 }  // extern "C"

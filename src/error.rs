@@ -47,20 +47,32 @@ pub enum Error {
         corners: [u32; 3],
     },
     /// A NaN or infinite coordinate.
-    #[error("vertex {vertex} has a non-finite coordinate {position:?}")]
+    #[error("vertex {vertex} of {of}{} has a non-finite coordinate {position:?}", in_object(.object))]
     NonFinite {
         /// The vertex (index in the input).
         vertex: usize,
         /// Its coordinates.
         position: [f64; 3],
+        /// Which positions: a mesh's, an update, the start or the end of a step.
+        of: Positions,
+        /// The scene object they belong to, in a scene call.
+        object: Option<u64>,
     },
     /// An `f64` coordinate too large to round to a finite `f32` (bounding volumes are `f32`).
-    #[error("vertex {vertex} has a coordinate beyond the f32 range {position:?} (|x| must be below about 3.4e38)")]
+    #[error(
+        "vertex {vertex} of {of}{} has a coordinate beyond the f32 range {position:?} (|x| \
+         must be below about 3.4e38)",
+        in_object(.object)
+    )]
     OutOfRange {
         /// The vertex (index in the input).
         vertex: usize,
         /// Its coordinates.
         position: [f64; 3],
+        /// Which positions.
+        of: Positions,
+        /// The scene object they belong to, in a scene call.
+        object: Option<u64>,
     },
     /// Positions of one precision given to a mesh or hierarchy of the other: an `f32`
     /// update of an `f64` hierarchy would silently round it.
@@ -71,13 +83,18 @@ pub enum Error {
         /// The precision of the positions given.
         got: Precision,
     },
-    /// A position update whose length is not the mesh's vertex count.
-    #[error("position update has {got} vertices, but the mesh has {expected}")]
+    /// Positions (an update, or the start or end of a step) whose length is not the mesh's
+    /// vertex count.
+    #[error("{of}{} has {got} vertices, but the mesh has {expected}", in_object(.object))]
     WrongVertexCount {
         /// The mesh's number of vertices.
         expected: usize,
         /// The number given.
         got: usize,
+        /// Which positions.
+        of: Positions,
+        /// The scene object they belong to, in a scene call.
+        object: Option<u64>,
     },
     /// A region tree depth outside `1..=max` ([`tree::MAX_LEVELS`](crate::tree::MAX_LEVELS)).
     #[error("levels must be between 1 and {max}, got {got}")]
@@ -128,7 +145,7 @@ pub enum Error {
     #[error("unknown precision {0:?} (expected f32 or f64)")]
     UnknownPrecision(String),
     /// A query distance that is negative, NaN or infinite.
-    #[error("distance {0} is not a finite number >= 0")]
+    #[error("distance {} is not a finite number >= 0", Num(*.0))]
     InvalidDistance(f64),
     /// A node id (e.g. given to `refit_nodes`) beyond the hierarchy's nodes.
     #[error("node {node} out of range (the hierarchy has {node_count} nodes)")]
@@ -188,10 +205,10 @@ pub enum Error {
         cores: usize,
     },
     /// A CCD time limit outside [0, 1] (or NaN).
-    #[error("CCD t_max must be in [0, 1], got {0}")]
+    #[error("CCD t_max must be in [0, 1], got {}", Num(*.0))]
     InvalidTimeLimit(f64),
     /// A CCD minimum distance that is negative, infinite or NaN.
-    #[error("CCD min_distance must be finite and >= 0, got {0}")]
+    #[error("CCD min_distance must be finite and >= 0, got {}", Num(*.0))]
     InvalidMinDistance(f64),
     /// A CCD query point with a NaN or infinite coordinate (`point` 0-3 at t = 0, 4-7 at
     /// t = 1, in the order of the query).
@@ -244,12 +261,13 @@ pub enum Error {
         /// The limit in bytes.
         limit: u64,
     },
-    /// A malformed mesh file: the line (1-based; 0 for binary files) and what is wrong.
-    #[error("{}:{line}: {}", escaped_path(.path), escaped(.message))]
+    /// A malformed mesh file: the line (1-based; 0 for binary files and for what concerns
+    /// the whole file, which the message then does not cite) and what is wrong.
+    #[error("{}{}: {}", escaped_path(.path), at_line(*.line), escaped(.message))]
     Parse {
         /// The file.
         path: PathBuf,
-        /// The line (1-based; 0 for binary files).
+        /// The line (1-based; 0 for binary files and for the whole file).
         line: usize,
         /// What is wrong.
         message: String,
@@ -258,6 +276,72 @@ pub enum Error {
 
 /// `Result` with this crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Which positions an error is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Positions {
+    /// A mesh's own positions (at construction).
+    Mesh,
+    /// A position update of a hierarchy or scene object.
+    Update,
+    /// The positions at the start of a step (`x0`, t = 0).
+    Start,
+    /// The positions at the end of a step (`x1`, t = 1).
+    End,
+}
+
+impl std::fmt::Display for Positions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Positions::Mesh => "the mesh",
+            Positions::Update => "the position update",
+            Positions::Start => "x0 (the positions at t = 0)",
+            Positions::End => "x1 (the positions at t = 1)",
+        })
+    }
+}
+
+/// ":N" for a line of a text file, nothing for line 0 (the whole file, or a binary one).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
+}
+
+/// " of object N" for an error in a scene call, else nothing.
+fn in_object(object: &Option<u64>) -> String {
+    object.map_or_else(String::new, |id| format!(" of object {id}"))
+}
+
+/// A number in messages: the shortest text that reads back as the same `f64`, with an
+/// exponent for very large or small magnitudes (`1e-300`, not 300 digits).
+pub(crate) struct Num(pub(crate) f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // `Debug` of an f64 is the shortest round-trip text, with an exponent outside
+        // 1e-5..1e16.
+        write!(f, "{:?}", self.0)
+    }
+}
+
+impl Error {
+    /// The error with the scene object it concerns (for errors about an object's
+    /// positions); other errors unchanged.
+    #[doc(hidden)]
+    pub fn in_object(mut self, id: u64) -> Self {
+        if let Error::NonFinite { object, .. }
+        | Error::OutOfRange { object, .. }
+        | Error::WrongVertexCount { object, .. } = &mut self
+        {
+            *object = Some(id);
+        }
+        self
+    }
+}
 
 /// `text` with every control character (newlines and NUL included) and line separator
 /// written as an escape (`\n`, `\0`, `\u{1b}`), so that a message that echoes a path or a

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::bv::{BoundingVolume, Method};
-use crate::error::{Error, Result};
+use crate::error::{Error, Positions, Result};
 use crate::mesh::{check_positions, check_positions_f64, Mesh};
 use crate::options::{Options, Refit};
 use crate::par::Par;
@@ -211,7 +211,7 @@ impl<K: BoundingVolume> Hierarchy<K> {
     /// [`Hierarchy::update_positions_f64`].
     pub fn update_positions(&mut self, positions: &[[f32; 3]]) -> Result<u64> {
         self.check_precision(Precision::F32)?;
-        check_positions(positions, self.tree.vertex_total())?;
+        check_positions(positions, self.tree.vertex_total(), Positions::Update)?;
         Ok(self.apply_positions(positions))
     }
 
@@ -221,7 +221,7 @@ impl<K: BoundingVolume> Hierarchy<K> {
     /// ([`Error::PrecisionMismatch`]).
     pub fn update_positions_f64(&mut self, positions: &[[f64; 3]]) -> Result<u64> {
         self.check_precision(Precision::F64)?;
-        check_positions_f64(positions, self.tree.vertex_total())?;
+        check_positions_f64(positions, self.tree.vertex_total(), Positions::Update)?;
         Ok(self.apply_positions_f64(positions))
     }
 
@@ -237,7 +237,9 @@ impl<K: BoundingVolume> Hierarchy<K> {
     /// [`Hierarchy::update_positions`] of positions the caller has checked
     /// ([`check_positions`] against [`RegionTree::vertex_total`], an `f32` hierarchy).
     pub(crate) fn apply_positions(&mut self, positions: &[[f32; 3]]) -> u64 {
-        debug_assert!(check_positions(positions, self.tree.vertex_total()).is_ok());
+        debug_assert!(
+            check_positions(positions, self.tree.vertex_total(), Positions::Update).is_ok()
+        );
         debug_assert!(self.exact.is_none());
         self.points.gather_from(positions, self.tree.vert_order());
         self.refit_after_update()
@@ -245,7 +247,9 @@ impl<K: BoundingVolume> Hierarchy<K> {
 
     /// [`Hierarchy::update_positions_f64`] of positions the caller has checked.
     pub(crate) fn apply_positions_f64(&mut self, positions: &[[f64; 3]]) -> u64 {
-        debug_assert!(check_positions_f64(positions, self.tree.vertex_total()).is_ok());
+        debug_assert!(
+            check_positions_f64(positions, self.tree.vertex_total(), Positions::Update).is_ok()
+        );
         let order = self.tree.vert_order();
         self.points.gather_rounded_from(positions, order);
         if let Some(exact) = &mut self.exact {

@@ -70,7 +70,7 @@ pub use any::AnyHierarchy;
 pub use bv::Method;
 pub use control::{Control, DEFAULT_MAX_PAIRS};
 pub use counters::Counters;
-pub use error::{Error, Result};
+pub use error::{Error, Positions, Result};
 pub use hierarchy::{Hierarchy, InvariantError};
 pub use mesh::Mesh;
 pub use options::{CentralVertex, Options, Refit};

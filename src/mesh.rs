@@ -1,6 +1,6 @@
 //! Validated triangle meshes.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Positions, Result};
 use crate::precision::Precision;
 
 impl std::str::FromStr for Precision {
@@ -34,7 +34,7 @@ pub struct Mesh {
 impl Mesh {
     /// Validates and wraps `positions` and `triangles` (an [`Precision::F32`] mesh).
     pub fn new(positions: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>) -> Result<Self> {
-        check_finite(&positions)?;
+        check_finite(&positions, Positions::Mesh)?;
         Self::checked(positions, None, triangles)
     }
 
@@ -43,7 +43,7 @@ impl Mesh {
     /// (magnitude below about `3.4e38`, [`Error::OutOfRange`]), since the bounding volumes
     /// are `f32` records.
     pub fn new_f64(positions: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Result<Self> {
-        check_finite_f64(&positions)?;
+        check_finite_f64(&positions, Positions::Mesh)?;
         let rounded = round_to_f32(&positions);
         Self::checked(rounded, Some(positions), triangles)
     }
@@ -146,7 +146,7 @@ impl Mesh {
                 got: Precision::F32,
             });
         }
-        check_positions(positions, self.positions.len())?;
+        check_positions(positions, self.positions.len(), Positions::Update)?;
         self.positions.copy_from_slice(positions);
         Ok(())
     }
@@ -161,7 +161,7 @@ impl Mesh {
                 got: Precision::F64,
             });
         };
-        check_positions_f64(positions, exact.len())?;
+        check_positions_f64(positions, exact.len(), Positions::Update)?;
         exact.copy_from_slice(positions);
         self.positions = round_to_f32(positions);
         Ok(())
@@ -180,18 +180,21 @@ impl Mesh {
     }
 }
 
-/// Checks a position update: `expected` vertices, all coordinates finite.
-pub fn check_positions(positions: &[[f32; 3]], expected: usize) -> Result<()> {
+/// Checks positions (`of`: an update, the start or end of a step): `expected` vertices, all
+/// coordinates finite.
+pub fn check_positions(positions: &[[f32; 3]], expected: usize, of: Positions) -> Result<()> {
     if positions.len() != expected {
         return Err(Error::WrongVertexCount {
             expected,
             got: positions.len(),
+            of,
+            object: None,
         });
     }
-    check_finite(positions)
+    check_finite(positions, of)
 }
 
-fn check_finite(positions: &[[f32; 3]]) -> Result<()> {
+fn check_finite(positions: &[[f32; 3]], of: Positions) -> Result<()> {
     // PERF: one branch per chunk of coordinates, the chunk folded without one (it vectorizes;
     // the per-vertex `all` was ~3% of a small scene's step); the error path finds the first
     // culprit.
@@ -209,23 +212,27 @@ fn check_finite(positions: &[[f32; 3]]) -> Result<()> {
     Err(Error::NonFinite {
         vertex,
         position: positions[vertex].map(f64::from),
+        of,
+        object: None,
     })
 }
 
-/// Checks an `f64` position update: `expected` vertices, every coordinate finite and within
-/// the `f32` range ([`Mesh::new_f64`]).
-pub fn check_positions_f64(positions: &[[f64; 3]], expected: usize) -> Result<()> {
+/// Checks `f64` positions (`of`: an update, the start or end of a step): `expected`
+/// vertices, every coordinate finite and within the `f32` range ([`Mesh::new_f64`]).
+pub fn check_positions_f64(positions: &[[f64; 3]], expected: usize, of: Positions) -> Result<()> {
     if positions.len() != expected {
         return Err(Error::WrongVertexCount {
             expected,
             got: positions.len(),
+            of,
+            object: None,
         });
     }
-    check_finite_f64(positions)
+    check_finite_f64(positions, of)
 }
 
 /// Every coordinate finite, and finite once rounded to `f32`.
-fn check_finite_f64(positions: &[[f64; 3]]) -> Result<()> {
+fn check_finite_f64(positions: &[[f64; 3]], of: Positions) -> Result<()> {
     // As `check_finite`: one branch per chunk. `|x| <= F32_LIMIT` is false for NaN and
     // infinities too.
     if positions
@@ -241,9 +248,19 @@ fn check_finite_f64(positions: &[[f64; 3]]) -> Result<()> {
         .expect("a bad vertex exists");
     let position = positions[vertex];
     Err(if position.iter().all(|x| x.is_finite()) {
-        Error::OutOfRange { vertex, position }
+        Error::OutOfRange {
+            vertex,
+            position,
+            of,
+            object: None,
+        }
     } else {
-        Error::NonFinite { vertex, position }
+        Error::NonFinite {
+            vertex,
+            position,
+            of,
+            object: None,
+        }
     })
 }
 

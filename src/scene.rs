@@ -27,7 +27,7 @@ use crate::bv::swept::{box_over_step, f32_up, Step};
 use crate::bv::{BoundingVolume, Method};
 use crate::control::{Budget, Control};
 use crate::counters::Counters;
-use crate::error::{Error, Result};
+use crate::error::{Error, Positions, Result};
 use crate::hierarchy::Hierarchy;
 use crate::mesh::{check_positions, Mesh};
 use crate::methods::{match_method, methods, with_method};
@@ -301,7 +301,7 @@ impl Scene {
     pub fn update_positions(&mut self, id: ObjectId, positions: &[[f32; 3]]) -> Result<()> {
         let i = self.index(id)?;
         each!(&mut self.objects, v => {
-            v[i].refitted += v[i].h.update_positions(positions)?;
+            v[i].refitted += v[i].h.update_positions(positions).map_err(|e| e.in_object(id.0))?;
             v[i].refresh_bounds();
         });
         Ok(())
@@ -312,7 +312,10 @@ impl Scene {
     pub fn update_positions_f64(&mut self, id: ObjectId, positions: &[[f64; 3]]) -> Result<()> {
         let i = self.index(id)?;
         each!(&mut self.objects, v => {
-            v[i].refitted += v[i].h.update_positions_f64(positions)?;
+            v[i].refitted += v[i]
+                .h
+                .update_positions_f64(positions)
+                .map_err(|e| e.in_object(id.0))?;
             v[i].refresh_bounds();
         });
         Ok(())
@@ -588,7 +591,8 @@ fn update_objects<K: BoundingVolume>(
             expected: o.h.precision(),
             got: Precision::F32,
         }),
-        Some(p) => check_positions(p, o.h.tree().vertex_total()),
+        Some(p) => check_positions(p, o.h.tree().vertex_total(), Positions::Update)
+            .map_err(|e| e.in_object(o.id)),
         None => Ok(()),
     };
     map_objects(objects.len(), parallel, |i| check((&objects[i], &slot[i])))
@@ -783,7 +787,7 @@ fn ccd_of<K: BoundingVolume>(
         let Some(motion) = motions[i] else {
             return Ok((None, o.bounds));
         };
-        let step = checked_step(o.h.tree(), motion)?;
+        let step = checked_step(o.h.tree(), motion).map_err(|e| e.in_object(o.id))?;
         let b = box_over_step(o.h.tree(), &step, 0);
         Ok((Some(step), [[b[0], b[1], b[2]], [b[3], b[4], b[5]]]))
     })

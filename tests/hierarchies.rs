@@ -382,7 +382,9 @@ fn bad_update_is_an_error_and_changes_nothing() {
             ha.update_positions(&a.positions()[..n - 1]),
             Err(Error::WrongVertexCount {
                 expected: n,
-                got: n - 1
+                got: n - 1,
+                of: dhcd::Positions::Update,
+                object: None,
             })
         );
         let mut nan = a.positions().to_vec();

@@ -5,6 +5,7 @@ use dhcd::calibration::Calibration;
 use dhcd::narrow::{brute_force_pairs, brute_force_self_pairs, intersection_segment};
 use dhcd::scene::{ObjectId, Scene, SceneContacts};
 use dhcd::shapes::{grid, icosphere, wave};
+use dhcd::Positions;
 use dhcd::{AnyHierarchy, Counters, Error, Mesh, Method, Options, Par, Refit, Workspace};
 
 /// The brute-force contacts of objects `(id, mesh in its current pose, self-collision)`.
@@ -464,6 +465,8 @@ fn update_many_checks_everything_before_changing_anything() {
                 Error::WrongVertexCount {
                     expected: moved.len(),
                     got: moved.len() - 1,
+                    of: Positions::Update,
+                    object: Some(b.0),
                 },
             ),
             (
@@ -471,11 +474,22 @@ fn update_many_checks_everything_before_changing_anything() {
                 Error::NonFinite {
                     vertex: 3,
                     position: nan[3].map(f64::from),
+                    of: Positions::Update,
+                    object: Some(b.0),
                 },
             ),
         ];
         for (updates, error) in cases {
             let got = scene.update_many(updates, par).unwrap_err();
+            if matches!(
+                got,
+                Error::NonFinite { .. } | Error::WrongVertexCount { .. }
+            ) {
+                assert!(
+                    got.to_string().contains(&format!("of object {}", b.0)),
+                    "{got}"
+                );
+            }
             // NaN != NaN: compare the messages.
             assert_eq!(got.to_string(), error.to_string(), "{par:?}");
             let got = scene.step(updates, par).unwrap_err();

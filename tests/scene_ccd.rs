@@ -7,7 +7,8 @@
 use dhcd::scene::{ObjectId, Scene, SceneImpacts};
 use dhcd::shapes::{grid, icosphere, jitter, translated};
 use dhcd::{
-    AnyHierarchy, CcdMode, CcdQuery, Error, Impacts, Mesh, Method, Motion, Options, Par, Workspace,
+    AnyHierarchy, CcdMode, CcdQuery, Error, Impacts, Mesh, Method, Motion, Options, Par, Positions,
+    Workspace,
 };
 
 fn f64s(p: &[[f32; 3]]) -> Vec<[f64; 3]> {
@@ -371,6 +372,8 @@ fn errors_change_nothing() {
             Error::WrongVertexCount {
                 expected: x0.len(),
                 got: x0.len() - 1,
+                of: Positions::Start,
+                object: Some(ids[1].0),
             },
         ),
         (
@@ -379,6 +382,8 @@ fn errors_change_nothing() {
             Error::WrongVertexCount {
                 expected: x0.len(),
                 got: x0.len() - 1,
+                of: Positions::End,
+                object: Some(ids[1].0),
             },
         ),
         (
@@ -387,6 +392,8 @@ fn errors_change_nothing() {
             Error::NonFinite {
                 vertex: 5,
                 position: nan[5],
+                of: Positions::End,
+                object: Some(ids[1].0),
             },
         ),
         (
@@ -395,6 +402,8 @@ fn errors_change_nothing() {
             Error::OutOfRange {
                 vertex: 2,
                 position: huge[2],
+                of: Positions::Start,
+                object: Some(ids[1].0),
             },
         ),
         (

@@ -30,6 +30,13 @@
 //! `dhcd::Par::MAX_THREADS` (1024) is `DHCD_ERR_INVALID_ARGUMENT`. Results never depend on it.
 #![warn(missing_docs)]
 
+mod control;
+
+pub use control::{
+    dhcd_cancel_free, dhcd_cancel_new, dhcd_cancel_reset, dhcd_cancel_set,
+    dhcd_hierarchy_set_control, dhcd_scene_set_control, DhcdCancel, DhcdPoll,
+};
+
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -80,6 +87,18 @@ pub const DHCD_ERR_REPEATED_OBJECT: c_int = -9;
 /// (built by `dhcd_hierarchy_new_f64` / `dhcd_scene_add_f64`), or `double` positions for an
 /// `f32` one.
 pub const DHCD_ERR_PRECISION: c_int = -10;
+/// A query would return more result pairs than its limit (`dhcd_hierarchy_set_control`,
+/// `dhcd_scene_set_control`); the message names the count reached and the limit.
+pub const DHCD_ERR_OUTPUT_LIMIT: c_int = -11;
+/// A result buffer could not be allocated.
+pub const DHCD_ERR_OUT_OF_MEMORY: c_int = -12;
+/// The query was stopped by its cancel token or poll callback.
+pub const DHCD_ERR_CANCELLED: c_int = -13;
+
+/// The default limit on the result pairs of one query (2^25).
+pub const DHCD_DEFAULT_MAX_PAIRS: u64 = 1 << 25;
+/// No limit on result pairs.
+pub const DHCD_NO_LIMIT: u64 = u64::MAX;
 
 /// `dhcd_hierarchy_precision` of a hierarchy built from `float` positions.
 pub const DHCD_PRECISION_F32: c_int = 32;
@@ -376,6 +395,9 @@ impl From<Error> for Fail {
             | Error::NonFinite { .. }
             | Error::OutOfRange { .. } => DHCD_ERR_INVALID_MESH,
             Error::PrecisionMismatch { .. } => DHCD_ERR_PRECISION,
+            Error::OutputLimit { .. } => DHCD_ERR_OUTPUT_LIMIT,
+            Error::OutOfMemory { .. } => DHCD_ERR_OUT_OF_MEMORY,
+            Error::Cancelled => DHCD_ERR_CANCELLED,
             Error::WrongVertexCount { .. } => DHCD_ERR_LENGTH_MISMATCH,
             Error::MethodMismatch { .. } => DHCD_ERR_WRONG_KIND,
             Error::UnknownObject(_) => DHCD_ERR_UNKNOWN_OBJECT,

@@ -19,8 +19,10 @@ from ._dhcd import (
     contact_segments,
     edge_edge_ccd,
     load_mesh,
+    max_pairs,
     proximity,
     self_proximity,
+    set_max_pairs,
     vertex_face_ccd,
 )
 from ._manager import CollisionManager
@@ -39,7 +41,9 @@ __all__ = [
     "contact_segments",
     "edge_edge_ccd",
     "load_mesh",
+    "max_pairs",
     "proximity",
     "self_proximity",
+    "set_max_pairs",
     "vertex_face_ccd",
 ]

@@ -63,8 +63,10 @@ __all__ = [
     "contact_segments",
     "edge_edge_ccd",
     "load_mesh",
+    "max_pairs",
     "proximity",
     "self_proximity",
+    "set_max_pairs",
     "vertex_face_ccd",
 ]
 
@@ -334,13 +336,28 @@ def edge_edge_ccd(
     come within ``min_distance``) at some t in ``[0, t_max]``, and when, as
     ``vertex_face_ccd``."""
 
+def set_max_pairs(n: Optional[int]) -> None:
+    """Sets the most result pairs one proximity or CCD query may return (``None``: no limit;
+    the default is ``2**25``, about 33.5 million, which a machine with a few GB survives). A
+    query that would return more raises ``ValueError`` naming the count reached and the
+    limit; one whose result the allocator refuses raises ``MemoryError``. Applies to every
+    later query of the module."""
+
+def max_pairs() -> Optional[int]:
+    """The most result pairs one query may return (``None``: no limit)."""
+
 def load_mesh(
     path: Union[str, "os.PathLike[str]"],
     max_file_bytes: Optional[int] = None,
-) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.int64]]:
-    """``(vertices, faces)`` of an OBJ, STL (ASCII or binary) or PLY file: ``(n, 3)`` float32
-    and ``(m, 3)`` int64, faces in file order (polygons split as fans). Only regular files of
-    at most ``max_file_bytes`` (default 1 GiB) are read; anything else raises ``OSError``."""
+    precision: str = "f32",
+) -> Tuple[npt.NDArray[np.floating[Any]], npt.NDArray[np.int64]]:
+    """``(vertices, faces)`` of an OBJ, STL (ASCII or binary) or PLY file: ``(n, 3)`` vertices
+    and ``(m, 3)`` int64 faces in file order (polygons split as fans). Vertices are float32
+    with ``precision="f32"`` (the default) and float64 at full precision with
+    ``precision="f64"`` (PLY doubles and OBJ decimals as written; float32 values widen
+    exactly): a float64 array builds an ``"f64"`` hierarchy. An unknown precision raises
+    ``ValueError``. Only regular files of at most ``max_file_bytes`` (default 1 GiB) are
+    read; anything else raises ``OSError``."""
 
 class Scene:
     """Many deformable objects of one method. Object ids are ints from 0 upwards, never
@@ -364,8 +381,9 @@ class Scene:
         ``update``), applied in parallel with ``threads`` (``"f64"`` objects one after the
         other). Every entry is checked before any is applied: an unknown id, an object given
         twice, a wrong shape, float type or vertex count, a non-finite coordinate raise
-        ``ValueError`` and nothing changes (an entry that is not a pair raises
-        ``TypeError``). The result equals one ``update`` per entry."""
+        ``ValueError`` and nothing changes (an entry that is not a tuple or list raises
+        ``TypeError``; a tuple or list of other than two items, ``ValueError``, as unpacking
+        it would). The result equals one ``update`` per entry."""
     def step(
         self,
         updates: Updates,

@@ -19,6 +19,8 @@
 //! sees what is rounded).
 #![forbid(unsafe_code)]
 
+mod interrupt;
+
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 
@@ -34,7 +36,9 @@ use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3,
     PyUntypedArrayMethods,
 };
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyTypeError, PyValueError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyKeyboardInterrupt, PyMemoryError, PyOSError, PyTypeError, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyString, PyTuple};
 
@@ -47,6 +51,8 @@ fn to_py(e: Error) -> PyErr {
             PyFileNotFoundError::new_err((2, e.to_string(), path.display().to_string()))
         }
         Error::Io { .. } | Error::FileTooLarge { .. } => PyOSError::new_err(e.to_string()),
+        Error::OutOfMemory { .. } => PyMemoryError::new_err(e.to_string()),
+        Error::Cancelled => PyKeyboardInterrupt::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
 }
@@ -111,6 +117,26 @@ fn counters(py: Python<'_>, c: Counters) -> PyResult<Py<PyDict>> {
 const REAL: (&str, &str) = ("fiu", "a real number type");
 const INTEGER: (&str, &str) = ("iu", "an integer type");
 
+/// `numpy.asarray(obj)`, or `TypeError` when `obj` is of a Python type that is no array at
+/// all (`None`, a string, a dict); `what` names it in messages. (An array of the wrong shape
+/// or dtype is a `ValueError`, raised by the caller.)
+fn array_of_numbers<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyAny>> {
+    let wrong_type = || -> PyResult<PyErr> {
+        let kind = obj.get_type().name()?;
+        Ok(PyTypeError::new_err(format!(
+            "{what} must be an array of numbers, got {kind}"
+        )))
+    };
+    if obj.is_none() || obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyDict>() {
+        return Err(wrong_type()?);
+    }
+    let np = obj.py().import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| value_error(format!("{what}: cannot convert to an array ({e})")))?;
+    Ok(arr)
+}
+
 /// `numpy.asarray(obj)` checked to be a 2-D array with 3 columns whose dtype is one of
 /// `kinds` (`REAL` or `INTEGER`); `what` names it in messages.
 fn numeric_n3<'py>(
@@ -118,10 +144,7 @@ fn numeric_n3<'py>(
     what: &str,
     (kinds, kinds_text): (&str, &str),
 ) -> PyResult<Bound<'py, PyAny>> {
-    let np = obj.py().import("numpy")?;
-    let arr = np
-        .call_method1("asarray", (obj,))
-        .map_err(|e| value_error(format!("{what}: cannot convert to an array ({e})")))?;
+    let arr = array_of_numbers(obj, what)?;
     let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
     if shape.len() != 2 || shape[1] != 3 {
         let shape = arr.getattr("shape")?.repr()?;
@@ -651,9 +674,10 @@ fn proximity(
     }
     let (mut a, mut b) = (a.try_borrow_mut()?, b.try_borrow_mut()?);
     let (a, b) = (&mut *a, &mut *b);
-    let rows = py
-        .detach(|| Ok(proximity_rows(a.h.proximity(&b.h, d, &mut a.ws, par)?)))
-        .map_err(to_py)?;
+    let rows = interrupt::run(py, par, |control| {
+        a.ws.control = control.clone();
+        Ok(proximity_rows(a.h.proximity(&b.h, d, &mut a.ws, par)?))
+    })?;
     Proximity::new(py, rows)
 }
 
@@ -670,9 +694,10 @@ fn self_proximity(
     let par = par(threads)?;
     let mut h = h.try_borrow_mut()?;
     let h = &mut *h;
-    let rows = py
-        .detach(|| Ok(proximity_rows(h.h.self_proximity(d, &mut h.ws, par)?)))
-        .map_err(to_py)?;
+    let rows = interrupt::run(py, par, |control| {
+        h.ws.control = control.clone();
+        Ok(proximity_rows(h.h.self_proximity(d, &mut h.ws, par)?))
+    })?;
     Proximity::new(py, rows)
 }
 
@@ -697,10 +722,7 @@ fn float64_rows<'py>(
     what: &str,
     tail: &[usize],
 ) -> PyResult<Bound<'py, PyAny>> {
-    let np = obj.py().import("numpy")?;
-    let arr = np
-        .call_method1("asarray", (obj,))
-        .map_err(|e| value_error(format!("{what}: cannot convert to an array ({e})")))?;
+    let arr = array_of_numbers(obj, what)?;
     let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
     if shape.len() != tail.len() + 1 || shape[1..] != *tail {
         let want: Vec<String> = std::iter::once("n".to_string())
@@ -719,6 +741,7 @@ fn float64_rows<'py>(
              explicitly, e.g. with .astype(numpy.float64))"
         )));
     }
+    let np = obj.py().import("numpy")?;
     np.call_method1("ascontiguousarray", (arr, "float64"))
 }
 
@@ -815,9 +838,10 @@ fn ccd(
             let m = Motion::new(rows_of(&x0, "x0")?, rows_of(&x1, "x1")?);
             let mut h = h.try_borrow_mut()?;
             let h = &mut *h;
-            let r = py
-                .detach(|| h.h.self_ccd(m, &q, &mut h.ws, par))
-                .map_err(to_py)?;
+            let r = interrupt::run(py, par, |control| {
+                h.ws.control = control.clone();
+                h.h.self_ccd(m, &q, &mut h.ws, par)
+            })?;
             Impacts::new(py, r)
         }
         6 => {
@@ -837,9 +861,10 @@ fn ccd(
             let mb = Motion::new(rows_of(&x[2], "b0")?, rows_of(&x[3], "b1")?);
             let (mut a, mut b) = (a.try_borrow_mut()?, b.try_borrow_mut()?);
             let (a, b) = (&mut *a, &mut *b);
-            let r = py
-                .detach(|| a.h.ccd_pair(ma, &b.h, mb, &q, &mut a.ws, par))
-                .map_err(to_py)?;
+            let r = interrupt::run(py, par, |control| {
+                a.ws.control = control.clone();
+                a.h.ccd_pair(ma, &b.h, mb, &q, &mut a.ws, par)
+            })?;
             Impacts::new(py, r)
         }
         n => Err(PyTypeError::new_err(format!(
@@ -987,7 +1012,8 @@ impl Impacts {
 type Batch<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>);
 
 /// One single-pair CCD test of the library, checked.
-type CcdTest = fn(&[[f64; 3]; 4], &[[f64; 3]; 4], &CcdOptions) -> dhcd::Result<Option<f64>>;
+type CcdTest =
+    fn(&[[f64; 3]; 4], &[[f64; 3]; 4], &CcdOptions, &dyn Fn() -> bool) -> dhcd::Result<Option<f64>>;
 
 /// `(hits, toi)` of a batch of single-pair queries: `x0` and `x1` float64 `(N, 4, 3)`.
 fn batch_ccd<'py>(
@@ -1018,18 +1044,16 @@ fn batch_ccd<'py>(
             .collect())
     };
     let (q0, q1) = (slice(&a0, "x0")?, slice(&a1, "x1")?);
-    let (hits, tois) = py
-        .detach(|| -> Result<(Vec<bool>, Vec<f64>), String> {
-            let mut hits = Vec::with_capacity(q0.len());
-            let mut tois = Vec::with_capacity(q0.len());
-            for (k, (p0, p1)) in q0.iter().zip(&q1).enumerate() {
-                let toi = test(p0, p1, &options).map_err(|e| format!("query {k}: {e}"))?;
-                hits.push(toi.is_some());
-                tois.push(toi.unwrap_or(f64::INFINITY));
-            }
-            Ok((hits, tois))
-        })
-        .map_err(value_error)?;
+    let (hits, tois) = interrupt::batch(py, |stop| {
+        let mut hits = Vec::with_capacity(q0.len());
+        let mut tois = Vec::with_capacity(q0.len());
+        for (k, (p0, p1)) in q0.iter().zip(&q1).enumerate() {
+            let toi = test(p0, p1, &options, stop).map_err(|e| format!("query {k}: {e}"))?;
+            hits.push(toi.is_some());
+            tois.push(toi.unwrap_or(f64::INFINITY));
+        }
+        Ok((hits, tois))
+    })?;
     Ok((hits.into_pyarray(py), tois.into_pyarray(py)))
 }
 
@@ -1047,7 +1071,14 @@ fn vertex_face_ccd<'py>(
     min_distance: Option<&Bound<'py, PyAny>>,
     t_max: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Batch<'py>> {
-    batch_ccd(py, dhcd::ccd::try_vertex_face, x0, x1, min_distance, t_max)
+    batch_ccd(
+        py,
+        dhcd::ccd::vertex_face_until,
+        x0,
+        x1,
+        min_distance,
+        t_max,
+    )
 }
 
 /// Edge-edge CCD of a batch of single pairs: `x0`, `x1` float64 `(N, 4, 3)`, rows
@@ -1064,21 +1095,48 @@ fn edge_edge_ccd<'py>(
     min_distance: Option<&Bound<'py, PyAny>>,
     t_max: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Batch<'py>> {
-    batch_ccd(py, dhcd::ccd::try_edge_edge, x0, x1, min_distance, t_max)
+    batch_ccd(py, dhcd::ccd::edge_edge_until, x0, x1, min_distance, t_max)
 }
 
-/// `(vertices, faces)` as numpy arrays.
-type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<i64>>);
-
-/// `(vertices, faces)` of an OBJ, STL or PLY file: float32 `(n, 3)` and int64 `(m, 3)`.
-/// Only regular files of at most `max_file_bytes` (default 1 GiB) are read.
+/// Sets the most result pairs one query may return (`None`: no limit; default 2**25); a
+/// query that would return more raises `ValueError` naming the count reached and the limit.
 #[pyfunction]
-#[pyo3(signature = (path, max_file_bytes = None))]
+#[pyo3(signature = (n))]
+fn set_max_pairs(n: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+    let n = match n {
+        None => u64::MAX,
+        Some(n) => {
+            let v = int_arg(n, "max_pairs")?;
+            u64::try_from(v)
+                .map_err(|_| value_error(format!("max_pairs must not be negative, got {v}")))?
+        }
+    };
+    interrupt::set_max_pairs(n);
+    Ok(())
+}
+
+/// The most result pairs one query may return (`None`: no limit).
+#[pyfunction]
+fn max_pairs() -> Option<u64> {
+    Some(interrupt::max_pairs()).filter(|&n| n != u64::MAX)
+}
+
+/// `(vertices, faces)` as numpy arrays: vertices float32 or float64, faces int64.
+type MeshArrays<'py> = (Bound<'py, PyAny>, Bound<'py, PyArray2<i64>>);
+
+/// `(vertices, faces)` of an OBJ, STL or PLY file: vertices `(n, 3)` float32 (`precision
+/// = "f32"`, the default) or float64 at full precision (`"f64"`: PLY doubles and OBJ
+/// decimals as written), faces int64 `(m, 3)`. Only regular files of at most
+/// `max_file_bytes` (default 1 GiB) are read.
+#[pyfunction]
+#[pyo3(signature = (path, max_file_bytes = None, precision = "f32"))]
 fn load_mesh<'py>(
     py: Python<'py>,
     path: PathBuf,
     max_file_bytes: Option<&Bound<'py, PyAny>>,
+    precision: &str,
 ) -> PyResult<MeshArrays<'py>> {
+    let precision: Precision = precision.parse().map_err(to_py)?;
     let limits = match max_file_bytes {
         None => dhcd::io::Limits::default(),
         Some(m) => dhcd::io::Limits {
@@ -1088,9 +1146,8 @@ fn load_mesh<'py>(
         },
     };
     let mesh = py
-        .detach(|| dhcd::io::load_with(&path, &limits))
+        .detach(|| dhcd::io::load_as(&path, &limits, precision))
         .map_err(to_py)?;
-    let v: Vec<f32> = mesh.positions().iter().flatten().copied().collect();
     let f: Vec<i64> = mesh
         .triangles()
         .iter()
@@ -1098,11 +1155,22 @@ fn load_mesh<'py>(
         .map(|&i| i64::from(i))
         .collect();
     let shape = |n: usize| (n, 3);
-    let v = Array2::from_shape_vec(shape(mesh.vertex_count()), v)
-        .map_err(|e| value_error(format!("internal error: {e}")))?;
-    let f = Array2::from_shape_vec(shape(mesh.triangle_count()), f)
-        .map_err(|e| value_error(format!("internal error: {e}")))?;
-    Ok((v.into_pyarray(py), f.into_pyarray(py)))
+    let internal = |e: numpy::ndarray::ShapeError| value_error(format!("internal error: {e}"));
+    let v = match mesh.positions_f64() {
+        Some(p) => Array2::from_shape_vec(shape(p.len()), p.as_flattened().to_vec())
+            .map_err(internal)?
+            .into_pyarray(py)
+            .into_any(),
+        None => {
+            let p = mesh.positions();
+            Array2::from_shape_vec(shape(p.len()), p.as_flattened().to_vec())
+                .map_err(internal)?
+                .into_pyarray(py)
+                .into_any()
+        }
+    };
+    let f = Array2::from_shape_vec(shape(mesh.triangle_count()), f).map_err(internal)?;
+    Ok((v, f.into_pyarray(py)))
 }
 
 /// Many deformable objects of one method; object ids are ints from 0 up, never reused.
@@ -1198,10 +1266,12 @@ fn update_many(scene: &mut dhcd::Scene, updates: &[Update<'_>], par: Par) -> dhc
     }
     for &(id, p) in updates {
         let n = scene.tree(id)?.vertex_total();
+        let of = dhcd::Positions::Update;
         match p {
-            Positions::F32(p) => check_positions(p, n)?,
-            Positions::F64(p) => check_positions_f64(p, n)?,
+            Positions::F32(p) => check_positions(p, n, of),
+            Positions::F64(p) => check_positions_f64(p, n, of),
         }
+        .map_err(|e| e.in_object(id.0))?;
     }
     scene.update_many(&f32s, par)?;
     for &(id, p) in updates {
@@ -1406,9 +1476,10 @@ impl Scene {
         let d = distance_arg(d)?;
         let par = par(threads)?;
         let scene = &mut self.scene;
-        let rows = py
-            .detach(|| Ok(scene_proximity_rows(scene.proximity(d, par)?)))
-            .map_err(to_py)?;
+        let rows = interrupt::run(py, par, |control| {
+            scene.set_control(control.clone());
+            Ok(scene_proximity_rows(scene.proximity(d, par)?))
+        })?;
         Proximity::new(py, rows)
     }
 
@@ -1419,7 +1490,7 @@ impl Scene {
         text_signature = "(self, motions, *, min_distance=0.0, earliest=False, t_max=1.0, threads=1)"
     )]
     fn ccd(
-        &self,
+        &mut self,
         py: Python<'_>,
         motions: &Bound<'_, PyAny>,
         min_distance: Option<&Bound<'_, PyAny>>,
@@ -1447,8 +1518,11 @@ impl Scene {
             .iter()
             .map(|(id, x0, x1)| Ok((*id, Motion::new(rows_of(x0, "x0")?, rows_of(x1, "x1")?))))
             .collect::<PyResult<_>>()?;
-        let scene = &self.scene;
-        let r = py.detach(|| scene.ccd(&motions, &q, par)).map_err(to_py)?;
+        let scene = &mut self.scene;
+        let r = interrupt::run(py, par, |control| {
+            scene.set_control(control.clone());
+            scene.ccd(&motions, &q, par)
+        })?;
         Impacts::of_scene(py, r)
     }
 
@@ -1492,8 +1566,9 @@ fn edge_edge_types() -> Vec<&'static str> {
 mod dhcd_native {
     #[pymodule_export]
     use super::{
-        ccd, collide, contact_segments, edge_edge_ccd, load_mesh, proximity, self_proximity,
-        vertex_face_ccd, Contacts, Hierarchy, Impacts, Proximity, Scene,
+        ccd, collide, contact_segments, edge_edge_ccd, load_mesh, max_pairs, proximity,
+        self_proximity, set_max_pairs, vertex_face_ccd, Contacts, Hierarchy, Impacts, Proximity,
+        Scene,
     };
 
     #[pymodule_init]

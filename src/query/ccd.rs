@@ -40,7 +40,7 @@ use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
 use crate::control::Budget;
 use crate::counters::Counters;
-use crate::error::Result;
+use crate::error::{Positions, Result};
 use crate::hierarchy::Hierarchy;
 use crate::mesh::check_positions_f64;
 use crate::par::Par;
@@ -255,8 +255,8 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
 /// `motion`'s positions (checked: the mesh's vertex count, finite, in range) in `tree`'s
 /// internal vertex order.
 pub(crate) fn checked_step(tree: &RegionTree, motion: Motion<'_>) -> Result<Step> {
-    check_positions_f64(motion.x0, tree.vertex_total())?;
-    check_positions_f64(motion.x1, tree.vertex_total())?;
+    check_positions_f64(motion.x0, tree.vertex_total(), Positions::Start)?;
+    check_positions_f64(motion.x1, tree.vertex_total(), Positions::End)?;
     Ok(Step::gather(tree, motion.x0, motion.x1))
 }
 

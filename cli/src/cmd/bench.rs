@@ -52,11 +52,11 @@ enum What {
         #[arg(required = true)]
         frames: Vec<PathBuf>,
         /// The distance.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         distance: Option<f64>,
         /// The distance as a fraction of the first frame's bounding-box diagonal (IPC's
         /// default contact distance is 1e-3).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         relative: Option<f64>,
         #[command(flatten)]
         opts: Opts,
@@ -68,7 +68,7 @@ enum What {
         #[arg(required = true, num_args = 2..)]
         frames: Vec<PathBuf>,
         /// Pairs collide when they come within this distance.
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         min_distance: f64,
         /// Only the earliest time of impact of each step.
         #[arg(long)]
@@ -164,7 +164,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
             _ => unreachable!("clap requires one"),
         };
         if !(x.is_finite() && x >= 0.0) {
-            return Err(format!("{name} must be a finite number >= 0, got {x}"));
+            return Err(format!("{name} must be a finite number >= 0, got {x:?}"));
         }
     }
     // CCD: its options, f64 input, and no broad-phase-only mode.
@@ -199,7 +199,17 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         } => Some(*d),
         What::Proximity {
             relative: Some(r), ..
-        } => Some(r * diagonal(&a[0])),
+        } => {
+            let diag = diagonal(&a[0]);
+            let d = r * diag;
+            if !d.is_finite() {
+                return Err(format!(
+                    "--relative {r:?} times the first frame's bounding-box diagonal {diag:?} \
+                     overflows to {d:?}; give a smaller --relative or --distance"
+                ));
+            }
+            Some(d)
+        }
         _ => None,
     };
     let options = Options {

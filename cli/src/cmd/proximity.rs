@@ -17,7 +17,7 @@ pub struct ProximityArgs {
     /// A second mesh: pairs between the two instead of inside MESH.
     other: Option<PathBuf>,
     /// The distance: a pair is reported when its closed features are at most this far apart.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     distance: f64,
     /// Threads (1: the calling thread; 0: all cores). The output does not depend on it.
     #[arg(long, default_value_t = 1)]
@@ -55,9 +55,10 @@ pub fn run(args: ProximityArgs) -> dhcd::Result<()> {
     })
 }
 
-/// `{"method", "precision", "distance", "vertex_face": [[v, t, dist_sq], ...],
-/// ("face_vertex": [[t, v, dist_sq], ...],) "edge_edge": [[a0, a1, b0, b1, dist_sq], ...],
-/// "counters"}`, streamed (`face_vertex` with two meshes).
+/// `{"method", "precision", "distance", "vertex_face": [[v, t, dist_sq, type], ...],
+/// ("face_vertex": [[t, v, dist_sq, type], ...],) "edge_edge": [[a0, a1, b0, b1, dist_sq,
+/// type], ...], "counters"}`, streamed (`face_vertex` with two meshes); `type` is IPC's
+/// distance type name, as in the text output.
 fn write_json(out: &mut dyn Write, args: &ProximityArgs, p: &Proximity) -> std::io::Result<()> {
     let num = |x: f64| serde_json::Number::from_f64(x).map_or("null".into(), |n| n.to_string());
     write!(
@@ -71,10 +72,11 @@ fn write_json(out: &mut dyn Write, args: &ProximityArgs, p: &Proximity) -> std::
         let sep = if k == 0 { "" } else { "," };
         write!(
             out,
-            "{sep}[{},{},{}]",
+            "{sep}[{},{},{},\"{}\"]",
             x.vertex,
             x.triangle,
-            num(x.distance_sq)
+            num(x.distance_sq),
+            x.kind.ipc_name()
         )?;
     }
     if args.other.is_some() {
@@ -83,10 +85,11 @@ fn write_json(out: &mut dyn Write, args: &ProximityArgs, p: &Proximity) -> std::
             let sep = if k == 0 { "" } else { "," };
             write!(
                 out,
-                "{sep}[{},{},{}]",
+                "{sep}[{},{},{},\"{}\"]",
                 x.triangle,
                 x.vertex,
-                num(x.distance_sq)
+                num(x.distance_sq),
+                x.kind.ipc_name()
             )?;
         }
     }
@@ -95,12 +98,13 @@ fn write_json(out: &mut dyn Write, args: &ProximityArgs, p: &Proximity) -> std::
         let sep = if k == 0 { "" } else { "," };
         write!(
             out,
-            "{sep}[{},{},{},{},{}]",
+            "{sep}[{},{},{},{},{},\"{}\"]",
             x.a[0],
             x.a[1],
             x.b[0],
             x.b[1],
-            num(x.distance_sq)
+            num(x.distance_sq),
+            x.kind.ipc_name()
         )?;
     }
     let c = p.counters;
@@ -122,7 +126,7 @@ fn write_text(out: &mut dyn Write, args: &ProximityArgs, p: &Proximity) -> std::
         p.vertex_face.len(),
         p.face_vertex.len(),
         p.edge_edge.len(),
-        args.distance,
+        format!("{:?}", args.distance),
         args.query.method,
         args.input.precision(),
         c.bv_tests,
