@@ -6,7 +6,7 @@
 use dhcd::bv::BoundingVolume;
 use dhcd::ccd::CcdOptions;
 use dhcd::io::{load_as, Limits};
-use dhcd::narrow::{brute_force_ccd, brute_force_self_ccd};
+use dhcd::narrow::{brute_force_ccd, brute_force_self_ccd, earliest_of};
 use dhcd::shapes::{grid, icosphere, jitter, splitmix64, wave};
 use dhcd::{
     ccd_pair_with, for_each_method, self_ccd_with, CcdMode, CcdQuery, Error, Hierarchy, Impacts,
@@ -28,18 +28,6 @@ fn assert_same(got: &Impacts, want: &Impacts, what: &str) {
     assert!(got.counters.prim_tests >= got.counters.contacts, "{what}");
 }
 
-/// What earliest mode must return: the least time, and every pair whose own time is within
-/// the tolerance of it.
-fn earliest_of(all: &Impacts) -> Impacts {
-    let mut e = all.clone();
-    let t = all.toi.unwrap_or(f64::INFINITY) + dhcd::ccd::TOI_TOLERANCE;
-    e.vertex_face.retain(|x| x.toi <= t);
-    e.face_vertex.retain(|x| x.toi <= t);
-    e.edge_edge.retain(|x| x.toi <= t);
-    e.counters.contacts = (e.vertex_face.len() + e.face_vertex.len() + e.edge_edge.len()) as u64;
-    e
-}
-
 fn check_self<K: BoundingVolume>(
     m: &Mesh,
     x0: &[[f64; 3]],
@@ -55,7 +43,7 @@ fn check_self<K: BoundingVolume>(
         for mode in [CcdMode::All, CcdMode::Earliest] {
             let want = match mode {
                 CcdMode::All => want.clone(),
-                CcdMode::Earliest => earliest_of(&want),
+                CcdMode::Earliest => earliest_of(&want, want.toi),
             };
             for par in [Par::Seq, Par::Rayon(2)] {
                 let q = CcdQuery { options, mode };
@@ -86,7 +74,7 @@ fn check_pair<K: BoundingVolume>(
         for mode in [CcdMode::All, CcdMode::Earliest] {
             let want = match mode {
                 CcdMode::All => want.clone(),
-                CcdMode::Earliest => earliest_of(&want),
+                CcdMode::Earliest => earliest_of(&want, want.toi),
             };
             for par in [Par::Seq, Par::Rayon(2)] {
                 let q = CcdQuery { options, mode };
@@ -324,7 +312,7 @@ fn frame_truth_through_the_pipeline() {
                 for (par, mode) in [(Par::Seq, CcdMode::All), (Par::Rayon(2), CcdMode::Earliest)] {
                     let q = CcdQuery { mode, ..CcdQuery::default() };
                     let other = self_ccd_with(&hk, motion, &q, &mut Workspace::default(), par).unwrap();
-                    let want = if mode == CcdMode::All { got.clone() } else { earliest_of(&got) };
+                    let want = if mode == CcdMode::All { got.clone() } else { earliest_of(&got, got.toi) };
                     assert_same(&other, &want, &format!("{name} {:?} {par:?} {mode:?}", K::METHOD));
                 }
             });
@@ -374,7 +362,7 @@ fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
         .collect();
     let m = Mesh::new_f64(p0.clone(), tris).unwrap();
     let all = brute_force_self_ccd(&m, Motion::new(&p0, &p1), &CcdOptions::default());
-    let want = earliest_of(&all);
+    let want = earliest_of(&all, all.toi);
     let tied = want.counters.contacts;
     assert!(tied > 500, "{tied} pairs tie at 1/2");
     assert_eq!(

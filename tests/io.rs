@@ -32,7 +32,13 @@ fn parse_err_at(result: dhcd::Result<Mesh>, path: &str, line: usize) -> String {
         }
         other => panic!("expected a Parse error, got {other:?}"),
     }
-    assert!(text.starts_with(&format!("{path}:{line}: ")), "{text}");
+    // Line 0 (the whole file, or a binary one) is not cited.
+    let at = if line == 0 {
+        format!("{path}: ")
+    } else {
+        format!("{path}:{line}: ")
+    };
+    assert!(text.starts_with(&at), "{text}");
     assert!(!text.contains('\n'), "message must be one line: {text}");
     text
 }

@@ -4,6 +4,7 @@
 //! equal to the direct `ccd_pair` / `self_ccd` calls, both modes, 1 and 2 threads, and every
 //! input error leaving the scene as it was.
 
+use dhcd::narrow::earliest_of;
 use dhcd::scene::{ObjectId, Scene, SceneImpacts};
 use dhcd::shapes::{grid, icosphere, jitter, translated};
 use dhcd::{
@@ -109,21 +110,6 @@ fn motions<'a>(bodies: &'a [Body], ids: &[ObjectId]) -> Vec<(ObjectId, Motion<'a
         .zip(ids)
         .filter_map(|(b, &id)| b.x1.as_ref().map(|x1| (id, Motion::new(&b.x0, x1))))
         .collect()
-}
-
-/// What earliest mode must return for one walk whose all-mode result is `all`, given the
-/// scene's least time `least`.
-fn earliest_of(all: &Impacts, least: Option<f64>) -> Impacts {
-    let mut e = all.clone();
-    if all.toi != least {
-        e.toi = None;
-    }
-    let t = e.toi.unwrap_or(f64::NEG_INFINITY);
-    e.vertex_face.retain(|x| x.toi == t);
-    e.face_vertex.retain(|x| x.toi == t);
-    e.edge_edge.retain(|x| x.toi == t);
-    e.counters.contacts = (e.vertex_face.len() + e.face_vertex.len() + e.edge_edge.len()) as u64;
-    e
 }
 
 fn pairs_of(i: &Impacts) -> usize {

@@ -1992,7 +1992,7 @@ fn distance_type_numbers_are_the_library_enums() {
 // ---------------------------------------------------------------------------------------------
 
 use dhcd::ccd::CcdOptions;
-use dhcd::narrow::{brute_force_ccd, brute_force_self_ccd};
+use dhcd::narrow::{brute_force_ccd, brute_force_self_ccd, earliest_of};
 use dhcd::query::{EdgeImpact, FaceImpact, VertexImpact};
 use dhcd::shapes::{grid, jitter};
 use dhcd::{CcdMode, CcdQuery, Impacts, Motion};
@@ -2162,18 +2162,6 @@ fn c_ccd(
     }
 }
 
-/// What earliest mode must return: the least time, and the pairs reaching it (the work
-/// counters depend on the order of the walk: compared apart).
-fn earliest_of(all: &Impacts) -> Impacts {
-    let mut e = all.clone();
-    let t = all.toi.unwrap_or(f64::INFINITY);
-    e.vertex_face.retain(|x| x.toi == t);
-    e.face_vertex.retain(|x| x.toi == t);
-    e.edge_edge.retain(|x| x.toi == t);
-    e.counters.contacts = (e.vertex_face.len() + e.face_vertex.len() + e.edge_edge.len()) as u64;
-    e
-}
-
 /// Pairs, times (to the bit) and contact count equal.
 fn assert_same_impacts(got: &Impacts, want: &Impacts, what: &str) {
     assert_eq!(got.vertex_face, want.vertex_face, "{what}: vertex-face");
@@ -2257,7 +2245,11 @@ fn self_ccd_equals_the_brute_force() {
                 let got = c_self_ccd(h, &x0, &x1, CcdQuery::all(), threads);
                 assert_same_impacts(&got, &all, &what);
                 let got = c_self_ccd(h, &x0, &x1, CcdQuery::earliest(), threads);
-                assert_same_impacts(&got, &earliest_of(&all), &format!("{what}, earliest"));
+                assert_same_impacts(
+                    &got,
+                    &earliest_of(&all, all.toi),
+                    &format!("{what}, earliest"),
+                );
             }
             // The same as the Rust API, counters included.
             let rust = AnyHierarchy::new(method_of(method), &mesh, options4()).unwrap();
@@ -2316,7 +2308,11 @@ fn pair_ccd_equals_the_brute_force() {
                 let got = c_ccd(ha, am, hb, bm, CcdQuery::all(), threads);
                 assert_same_impacts(&got, &all, &what);
                 let got = c_ccd(ha, am, hb, bm, CcdQuery::earliest(), threads);
-                assert_same_impacts(&got, &earliest_of(&all), &format!("{what}, earliest"));
+                assert_same_impacts(
+                    &got,
+                    &earliest_of(&all, all.toi),
+                    &format!("{what}, earliest"),
+                );
                 let q = CcdQuery::all().with_t_max(early.t_max);
                 let got = c_ccd(ha, am, hb, bm, q, threads);
                 assert_same_impacts(&got, &part, &format!("{what}, t_max"));

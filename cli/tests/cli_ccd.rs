@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use dhcd::ccd::CcdOptions;
-use dhcd::narrow::brute_force_self_ccd;
+use dhcd::narrow::{brute_force_self_ccd, earliest_of};
 use dhcd::shapes::{grid, jitter};
 use dhcd::{Impacts, Mesh, Motion};
 
@@ -60,16 +60,6 @@ fn check_against(v: &serde_json::Value, want: &Impacts) {
     );
 }
 
-/// Only the pairs reaching the least time, as `--earliest` reports them.
-fn earliest_of(all: &Impacts) -> Impacts {
-    let mut e = all.clone();
-    let t = all.toi.unwrap_or(f64::INFINITY);
-    e.vertex_face.retain(|x| x.toi == t);
-    e.edge_edge.retain(|x| x.toi == t);
-    e.counters.contacts = (e.vertex_face.len() + e.edge_edge.len()) as u64;
-    e
-}
-
 #[test]
 fn ccd_json_equals_brute_force() {
     let (g, x0, x1) = folding_sheet(8, 1.0);
@@ -113,7 +103,7 @@ fn ccd_json_equals_brute_force() {
                     assert_eq!(v["earliest"], earliest);
                     assert_eq!(v["min_distance"].as_f64(), Some(delta));
                     let want = if earliest {
-                        earliest_of(&all)
+                        earliest_of(&all, all.toi)
                     } else {
                         all.clone()
                     };
@@ -246,7 +236,11 @@ fn bench_ccd_counts_each_steps_pairs() {
             let frames = r["frames"].as_array().unwrap();
             assert_eq!(frames.len(), 2, "steps between consecutive frames");
             for (f, w) in frames.iter().zip(&want) {
-                let w = if earliest { earliest_of(w) } else { w.clone() };
+                let w = if earliest {
+                    earliest_of(w, w.toi)
+                } else {
+                    w.clone()
+                };
                 assert_eq!(f["contacts"].as_u64().unwrap(), w.counters.contacts);
             }
         }

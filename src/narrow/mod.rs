@@ -31,7 +31,7 @@ mod tritri;
 
 pub use oracle::{
     brute_force_ccd, brute_force_pairs, brute_force_proximity, brute_force_self_ccd,
-    brute_force_self_pairs, brute_force_self_proximity,
+    brute_force_self_pairs, brute_force_self_proximity, earliest_of,
 };
 
 /// Whether the closed triangles share at least one point, decided exactly for the f32 inputs.

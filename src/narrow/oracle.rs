@@ -319,6 +319,20 @@ pub fn brute_force_self_ccd(
     out
 }
 
+/// What earliest mode returns given the all-mode result `all` of a walk and the least time
+/// `least` over every walk that shared the query (`all.toi` for one walk): the pairs whose
+/// time is within [`crate::ccd::TOI_TOLERANCE`] of `least`, the least of their times (`None`
+/// if none) and their count; the work counters as `all`'s.
+pub fn earliest_of(all: &crate::query::Impacts, least: Option<f64>) -> crate::query::Impacts {
+    let mut e = all.clone();
+    let bound = least.map_or(f64::NEG_INFINITY, |t| t + crate::ccd::TOI_TOLERANCE);
+    e.vertex_face.retain(|x| x.toi <= bound);
+    e.face_vertex.retain(|x| x.toi <= bound);
+    e.edge_edge.retain(|x| x.toi <= bound);
+    finish_impacts(&mut e);
+    e
+}
+
 /// The earliest time and the count of an oracle's result (its lists are in order).
 fn finish_impacts(out: &mut crate::query::Impacts) {
     out.toi = out
