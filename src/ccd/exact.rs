@@ -8,7 +8,7 @@
 //! contacts nor their times. A point moving from `x0` to `x1` is then the polynomial
 //! `X0 + t (X1 - X0)` with integer coefficients.
 
-use num_bigint::{BigInt, Sign};
+use num_bigint::{BigInt, BigUint, Sign};
 use num_integer::Integer;
 use num_traits::{One, Signed, ToPrimitive, Zero};
 
@@ -209,9 +209,9 @@ fn pmul(a: &[BigInt], b: &[BigInt]) -> Vec<BigInt> {
 
 /// `p` divided by the gcd of its coefficients (a positive number).
 fn primitive(p: Vec<BigInt>) -> Vec<BigInt> {
-    let mut g = BigInt::zero();
+    let mut g = BigUint::zero();
     for c in &p {
-        g = g.gcd(c);
+        g = gcd(g, c.magnitude().clone());
         if g.is_one() {
             return p;
         }
@@ -219,7 +219,61 @@ fn primitive(p: Vec<BigInt>) -> Vec<BigInt> {
     if g.is_zero() {
         return p;
     }
+    let g = BigInt::from(g);
     p.into_iter().map(|c| c / &g).collect()
+}
+
+/// The gcd of two naturals by Lehmer's algorithm (Knuth, TAOCP vol. 2, 4.5.2, Algorithm L):
+/// the quotients of Euclid's algorithm are found on the leading 64 bits while they are
+/// certain, and applied to the full numbers as one 2 x 2 step.
+///
+/// PERF: `Integer::gcd` of num-bigint is Stein's binary algorithm, one bit per step of a
+/// shift and a subtraction of the whole number: on the 7,000-bit coefficients of a query
+/// whose coordinates span `5e-324` to `3e38`, four fifths of the exact path's time.
+fn gcd(a: BigUint, b: BigUint) -> BigUint {
+    let (mut u, mut v) = if a >= b { (a, b) } else { (b, a) };
+    while !v.is_zero() {
+        let n = u.bits();
+        if n <= 64 {
+            let (mut x, mut y) = (
+                u.to_u64().expect("64 bits"),
+                v.to_u64().expect("at most u"),
+            );
+            while y != 0 {
+                (x, y) = (y, x % y);
+            }
+            return BigUint::from(x);
+        }
+        // The leading 64 bits of u, and v's bits at the same places.
+        let shift = n - 64;
+        let mut x = i128::from((&u >> shift).to_u64().expect("64 bits"));
+        let mut y = i128::from((&v >> shift).to_u64().expect("at most u's"));
+        let (mut ca, mut cb, mut cc, mut cd) = (1i128, 0i128, 0i128, 1i128);
+        loop {
+            if y + cc == 0 || y + cd == 0 {
+                break;
+            }
+            let q = (x + ca) / (y + cc);
+            if q != (x + cb) / (y + cd) {
+                break;
+            }
+            (ca, cc) = (cc, ca - q * cc);
+            (cb, cd) = (cd, cb - q * cd);
+            (x, y) = (y, x - q * y);
+        }
+        if cb == 0 {
+            // No quotient was certain: one step of Euclid on the full numbers.
+            let r = &u % &v;
+            (u, v) = (v, r);
+        } else {
+            let (bu, bv) = (BigInt::from(u), BigInt::from(v));
+            let nu = &bu * ca + &bv * cb;
+            let nv = &bu * cc + &bv * cd;
+            u = nu.to_biguint().expect("Lehmer's combinations are natural");
+            v = nv.to_biguint().expect("Lehmer's combinations are natural");
+        }
+    }
+    u
 }
 
 /// `(r, s)` with `r = c * rem(a, b)` for some `c` of sign `s` (+1 or -1), `b` nonzero.
@@ -936,4 +990,45 @@ pub(crate) fn refine_root(
         _ => false,
     });
     Ok(lower_bound(&root, super::TOI_TOL_LOG2 as u64, stop)?.round_down())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Lehmer's gcd equals Stein's (`Integer::gcd`) on numbers of every size, with common
+    /// factors planted, zeros and equal arguments.
+    #[test]
+    fn lehmer_gcd_equals_steins() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut number = |words: usize| {
+            let digits: Vec<u64> = (0..words).map(|_| next()).collect();
+            BigUint::from_slice(
+                &digits
+                    .iter()
+                    .flat_map(|d| [*d as u32, (*d >> 32) as u32])
+                    .collect::<Vec<_>>(),
+            )
+        };
+        for words in [0, 1, 2, 3, 5, 17, 60, 120] {
+            for _ in 0..20 {
+                let common = number(words / 2 + 1);
+                let a = number(words) * &common;
+                let b = number(words / 3 + 1) * &common;
+                assert_eq!(gcd(a.clone(), b.clone()), a.gcd(&b), "{words}");
+                assert_eq!(gcd(b.clone(), a.clone()), a.gcd(&b));
+                assert_eq!(gcd(a.clone(), a.clone()), a);
+                assert_eq!(gcd(a.clone(), BigUint::zero()), a);
+                assert_eq!(gcd(BigUint::zero(), a.clone()), a);
+                let pow = BigUint::one() << (words * 40);
+                assert_eq!(gcd(&a * &pow, &b * &pow), a.gcd(&b) * &pow);
+            }
+        }
+    }
 }
