@@ -2880,3 +2880,108 @@ fn scene_ccd_equals_the_rust_scene() {
         }
     }
 }
+
+/// Limits and cancellation from C: a result over the hierarchy's limit is
+/// `DHCD_ERR_OUTPUT_LIMIT` with an empty result, a set cancel token or a poll callback that
+/// says stop is `DHCD_ERR_CANCELLED`, and once reset the same query answers; the scene's
+/// control likewise; the default limit is the library's. A vertex no face uses is a point.
+#[test]
+fn limits_cancellation_and_free_points() {
+    use std::ffi::{c_int, c_void};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    assert_eq!(DHCD_DEFAULT_MAX_PAIRS, dhcd::DEFAULT_MAX_PAIRS);
+    let sheet = dhcd::shapes::grid(12, 12, 1.0 / 12.0, [0.0; 3]);
+    let h = new_h(DHCD_METHOD_DH, &sheet);
+    let run = |threads: u32| {
+        let mut p = no_proximity();
+        // SAFETY: a live handle, writable output.
+        let rc = unsafe { dhcd_self_proximity(h, 2.0, threads, &mut p) };
+        // SAFETY: filled (or emptied) by the library.
+        (rc, unsafe { taken_proximity(&mut p) })
+    };
+    // SAFETY: a live handle; null token and callback.
+    let rc = unsafe { dhcd_hierarchy_set_control(h, 100, null(), None, null_mut()) };
+    assert_eq!(rc, DHCD_OK);
+    for threads in [1, 2] {
+        let (rc, p) = run(threads);
+        assert_eq!(rc, DHCD_ERR_OUTPUT_LIMIT, "{}", last_error());
+        assert!(
+            last_error().contains("over the limit of 100"),
+            "{}",
+            last_error()
+        );
+        assert_eq!(p.counters.contacts, 0);
+    }
+    let mut token = null_mut();
+    // SAFETY: writable output; then a live token and handle.
+    unsafe {
+        assert_eq!(dhcd_cancel_new(&mut token), DHCD_OK);
+        assert_eq!(dhcd_cancel_set(token), DHCD_OK);
+        let rc = dhcd_hierarchy_set_control(h, DHCD_NO_LIMIT, token, None, null_mut());
+        assert_eq!(rc, DHCD_OK);
+    }
+    assert_eq!(run(1).0, DHCD_ERR_CANCELLED, "{}", last_error());
+    // SAFETY: a live token.
+    unsafe { assert_eq!(dhcd_cancel_reset(token), DHCD_OK) };
+    let (rc, all) = run(2);
+    assert_eq!(rc, DHCD_OK, "{}", last_error());
+    assert!(all.counters.contacts > 100);
+    // A poll callback that stops at its third call.
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    unsafe extern "C" fn third(_: *mut c_void) -> c_int {
+        (CALLS.fetch_add(1, Ordering::Relaxed) >= 2) as c_int
+    }
+    let big = dhcd::shapes::grid(40, 40, 1.0 / 40.0, [0.0; 3]);
+    let hb = new_h(DHCD_METHOD_AABB, &big);
+    let mut p = no_proximity();
+    // SAFETY: live handles and token, writable output; the callback is thread-safe.
+    unsafe {
+        let rc = dhcd_hierarchy_set_control(hb, DHCD_NO_LIMIT, token, Some(third), null_mut());
+        assert_eq!(rc, DHCD_OK);
+        assert_eq!(dhcd_self_proximity(hb, 2.0, 1, &mut p), DHCD_ERR_CANCELLED);
+        assert!(is_empty(&p));
+        dhcd_cancel_free(token);
+        dhcd_hierarchy_free(hb);
+    }
+    assert_eq!(CALLS.load(Ordering::Relaxed), 3);
+    // The scene's control.
+    let (scene, _) = scene_of(&sheet, 2);
+    // SAFETY: a live scene.
+    unsafe {
+        assert_eq!(
+            dhcd_scene_set_control(scene, 50, null(), None, null_mut()),
+            DHCD_OK
+        );
+        let mut sp = std::mem::zeroed::<DhcdSceneProximity>();
+        assert_eq!(
+            dhcd_scene_proximity(scene, 2.0, 1, &mut sp),
+            DHCD_ERR_OUTPUT_LIMIT
+        );
+        dhcd_scene_free(scene);
+        dhcd_hierarchy_free(h);
+    }
+    // A free vertex 0.5 above the only face.
+    let m = Mesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.25, 0.25, 0.5],
+        ],
+        vec![[0, 1, 2]],
+    )
+    .unwrap();
+    for method in [DHCD_METHOD_DH, DHCD_METHOD_SPHERE, DHCD_METHOD_AABB] {
+        let hf = new_h(method, &m);
+        let p = c_self_proximity(hf, 1.0, 1);
+        assert_eq!(
+            p.vertex_face
+                .iter()
+                .map(|x| (x.vertex, x.triangle))
+                .collect::<Vec<_>>(),
+            [(3, 0)]
+        );
+        // SAFETY: a live handle.
+        unsafe { dhcd_hierarchy_free(hf) };
+    }
+}

@@ -34,6 +34,7 @@ fn check_against(v: &serde_json::Value, want: &Proximity, two_meshes: bool) {
         assert_eq!(r[0], w.vertex);
         assert_eq!(r[1], w.triangle);
         assert_eq!(r[2].as_f64().unwrap(), w.distance_sq);
+        assert_eq!(r[3], w.kind.ipc_name(), "the JSON names the distance type");
     }
     let ee = rows("edge_edge");
     assert_eq!(ee.len(), want.edge_edge.len());
@@ -41,6 +42,7 @@ fn check_against(v: &serde_json::Value, want: &Proximity, two_meshes: bool) {
         let ids: Vec<u64> = (0..4).map(|k| r[k].as_u64().unwrap()).collect();
         assert_eq!(ids, [w.a[0], w.a[1], w.b[0], w.b[1]].map(u64::from));
         assert_eq!(r[4].as_f64().unwrap(), w.distance_sq);
+        assert_eq!(r[5], w.kind.ipc_name());
     }
     if two_meshes {
         let fv = rows("face_vertex");
@@ -264,4 +266,47 @@ fn bench_proximity_reports_pairs_distance_and_precision() {
             assert!(f["contacts"].as_u64().unwrap() > 0);
         }
     }
+}
+
+/// The red team's findings on the command line: a negative distance is a value (not an
+/// unknown flag) and is refused by name; numbers are echoed in short form; a relative
+/// distance that overflows says so; a vertex no face uses is a point.
+#[test]
+fn negative_and_overflowing_distances_and_free_points() {
+    let m = Mesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.25, 0.25, 0.5],
+        ],
+        vec![[0, 1, 2]],
+    )
+    .unwrap();
+    let path = write("free_point.obj", &m);
+    let p = path.to_str().unwrap();
+    let (code, _, err) = dhcd(&["proximity", p, "--distance", "-1"]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("distance -1.0 is not a finite number >= 0"),
+        "{err}"
+    );
+    let (code, _, err) = dhcd(&["proximity", p, "--distance", "-1e-300"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("-1e-300") && err.len() < 200, "{err}");
+    let (code, _, err) = dhcd(&["bench", "proximity", p, "--relative", "1.7e308"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("overflows"), "{err}");
+    let (code, out, err) = dhcd(&["proximity", p, "--distance", "1", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v = json(&out);
+    assert_eq!(v["vertex_face"][0][0], 3);
+    assert_eq!(v["vertex_face"][0][1], 0);
+    assert_eq!(v["vertex_face"][0][3], "P_T");
+    // Whole-file errors cite no line 0.
+    let empty = dir().join("empty.obj");
+    std::fs::write(&empty, "# nothing\n").unwrap();
+    let (code, _, err) = dhcd(&["proximity", empty.to_str().unwrap(), "--distance", "1"]);
+    assert_ne!(code, 0);
+    assert!(!err.contains(":0:"), "{err}");
 }

@@ -235,10 +235,7 @@ fn gcd(a: BigUint, b: BigUint) -> BigUint {
     while !v.is_zero() {
         let n = u.bits();
         if n <= 64 {
-            let (mut x, mut y) = (
-                u.to_u64().expect("64 bits"),
-                v.to_u64().expect("at most u"),
-            );
+            let (mut x, mut y) = (u.to_u64().expect("64 bits"), v.to_u64().expect("at most u"));
             while y != 0 {
                 (x, y) = (y, x % y);
             }

@@ -52,11 +52,11 @@ enum What {
         #[arg(required = true)]
         frames: Vec<PathBuf>,
         /// The distance.
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         distance: Option<f64>,
         /// The distance as a fraction of the first frame's bounding-box diagonal (IPC's
         /// default contact distance is 1e-3).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         relative: Option<f64>,
         #[command(flatten)]
         opts: Opts,
@@ -68,7 +68,7 @@ enum What {
         #[arg(required = true, num_args = 2..)]
         frames: Vec<PathBuf>,
         /// Pairs collide when they come within this distance.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
         min_distance: f64,
         /// Only the earliest time of impact of each step.
         #[arg(long)]

@@ -20,7 +20,7 @@ pub struct CcdArgs {
     /// The same mesh at the end of the step: the same vertices and triangles, new positions.
     t1: PathBuf,
     /// Pairs collide when they come within this distance (IPC's minimum separation).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     min_distance: f64,
     /// Only the earliest time of impact, with every pair whose own time is within 1e-12 of it.
     #[arg(long)]

@@ -17,7 +17,7 @@ pub struct ProximityArgs {
     /// A second mesh: pairs between the two instead of inside MESH.
     other: Option<PathBuf>,
     /// The distance: a pair is reported when its closed features are at most this far apart.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     distance: f64,
     /// Threads (1: the calling thread; 0: all cores). The output does not depend on it.
     #[arg(long, default_value_t = 1)]
