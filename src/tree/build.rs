@@ -250,9 +250,9 @@ fn free_points_by_leaf(
             let mut b = boxes[n];
             for &t in &order[tri_start[n] as usize..tri_end[n] as usize] {
                 for &v in &mesh.triangles()[t as usize] {
-                    for k in 0..3 {
-                        b.0[k] = b.0[k].min(p[v as usize][k]);
-                        b.1[k] = b.1[k].max(p[v as usize][k]);
+                    for (k, &x) in p[v as usize].iter().enumerate() {
+                        b.0[k] = b.0[k].min(x);
+                        b.1[k] = b.1[k].max(x);
                     }
                 }
             }
