@@ -241,6 +241,23 @@ pub enum Error {
     /// function asked to stop): nothing is returned.
     #[error("the query was cancelled")]
     Cancelled,
+    /// A contact type code outside 0..=3 (point-point, point-edge, point-triangle,
+    /// edge-edge).
+    #[error("unknown contact type {0} (expected 0 point-point, 1 point-edge, 2 point-triangle or 3 edge-edge)")]
+    UnknownContactType(u8),
+    /// Two arrays that must have one entry each per row differ in length.
+    #[error("{what} has {got} rows, expected {expected}")]
+    LengthMismatch {
+        /// What was given.
+        what: &'static str,
+        /// The rows expected.
+        expected: usize,
+        /// The rows given.
+        got: usize,
+    },
+    /// A step-size rescaling outside `(0, 1]`.
+    #[error("rescaling must be in (0, 1], got {}", Num(*.0))]
+    InvalidRescaling(f64),
     /// A file that cannot be read (or written), with the system's message.
     #[error("{}: {}", escaped_path(.path), escaped(.message))]
     Io {
@@ -289,6 +306,8 @@ pub enum Positions {
     Start,
     /// The positions at the end of a step (`x1`, t = 1).
     End,
+    /// Rest positions given for a contact set's mollifier thresholds.
+    Rest,
 }
 
 impl std::fmt::Display for Positions {
@@ -298,6 +317,7 @@ impl std::fmt::Display for Positions {
             Positions::Update => "the position update",
             Positions::Start => "x0 (the positions at t = 0)",
             Positions::End => "x1 (the positions at t = 1)",
+            Positions::Rest => "the rest positions",
         })
     }
 }

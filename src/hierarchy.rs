@@ -47,6 +47,9 @@ pub struct Hierarchy<K: BoundingVolume> {
     /// The boxes of each leaf's own edges in the current pose, refreshed lazily per leaf;
     /// allocated by the first query on features (proximity).
     edges: std::sync::OnceLock<EdgeCache>,
+    /// The positions it was built with (caller's order, as `f64`): the rest pose the
+    /// contact set's mollifier thresholds are measured in.
+    rest: Arc<[[f64; 3]]>,
 }
 
 /// Every triangle's corners and closed box in the current pose, refreshed lazily one leaf at
@@ -190,7 +193,12 @@ impl<K: BoundingVolume> Hierarchy<K> {
             ),
         };
         let nodes = K::build(&tree, &points, &options);
+        let rest: Arc<[[f64; 3]]> = match mesh.positions_f64() {
+            Some(p) => p.into(),
+            None => mesh.positions().iter().map(|p| p.map(f64::from)).collect(),
+        };
         Ok(Self {
+            rest,
             tris: TriCache::new(&tree),
             edges: std::sync::OnceLock::new(),
             tree,
@@ -410,6 +418,19 @@ impl<K: BoundingVolume> Hierarchy<K> {
     #[doc(hidden)]
     pub fn points(&self) -> &Points {
         &self.points
+    }
+
+    /// The positions the hierarchy was built with (the rest pose; caller's vertex order).
+    pub fn rest_positions(&self) -> &[[f64; 3]] {
+        &self.rest
+    }
+
+    /// The current positions in the caller's vertex order (exact for either precision).
+    pub fn positions_f64(&self) -> Vec<[f64; 3]> {
+        let slot = self.tree.vert_slot();
+        (0..slot.len())
+            .map(|v| self.position_f64(slot[v] as usize))
+            .collect()
     }
 
     /// The exact current position of internal vertex `v`.

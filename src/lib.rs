@@ -44,6 +44,7 @@ mod any;
 pub mod bv;
 pub mod calibration;
 pub mod ccd;
+pub mod contact;
 mod control;
 mod counters;
 pub mod distance;
@@ -68,6 +69,7 @@ mod walk;
 
 pub use any::AnyHierarchy;
 pub use bv::Method;
+pub use contact::{contact_set, self_contact_set, ContactSet};
 pub use control::{Control, DEFAULT_MAX_PAIRS};
 pub use counters::Counters;
 pub use error::{Error, Positions, Result};

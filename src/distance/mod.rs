@@ -237,3 +237,54 @@ pub fn edge_edge_within(
 ) -> Option<(f64, EdgeEdge)> {
     edge_edge::within([a0, a1, b0, b1], d)
 }
+
+/// Whether `|(a1 - a0) x (b1 - b0)|^2 < threshold`, decided exactly for the `f64` inputs:
+/// the contact set's test of nearly parallel edges (the IPC Toolkit's mollifier test, which
+/// it evaluates in floating point). A float evaluation with a forward error bound decides
+/// most; the rest are decided on the integers of the inputs' binary grid.
+pub(crate) fn edges_cross_sq_below(e: [[f64; 3]; 4], threshold: f64) -> bool {
+    use arith::{cross, dot, sub3, EPS};
+    if threshold.is_nan() || threshold <= 0.0 {
+        return false;
+    }
+    if threshold == f64::INFINITY {
+        return true;
+    }
+    let a = sub3(&e[1], &e[0]);
+    let b = sub3(&e[3], &e[2]);
+    let c = cross(&a, &b);
+    let v = dot(&c, &c);
+    let l1 = |x: &[f64; 3]| x[0].abs() + x[1].abs() + x[2].abs();
+    // |c|^2 <= (|a|_1 |b|_1)^2 term by term; 12 roundings along any path (two differences,
+    // the products and sums of the cross product, its square and sum), each at most EPS
+    // relative, with ample slack.
+    let scale = (l1(&a) * l1(&b)).powi(2);
+    let err = 16.0 * EPS * scale;
+    if v.is_finite() && scale.is_finite() && scale > arith::VALUE_TINY {
+        if v + err < threshold {
+            return true;
+        }
+        if v - err >= threshold {
+            return false;
+        }
+    }
+    // Exact: the coordinates as integers X 2^unit, so |c|^2 = C 2^(4 unit).
+    let flat: [f64; 12] = std::array::from_fn(|k| e[k / 3][k % 3]);
+    let (ints, unit) = arith::to_grid(&flat);
+    let p =
+        |i: usize| -> [num_bigint::BigInt; 3] { std::array::from_fn(|k| ints[3 * i + k].clone()) };
+    let (a, b) = (sub3(&p(1), &p(0)), sub3(&p(3), &p(2)));
+    let c = cross(&a, &b);
+    let lhs = dot(&c, &c);
+    let (m, k) = arith::decompose(threshold);
+    if m <= 0 {
+        return false;
+    }
+    let rhs = num_bigint::BigInt::from(m);
+    let shift = i64::from(k) - 4 * i64::from(unit);
+    if shift >= 0 {
+        lhs < rhs << shift as usize
+    } else {
+        (lhs << (-shift) as usize) < rhs
+    }
+}

@@ -214,6 +214,7 @@ impl RegionTree {
             vert_slot,
             shared: OnceLock::new(),
             edges: OnceLock::new(),
+            tables: OnceLock::new(),
         };
         debug_assert_eq!(tree.check_topology(mesh), Ok(()));
         Ok(tree)

@@ -73,3 +73,40 @@ impl LeafEdges {
         &self.edges
     }
 }
+
+/// The mesh's triangles and unique edges in the caller's indices: the public edge table
+/// ([`RegionTree::edges`]) and what the contact set reads to name a row's vertices.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct MeshTables {
+    /// Every unique edge as its two vertices (caller's indices, smaller first), sorted: an
+    /// edge's id is its position here.
+    pub(crate) edges: Vec<[u32; 2]>,
+    /// Every triangle's corners (caller's indices and order), by the caller's triangle index.
+    pub(crate) triangles: Vec<[u32; 3]>,
+}
+
+impl MeshTables {
+    pub(crate) fn build(tree: &RegionTree) -> Self {
+        let order = tree.vert_order();
+        let mut triangles = vec![[0u32; 3]; tree.triangle_total()];
+        for (tri, &t) in tree.triangles().iter().zip(tree.tri_order()) {
+            triangles[t as usize] = tri.map(|v| order[v as usize]);
+        }
+        let mut edges: Vec<[u32; 2]> = triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .map(|(u, v)| [u.min(v), u.max(v)])
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        Self { edges, triangles }
+    }
+
+    /// The id of the edge `(u, v)` (either order), if the mesh has it.
+    pub(crate) fn edge_id(&self, u: u32, v: u32) -> Option<u32> {
+        self.edges
+            .binary_search(&[u.min(v), u.max(v)])
+            .ok()
+            .map(|i| i as u32)
+    }
+}

@@ -132,6 +132,9 @@ pub struct RegionTree {
     shared: OnceLock<Option<shared::SharedPairs>>,
     /// Each leaf's own edges, built by the first query on features (`edges.rs`).
     edges: OnceLock<edges::LeafEdges>,
+    /// The caller's triangles and the unique edge table, built by the first call that needs
+    /// them ([`RegionTree::edges`], the contact set).
+    tables: OnceLock<edges::MeshTables>,
 }
 
 impl RegionTree {
@@ -371,6 +374,23 @@ impl RegionTree {
     /// Each leaf's own edges (built by the first call; see `edges.rs`).
     pub(crate) fn leaf_edges(&self) -> &edges::LeafEdges {
         self.edges.get_or_init(|| edges::LeafEdges::build(self))
+    }
+
+    /// The mesh's unique edges, each as its two vertices (the caller's indices, smaller
+    /// first), sorted: edge ids (as the contact set's `edges` give them) index this table.
+    /// Built by the first call (one sort of the `3 T` triangle edges).
+    pub fn edges(&self) -> &[[u32; 2]] {
+        &self.tables().edges
+    }
+
+    /// The id of the edge joining vertices `u` and `v` (caller's indices, either order), or
+    /// `None` if no triangle has that edge.
+    pub fn edge_id(&self, u: u32, v: u32) -> Option<u32> {
+        self.tables().edge_id(u, v)
+    }
+
+    pub(crate) fn tables(&self) -> &edges::MeshTables {
+        self.tables.get_or_init(|| edges::MeshTables::build(self))
     }
 
     /// Bytes of topology (shared by the three methods; not part of a BV's record; the
