@@ -16,10 +16,10 @@ fn scaled(x: f64, k: i32) -> Option<f64> {
     (y.is_finite() && y / s == x && (y != 0.0 || x == 0.0)).then_some(y)
 }
 
-fn scale_query(
-    q: &([[f64; 3]; 4], [[f64; 3]; 4]),
-    k: i32,
-) -> Option<([[f64; 3]; 4], [[f64; 3]; 4])> {
+/// One CCD query: the four points at t = 0 and at t = 1.
+type Query = ([[f64; 3]; 4], [[f64; 3]; 4]);
+
+fn scale_query(q: &Query, k: i32) -> Option<Query> {
     let mut out = *q;
     for p in out.0.iter_mut().chain(out.1.iter_mut()) {
         for x in p.iter_mut() {

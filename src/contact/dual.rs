@@ -4,6 +4,10 @@
 //! products and one division), so carrying the derivatives through each operation costs a
 //! few hundred flops per operation and needs no generated code.
 
+// The product and quotient rules mix operations inside `Mul` and `Div`, which is what the
+// lint suspects.
+#![allow(clippy::suspicious_arithmetic_impl)]
+
 use std::ops::{Add, Div, Mul, Sub};
 
 /// What the distance formulas need of a number.

@@ -133,7 +133,7 @@ fn write_text(out: &mut dyn Write, args: &CcdArgs, p: &Impacts) -> std::io::Resu
     writeln!(
         out,
         "{} vertex-face and {} edge-edge pairs collide{} (earliest time of impact {toi}; {}, \
-         min distance {}): {} BV pairs tested, {} feature pairs tested, {} BV updates",
+         min distance {:?}): {} BV pairs tested, {} feature pairs tested, {} BV updates",
         p.vertex_face.len(),
         p.edge_edge.len(),
         if args.earliest {
@@ -142,7 +142,7 @@ fn write_text(out: &mut dyn Write, args: &CcdArgs, p: &Impacts) -> std::io::Resu
             ""
         },
         args.query.method,
-        format!("{:?}", args.min_distance),
+        args.min_distance,
         c.bv_tests,
         c.prim_tests,
         c.bv_updates

@@ -121,12 +121,12 @@ fn write_text(out: &mut dyn Write, args: &ProximityArgs, p: &Proximity) -> std::
     let c = p.counters;
     writeln!(
         out,
-        "{} vertex-face, {} face-vertex and {} edge-edge pairs within {} ({}, {}): {} BV pairs \
+        "{} vertex-face, {} face-vertex and {} edge-edge pairs within {:?} ({}, {}): {} BV pairs \
          tested, {} feature pairs tested, {} BV updates",
         p.vertex_face.len(),
         p.face_vertex.len(),
         p.edge_edge.len(),
-        format!("{:?}", args.distance),
+        args.distance,
         args.query.method,
         args.input.precision(),
         c.bv_tests,
