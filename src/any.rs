@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use crate::bv::Method;
 use crate::calibration::{BroadPhase, Calibration};
+use crate::contact::{contact_set_with, self_contact_set_with, ContactSet};
 use crate::error::Result;
 use crate::hierarchy::{Hierarchy, InvariantError};
 use crate::mesh::Mesh;
@@ -124,6 +125,37 @@ impl AnyHierarchy {
     /// [`self_proximity`](crate::self_proximity())).
     pub fn self_proximity(&self, d: f64, ws: &mut Workspace, par: Par) -> Result<Proximity> {
         each!(self, h => self_proximity_with(h, d, ws, par))
+    }
+
+    /// The contact set of two hierarchies of the same method within `dhat` (see
+    /// [`contact_set`](crate::contact_set())); `rest` the rest positions of each (`None`: its
+    /// build positions).
+    pub fn contact_set(
+        &self,
+        other: &AnyHierarchy,
+        dhat: f64,
+        rest: [Option<&[[f64; 3]]>; 2],
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<ContactSet> {
+        pairwise!(self, other, a, b => contact_set_with(a, b, dhat, rest, ws, par)?)
+    }
+
+    /// The contact set of this object within `dhat` (see
+    /// [`self_contact_set`](crate::self_contact_set())).
+    pub fn self_contact_set(
+        &self,
+        dhat: f64,
+        rest: Option<&[[f64; 3]]>,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<ContactSet> {
+        each!(self, h => self_contact_set_with(h, dhat, rest, ws, par))
+    }
+
+    /// The positions the hierarchy was built with (caller's order).
+    pub fn rest_positions(&self) -> &[[f64; 3]] {
+        each!(self, h => h.rest_positions())
     }
 
     /// Colliding feature pairs between this object moving by `motion` and `other` moving by

@@ -53,6 +53,7 @@ __all__ = [
     "EDGE_EDGE_TYPES",
     "POINT_TRIANGLE_TYPES",
     "CollisionManager",
+    "ContactSet",
     "Contacts",
     "Hierarchy",
     "Impacts",
@@ -61,10 +62,15 @@ __all__ = [
     "ccd",
     "collide",
     "contact_segments",
+    "contact_set",
+    "distance_gradient",
+    "distance_hessian",
+    "distance_sq",
     "edge_edge_ccd",
     "load_mesh",
     "max_pairs",
     "proximity",
+    "self_contact_set",
     "self_proximity",
     "set_max_pairs",
     "vertex_face_ccd",
@@ -253,6 +259,81 @@ class Hierarchy:
     def vertex_count(self) -> int: ...
     @property
     def face_count(self) -> int: ...
+    def edges(self) -> npt.NDArray[np.int64]:
+        """The mesh's unique edges, ``(E, 2)`` int64, smaller vertex first, sorted: the edge
+        ids of ``ContactSet.edges``."""
+
+class ContactSet:
+    """Every pair of features within ``dhat``, once, with the IPC Toolkit's collision type
+    (``NormalCollisions.build``'s rules): a vertex near a vertex (PP), near the interior of an
+    edge (PE) or of a face (PT), and two edges whose closest points are interior to both, or
+    that are nearly parallel (EE, ``mollified``). Sorted by type, then vertices."""
+
+    @property
+    def vertices(self) -> npt.NDArray[np.int64]:
+        """``(K, 4)``, ``-1``-padded: PP ``[v, w]`` (``v < w``), PE ``[v, e0, e1]``
+        (``e0 < e1``), PT ``[v, t0, t1, t2]``, EE ``[a0, a1, b0, b1]``."""
+    @property
+    def type(self) -> npt.NDArray[np.uint8]:
+        """``(K,)``: 0 PP, 1 PE, 2 PT, 3 EE."""
+    @property
+    def distance_sq(self) -> npt.NDArray[np.float64]:
+        """``(K,)`` squared distances of the closest features."""
+    @property
+    def weights(self) -> npt.NDArray[np.float64]:
+        """``(K, 4)``: ``sum_i weights[k, i] * x[vertices[k, i]]`` is the vector between the
+        closest points (the first feature's minus the second's; ipctk's
+        ``compute_coefficients``); 0 in unused slots."""
+    @property
+    def mollified(self) -> npt.NDArray[np.bool_]:
+        """``(K,)``: EE rows of nearly parallel edges (``|a x b|^2 < 1e-3 |a|^2 |b|^2`` at
+        rest, decided exactly), measured by their closest features' formula."""
+    @property
+    def edges(self) -> npt.NDArray[np.int64]:
+        """``(K, 2)`` edge ids (``Hierarchy.edges()``; in a pair query ``b``'s are offset by
+        ``len(a.edges())``): PE ``[e, -1]``, EE ``[a, b]``, else ``[-1, -1]``."""
+    @property
+    def counters(self) -> Dict[str, int]: ...
+    def gradient(self) -> npt.NDArray[np.float64]:
+        """``(K, 12)``: the gradient of each row's squared distance with respect to its
+        four vertices' coordinates (slot ``i``, coordinate ``c`` at ``3 i + c``)."""
+    def hessian(self) -> npt.NDArray[np.float64]:
+        """``(K, 12, 12)``: the Hessian of each row's squared distance."""
+    def __len__(self) -> int: ...
+
+def self_contact_set(
+    h: Hierarchy, dhat: float, rest: Optional[Vertices] = None, threads: int = 1
+) -> ContactSet:
+    """Every pair of features of one mesh within ``dhat`` (finite, ``>= 0``), once.
+    ``rest``: the rest positions of the mollifier test (default: those ``h`` was built
+    with)."""
+
+def contact_set(
+    a: Hierarchy,
+    b: Hierarchy,
+    dhat: float,
+    rest_a: Optional[Vertices] = None,
+    rest_b: Optional[Vertices] = None,
+    threads: int = 1,
+) -> ContactSet:
+    """Every pair of features of ``a`` and ``b`` within ``dhat``, once; vertices numbered
+    ``a``'s first, then ``b``'s (offset by ``a.vertex_count``), edges likewise."""
+
+def distance_sq(
+    types: npt.ArrayLike, x: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]:
+    """``(K,)``: the squared distance of each row's type (0 PP, 1 PE, 2 PT, 3 EE; another
+    value raises ``ValueError``) at ``x`` float64 ``(K, 4, 3)`` (unused slots ignored)."""
+
+def distance_gradient(
+    types: npt.ArrayLike, x: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]:
+    """``(K, 12)``: the gradient of ``distance_sq``."""
+
+def distance_hessian(
+    types: npt.ArrayLike, x: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]:
+    """``(K, 12, 12)``: the Hessian of ``distance_sq``."""
 
 def collide(a: Hierarchy, b: Hierarchy, threads: int = 1) -> Contacts:
     """Every pair ``[face of a, face of b]`` of intersecting faces. ``a`` and ``b`` must be

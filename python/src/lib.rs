@@ -19,6 +19,7 @@
 //! sees what is rounded).
 #![forbid(unsafe_code)]
 
+mod contact;
 mod interrupt;
 
 use std::collections::{HashMap, HashSet};
@@ -584,6 +585,12 @@ impl Hierarchy {
     #[getter]
     fn bytes_per_node(&self) -> usize {
         self.h.bytes_per_node()
+    }
+
+    /// The mesh's unique edges, `(E, 2)` int64 (smaller vertex first, sorted): the edge ids
+    /// of `ContactSet.edges`.
+    fn edges<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        contact::edges(py, self)
     }
 
     #[getter]
@@ -1564,6 +1571,10 @@ fn edge_edge_types() -> Vec<&'static str> {
 /// AABB hierarchies, exact contacts); the native part of the `dhcd` package.
 #[pymodule(name = "_dhcd")]
 mod dhcd_native {
+    #[pymodule_export]
+    use super::contact::{
+        contact_set, distance_gradient, distance_hessian, distance_sq, self_contact_set, ContactSet,
+    };
     #[pymodule_export]
     use super::{
         ccd, collide, contact_segments, edge_edge_ccd, load_mesh, max_pairs, proximity,
