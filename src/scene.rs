@@ -830,7 +830,7 @@ fn ccd_of<K: BoundingVolume>(
             ),
         };
         // A job stopped by the budget gives nothing; `finish` below says why.
-        ccd::run(a, b, self_job, query, best.as_ref(), budget, ws, par).unwrap_or_default()
+        ccd::run(a, b, self_job, query, best.as_ref(), budget, None, ws, par).unwrap_or_default()
     });
     budget.finish()?;
     let mut impacts = credit_refits(

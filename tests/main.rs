@@ -27,6 +27,7 @@ mod scene;
 mod scene_ccd;
 mod self_collision;
 mod shared_pairs;
+mod step_size;
 mod support;
 mod temp_dir;
 mod threads;

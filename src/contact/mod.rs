@@ -1,6 +1,7 @@
 //! What a barrier solver sums over: the contact set (every pair of features within `dhat`,
-//! once, with the IPC Toolkit's collision type and closest-point weights) and the geometry
-//! of one contact (its squared distance with gradient and Hessian).
+//! once, with the IPC Toolkit's collision type and closest-point weights), the geometry of
+//! one contact (its squared distance with gradient and Hessian), and the collision-free step
+//! size of a line search.
 //!
 //! ```
 //! use dhcd::{bv::Dh, contact::{self, ContactType}, Hierarchy, Mesh, Options};
@@ -22,9 +23,14 @@
 mod dual;
 pub mod geometry;
 mod set;
+mod step;
 
 pub use geometry::{distance_gradient, distance_hessian, distance_sq, ContactType};
 pub use set::{
     contact_set, contact_set_with, self_contact_set, self_contact_set_with, Contact, ContactSet,
     MOLLIFIER_FACTOR, NONE,
+};
+pub use step::{
+    collision_free_stepsize, collision_free_stepsize_pair, collision_free_stepsize_with,
+    StepOptions, StepSize,
 };

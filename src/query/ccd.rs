@@ -212,7 +212,18 @@ pub fn ccd_pair_with<K: BoundingVolume>(
     let best = earliest_bound(query);
     let control = ws.control.clone();
     let budget = Budget::new(&control);
-    Ok(run(&sa, &sb, false, query, best.as_ref(), &budget, ws, par)?.0)
+    Ok(run(
+        &sa,
+        &sb,
+        false,
+        query,
+        best.as_ref(),
+        &budget,
+        None,
+        ws,
+        par,
+    )?
+    .0)
 }
 
 /// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
@@ -238,7 +249,7 @@ pub fn self_ccd_with<K: BoundingVolume>(
     let best = earliest_bound(query);
     let control = ws.control.clone();
     let budget = Budget::new(&control);
-    Ok(run(&s, &s, true, query, best.as_ref(), &budget, ws, par)?.0)
+    Ok(run(&s, &s, true, query, best.as_ref(), &budget, None, ws, par)?.0)
 }
 
 /// One hierarchy over a step: its positions at t0 and t1 (internal order), its node bounds
@@ -360,6 +371,44 @@ struct SweptQuery<'s, 'h, K: BoundingVolume> {
     best: Option<&'s AtomicU64>,
     /// The result pairs so far, against the query's limit, and cancellation.
     budget: &'s Budget<'s>,
+    /// The step-size rule: each pair's minimum distance from its distance at t0 (the
+    /// options' minimum distance is then only the walk's culling distance).
+    gap: Option<Gap>,
+}
+
+/// The IPC Toolkit's step-size rule: a pair at distance `d0` at t0 must stay at least
+/// `min_distance + (1 - rescaling) (d0 - min_distance)` apart.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Gap {
+    pub(crate) min_distance: f64,
+    pub(crate) rescaling: f64,
+}
+
+impl Gap {
+    /// The options of one pair (`vertex_face`: `x0` is `[v, t0, t1, t2]`, else `[a0, a1,
+    /// b0, b1]`, at t0): its minimum distance by the rule, from its distance at t0 (the
+    /// exact closest features' `f64` distance, rounded up a few ulps so that the kept gap is
+    /// never below the rule's).
+    #[inline]
+    pub(crate) fn options(
+        &self,
+        vertex_face: bool,
+        x0: &[[f64; 3]; 4],
+        o: CcdOptions,
+    ) -> CcdOptions {
+        let d0_sq = if vertex_face {
+            crate::distance::point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
+        } else {
+            crate::distance::edge_edge_distance_sq(x0[0], x0[1], x0[2], x0[3]).0
+        };
+        let d0 = d0_sq.sqrt();
+        let g = self.min_distance + (1.0 - self.rescaling) * (d0 - self.min_distance);
+        let g = (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0);
+        CcdOptions {
+            min_distance: if g.is_finite() { g } else { f64::MAX },
+            ..o
+        }
+    }
 }
 
 #[derive(Default)]
@@ -405,6 +454,7 @@ pub(crate) fn run<K: BoundingVolume>(
     query: &CcdQuery,
     best: Option<&AtomicU64>,
     budget: &Budget<'_>,
+    gap: Option<Gap>,
     ws: &mut Workspace,
     par: Par,
 ) -> Result<(Impacts, [u64; 2])> {
@@ -416,6 +466,7 @@ pub(crate) fn run<K: BoundingVolume>(
         margin: f32_up(query.options.min_distance),
         best,
         budget,
+        gap,
     };
     let w = walk::walk(&q, ws, par);
     budget.finish()?;
@@ -528,6 +579,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                 st,
                 it[t as usize] as usize,
                 o,
+                self.gap.as_ref(),
                 &stop,
             )
         };
@@ -548,7 +600,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             // Pair queries: `a` is the first mesh's; self queries: both are one mesh's.
             let pa = x.a.map(|v| a.step_at(va[v as usize] as usize));
             let pb = x.b.map(|v| b.step_at(vb[v as usize] as usize));
-            if let Some(toi) = edge_edge_toi(pa, pb, o, &stop) {
+            if let Some(toi) = edge_edge_toi(pa, pb, o, self.gap.as_ref(), &stop) {
                 edge_edge.push(EdgeImpact { toi, ..*x });
             }
         }
@@ -591,6 +643,7 @@ fn vertex_face_toi<K: BoundingVolume>(
     st: &Swept<'_, K>,
     t: usize,
     options: &CcdOptions,
+    gap: Option<&Gap>,
     stop: &dyn Fn() -> bool,
 ) -> Option<f64> {
     let c = st.tree().triangles()[t].map(|c| c as usize);
@@ -606,8 +659,9 @@ fn vertex_face_toi<K: BoundingVolume>(
         st.step.x1[c[1]],
         st.step.x1[c[2]],
     ];
+    let options = gap.map_or(*options, |g| g.options(true, &x0, *options));
     // Stopped: no answer; the budget has stopped the query, which returns the error.
-    ccd::pair_until(true, &x0, &x1, options, stop).unwrap_or(None)
+    ccd::pair_until(true, &x0, &x1, &options, stop).unwrap_or(None)
 }
 
 /// The exact edge-edge test of two edges given as their endpoints at t0 and t1.
@@ -616,11 +670,13 @@ fn edge_edge_toi(
     a: [([f64; 3], [f64; 3]); 2],
     b: [([f64; 3], [f64; 3]); 2],
     options: &CcdOptions,
+    gap: Option<&Gap>,
     stop: &dyn Fn() -> bool,
 ) -> Option<f64> {
     let x0 = [a[0].0, a[1].0, b[0].0, b[1].0];
     let x1 = [a[0].1, a[1].1, b[0].1, b[1].1];
-    ccd::pair_until(false, &x0, &x1, options, stop).unwrap_or(None)
+    let options = gap.map_or(*options, |g| g.options(false, &x0, *options));
+    ccd::pair_until(false, &x0, &x1, &options, stop).unwrap_or(None)
 }
 
 impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
@@ -773,7 +829,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                     }
                     counters.prim_tests += 1;
                     let stop = || self.budget.poll();
-                    if let Some(toi) = vertex_face_toi(sv, v, st, t, &self.options_now(), &stop) {
+                    let o = self.options_now();
+                    if let Some(toi) = vertex_face_toi(sv, v, st, t, &o, self.gap.as_ref(), &stop) {
                         self.found(toi);
                         emit(v, t, toi);
                     }
@@ -837,7 +894,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                             (a_ids, b_ids, pa, pb)
                         };
                         let stop = || self.budget.poll();
-                        if let Some(toi) = edge_edge_toi(px, py, &self.options_now(), &stop) {
+                        let o = self.options_now();
+                        if let Some(toi) = edge_edge_toi(px, py, &o, self.gap.as_ref(), &stop) {
                             self.found(toi);
                             self.budget.push(
                                 out,

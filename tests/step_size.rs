@@ -1,0 +1,214 @@
+//! The collision-free step size: planted cases with known answers, equal to a brute force
+//! over every feature pair (each tested by exact CCD at its own gap), never past the earliest
+//! impact, the same for every method and thread count, typed errors for bad options.
+
+use dhcd::bv::BoundingVolume;
+use dhcd::ccd::{self, CcdOptions, TOI_TOLERANCE};
+use dhcd::contact::{collision_free_stepsize, collision_free_stepsize_with, StepOptions};
+use dhcd::distance::{edge_edge_distance_sq, point_triangle_distance_sq};
+use dhcd::shapes::{fold_x, grid, jitter};
+use dhcd::{
+    for_each_method, self_ccd, CcdQuery, Error, Hierarchy, Mesh, Motion, Options, Par, Workspace,
+};
+
+fn f64s(p: &[[f32; 3]]) -> Vec<[f64; 3]> {
+    p.iter().map(|q| q.map(f64::from)).collect()
+}
+
+/// A triangle at z = 0 and a vertex falling from z = 1 to z = -1 (through its middle).
+fn falling_vertex() -> (Mesh, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let x0 = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.25, 0.25, 1.0],
+        [5.0, 5.0, 5.0],
+        [6.0, 5.0, 5.0],
+    ];
+    let mut x1 = x0.clone();
+    x1[3][2] = -1.0;
+    // A second triangle far away keeps the vertex in a triangle of its own.
+    let m = Mesh::new_f64(x0.clone(), vec![[0, 1, 2], [3, 4, 5]]).unwrap();
+    (m, x0, x1)
+}
+
+#[test]
+fn a_falling_vertex_stops_at_its_gap() {
+    let (m, x0, x1) = falling_vertex();
+    for_each_method!(K => {
+        let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
+        let motion = Motion::new(&x0, &x1);
+        // Gap 0.2 (of d0 = 1): reached at z = 0.2, t = 0.4.
+        let s = collision_free_stepsize(&h, motion, &StepOptions::default()).unwrap();
+        assert!(s.step <= 0.4 && 0.4 - s.step <= 2.0 * TOI_TOLERANCE, "{}", s.step);
+        assert_eq!(s.limiting.vertex_face.len(), 1);
+        assert_eq!(s.limiting.vertex_face[0].vertex, 3);
+        // min distance 0.1: gap 0.1 + 0.2 * 0.9 = 0.28, at t = 0.36.
+        let o = StepOptions { min_distance: 0.1, rescaling: 0.8 };
+        let s = collision_free_stepsize(&h, motion, &o).unwrap();
+        assert!(s.step <= 0.36 && 0.36 - s.step <= 2.0 * TOI_TOLERANCE, "{}", s.step);
+        // rescaling 1: the impact itself, t = 0.5.
+        let o = StepOptions { min_distance: 0.0, rescaling: 1.0 };
+        let s = collision_free_stepsize(&h, motion, &o).unwrap();
+        assert!(s.step <= 0.5 && 0.5 - s.step <= 2.0 * TOI_TOLERANCE, "{}", s.step);
+        // Nothing comes near: 1.
+        let still = Motion::new(&x0, &x0);
+        let s = collision_free_stepsize(&h, still, &StepOptions::default()).unwrap();
+        assert_eq!(s.step, 1.0);
+        assert!(s.limiting.vertex_face.is_empty() && s.limiting.edge_edge.is_empty());
+    });
+}
+
+/// Every vertex-triangle and edge-edge pair of the mesh, each by exact CCD at its own gap.
+fn brute_force_step(m: &Mesh, x0: &[[f64; 3]], x1: &[[f64; 3]], o: &StepOptions) -> f64 {
+    let gap = |d0_sq: f64| {
+        let g = o.min_distance + (1.0 - o.rescaling) * (d0_sq.sqrt() - o.min_distance);
+        (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0)
+    };
+    let mut best = 1.0f64;
+    let tris = m.triangles();
+    for v in 0..x0.len() as u32 {
+        for t in tris {
+            if t.contains(&v) {
+                continue;
+            }
+            let p0 = [
+                x0[v as usize],
+                x0[t[0] as usize],
+                x0[t[1] as usize],
+                x0[t[2] as usize],
+            ];
+            let p1 = [
+                x1[v as usize],
+                x1[t[0] as usize],
+                x1[t[1] as usize],
+                x1[t[2] as usize],
+            ];
+            let g = gap(point_triangle_distance_sq(p0[0], [p0[1], p0[2], p0[3]]).0);
+            let c = CcdOptions {
+                t_max: 1.0,
+                min_distance: g,
+            };
+            if let Some(toi) = ccd::vertex_face(&p0, &p1, &c) {
+                best = best.min(toi);
+            }
+        }
+    }
+    let mut edges: Vec<[u32; 2]> = tris
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])]))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    for (i, a) in edges.iter().enumerate() {
+        for b in &edges[i + 1..] {
+            if a.iter().any(|v| b.contains(v)) {
+                continue;
+            }
+            let q = |x: &[[f64; 3]]| {
+                [
+                    x[a[0] as usize],
+                    x[a[1] as usize],
+                    x[b[0] as usize],
+                    x[b[1] as usize],
+                ]
+            };
+            let (p0, p1) = (q(x0), q(x1));
+            let g = gap(edge_edge_distance_sq(p0[0], p0[1], p0[2], p0[3]).0);
+            let c = CcdOptions {
+                t_max: 1.0,
+                min_distance: g,
+            };
+            if let Some(toi) = ccd::edge_edge(&p0, &p1, &c) {
+                best = best.min(toi);
+            }
+        }
+    }
+    best
+}
+
+fn check<K: BoundingVolume>(
+    m: &Mesh,
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    o: &StepOptions,
+    want: f64,
+) {
+    let h = Hierarchy::<K>::new(m, Options::default()).unwrap();
+    let motion = Motion::new(x0, x1);
+    for par in [Par::Seq, Par::Rayon(2)] {
+        let s =
+            collision_free_stepsize_with(&h, motion, o, &mut Workspace::default(), par).unwrap();
+        // The walk finds the limiting pair; its time may be from any pair within the
+        // tolerance of the brute force's least.
+        assert!(
+            (s.step - want).abs() <= TOI_TOLERANCE,
+            "{:?} {par:?} {o:?}: {} vs brute force {want}",
+            K::METHOD,
+            s.step
+        );
+        // Never past the earliest impact at the minimum distance.
+        let q = CcdQuery::earliest().with_min_distance(o.min_distance);
+        if let Some(t) = self_ccd(&h, motion, &q).unwrap().toi {
+            assert!(
+                s.step <= t + TOI_TOLERANCE,
+                "{} past the impact {t}",
+                s.step
+            );
+        }
+    }
+}
+
+/// A sheet folding onto itself over the step, jittered: the brute force over every pair.
+#[test]
+fn a_folding_sheet_equals_the_brute_force() {
+    let rest = grid(6, 6, 0.1, [0.0, 0.0, 0.0]);
+    let x0 = f64s(&jitter(&fold_x(rest.positions(), 0.28), [0.01; 3], 5));
+    let x1 = f64s(&jitter(&fold_x(rest.positions(), 0.3), [0.02; 3], 6));
+    let m = Mesh::new_f64(x0.clone(), rest.triangles().to_vec()).unwrap();
+    for o in [
+        StepOptions::default(),
+        StepOptions {
+            min_distance: 0.005,
+            rescaling: 0.8,
+        },
+        StepOptions {
+            min_distance: 0.0,
+            rescaling: 0.5,
+        },
+        StepOptions {
+            min_distance: 0.001,
+            rescaling: 1.0,
+        },
+    ] {
+        let want = brute_force_step(&m, &x0, &x1, &o);
+        assert!(want < 1.0, "the planted motion limits the step ({o:?})");
+        for_each_method!(K => check::<K>(&m, &x0, &x1, &o, want));
+    }
+}
+
+#[test]
+fn bad_options_are_typed_errors() {
+    let (m, x0, x1) = falling_vertex();
+    let h = Hierarchy::<dhcd::bv::Dh>::new(&m, Options::default()).unwrap();
+    let motion = Motion::new(&x0, &x1);
+    for r in [0.0, -0.5, 1.5, f64::NAN, f64::INFINITY] {
+        let o = StepOptions {
+            min_distance: 0.0,
+            rescaling: r,
+        };
+        let e = collision_free_stepsize(&h, motion, &o).unwrap_err();
+        assert!(matches!(e, Error::InvalidRescaling(_)), "{e}");
+    }
+    for d in [-1.0, f64::NAN, f64::INFINITY] {
+        let o = StepOptions {
+            min_distance: d,
+            rescaling: 0.8,
+        };
+        let e = collision_free_stepsize(&h, motion, &o).unwrap_err();
+        assert!(matches!(e, Error::InvalidMinDistance(_)), "{e}");
+    }
+    let e = collision_free_stepsize(&h, Motion::new(&x0[1..], &x1), &StepOptions::default())
+        .unwrap_err();
+    assert!(matches!(e, Error::WrongVertexCount { .. }), "{e}");
+}
