@@ -165,6 +165,11 @@
 #define DHCD_PRECISION_F64 64
 
 /**
+ * No `closest` type: the row is not an edge-edge row.
+ */
+#define DHCD_CLOSEST_NONE UINT8_MAX
+
+/**
  * Opaque: a cancel token. `dhcd_cancel_set` (from any thread) stops every query of the
  * hierarchies and scenes it is given to, which then return `DHCD_ERR_CANCELLED`, until
  * `dhcd_cancel_reset`.
@@ -539,6 +544,61 @@ typedef struct DhcdSceneImpacts {
    */
   struct DhcdCounters counters;
 } DhcdSceneImpacts;
+
+/**
+ * Every pair of features within `dhat`, once, with the IPC Toolkit's collision type, from
+ * `dhcd_self_contact_set` or `dhcd_contact_set` (release with `dhcd_contact_set_free`).
+ * Row `k` of each array; rows sorted by type, then vertices.
+ */
+typedef struct DhcdContactSet {
+  /**
+   * `[count][4]` vertices, `-1` in unused slots: point-point `[v, w]` (`v < w`),
+   * point-edge `[v, e0, e1]` (`e0 < e1`), point-triangle `[v, t0, t1, t2]`, edge-edge
+   * `[a0, a1, b0, b1]`. In a pair query `b`'s vertices are offset by `a`'s vertex count.
+   */
+  int64_t *vertices;
+  /**
+   * `[count]` types: 0 point-point, 1 point-edge, 2 point-triangle, 3 edge-edge.
+   */
+  uint8_t *types;
+  /**
+   * `[count]` squared distances of the closest features.
+   */
+  double *distance_sq;
+  /**
+   * `[count][4]` closest-point weights: `sum_i weights[4k + i] * x[vertices[4k + i]]` is
+   * the vector between the closest points (the first feature's minus the second's).
+   */
+  double *weights;
+  /**
+   * `[count]` 1 for edge-edge rows of nearly parallel edges (the IPC Toolkit mollifies
+   * their barrier), else 0.
+   */
+  uint8_t *mollified;
+  /**
+   * `[count][2]` edge ids (`dhcd_hierarchy_edges`; `b`'s offset by `a`'s edge count):
+   * point-edge `[e, -1]`, edge-edge `[a, b]`, else `[-1, -1]`.
+   */
+  int64_t *edges;
+  /**
+   * `[count]` edge-edge rows: the closest sub-features (`DHCD_EE_*`), which choose the
+   * formula of a mollified row's distance; `DHCD_CLOSEST_NONE` for other rows.
+   */
+  uint8_t *closest;
+  /**
+   * `[count][4][3]` the positions of each row's vertex slots at the query (zero in unused
+   * slots): what `dhcd_contact_set_gradient` and `_hessian` differentiate at.
+   */
+  double *positions;
+  /**
+   * Number of rows.
+   */
+  size_t count;
+  /**
+   * Work counted by the query (`contacts`: the rows).
+   */
+  struct DhcdCounters counters;
+} DhcdContactSet;
 
 /**
  * A poll callback: called by the threads doing a query's work, once every 64 leaf pairs
@@ -1048,6 +1108,147 @@ int dhcd_scene_ccd(struct DhcdScene *s,
  * `p` null or a `DhcdSceneImpacts` filled by this library and not modified since.
  */
 void dhcd_scene_impacts_free(struct DhcdSceneImpacts *p);
+
+/**
+ * Every pair of features of one mesh within `dhat` (finite, `>= 0`), once, into `*out` (see
+ * `DhcdContactSet`; release with `dhcd_contact_set_free`). `rest`: null, or the rest
+ * positions of the mollifier test (`3 * rest_count` doubles, `rest_count` the vertex count;
+ * default: the positions the hierarchy was built with).
+ *
+ * # Safety
+ * `h` null or a live handle; `rest` null or valid for `3 * rest_count` doubles; `out` null
+ * or valid for a write.
+ */
+int dhcd_self_contact_set(struct DhcdHierarchy *h,
+                          double dhat,
+                          const double *rest_positions,
+                          size_t rest_count,
+                          uint32_t threads,
+                          struct DhcdContactSet *out);
+
+/**
+ * Every pair of features of `a` and `b` (different handles of the same method) within
+ * `dhat`, once; `b`'s vertices and edges numbered after `a`'s. `rest_a`, `rest_b` as in
+ * `dhcd_self_contact_set`.
+ *
+ * # Safety
+ * `a`, `b` null or live handles; each `rest` null or valid for `3 * count` doubles; `out`
+ * null or valid for a write.
+ */
+int dhcd_contact_set(struct DhcdHierarchy *a,
+                     struct DhcdHierarchy *b,
+                     double dhat,
+                     const double *rest_a,
+                     size_t rest_a_count,
+                     const double *rest_b,
+                     size_t rest_b_count,
+                     uint32_t threads,
+                     struct DhcdContactSet *out);
+
+/**
+ * The gradient of each row's squared distance with respect to its four vertex slots
+ * (`12 * count` doubles into `out`: row `k`, slot `i`, coordinate `c` at `12 k + 3 i + c`;
+ * zero in unused slots).
+ *
+ * # Safety
+ * `s` null or a set filled by this library; `out` null or valid for `12 * count` doubles.
+ */
+int dhcd_contact_set_gradient(const struct DhcdContactSet *s, double *out);
+
+/**
+ * The Hessian of each row's squared distance (`144 * count` doubles into `out`, row-major
+ * 12 x 12 per row).
+ *
+ * # Safety
+ * `s` null or a set filled by this library; `out` null or valid for `144 * count` doubles.
+ */
+int dhcd_contact_set_hessian(const struct DhcdContactSet *s, double *out);
+
+/**
+ * Releases the arrays of a `DhcdContactSet` and resets it to empty. Null, or an already
+ * released or empty set, is a no-op.
+ *
+ * # Safety
+ * `s` null or a set filled by this library and not modified since.
+ */
+void dhcd_contact_set_free(struct DhcdContactSet *s);
+
+/**
+ * The squared distance of each row's type (0 point-point, 1 point-edge, 2 point-triangle, 3
+ * edge-edge; another is `DHCD_ERR_INVALID_ARGUMENT`) at `x` (`[count][4][3]` doubles, unused
+ * slots ignored), into `out` (`count` doubles).
+ *
+ * # Safety
+ * `types` valid for `count` bytes, `x` for `12 * count` doubles, `out` for `count` doubles.
+ */
+int dhcd_distance_sq(const uint8_t *types, const double *x, size_t count, double *out);
+
+/**
+ * The gradient of `dhcd_distance_sq` of each row (`12 * count` doubles into `out`).
+ *
+ * # Safety
+ * As `dhcd_distance_sq`, `out` valid for `12 * count` doubles.
+ */
+int dhcd_distance_gradient(const uint8_t *types, const double *x, size_t count, double *out);
+
+/**
+ * The Hessian of `dhcd_distance_sq` of each row (`144 * count` doubles into `out`).
+ *
+ * # Safety
+ * As `dhcd_distance_sq`, `out` valid for `144 * count` doubles.
+ */
+int dhcd_distance_hessian(const uint8_t *types, const double *x, size_t count, double *out);
+
+/**
+ * The mesh's unique edges (`*count` of them, `2 * *count` `uint32_t` at `*edges`, smaller
+ * vertex first, sorted): the edge ids of `DhcdContactSet.edges`. The array belongs to the
+ * handle and lives as long as it.
+ *
+ * # Safety
+ * `h` null or a live handle; `edges`, `count` null or valid for a write.
+ */
+int dhcd_hierarchy_edges(struct DhcdHierarchy *h, const uint32_t **edges, size_t *count);
+
+/**
+ * The largest fraction of the step `x0 -> x1` (`3 * vertex_count` doubles each), in `[0,
+ * 1]`, that keeps every vertex-triangle and edge-edge pair at least `min_distance + (1 -
+ * rescaling) (d0 - min_distance)` apart, `d0` its distance at `x0` (the IPC Toolkit's rule,
+ * exactly; `rescaling` in `(0, 1]`, 0.8 in ipctk), into `*step`. Never past the earliest
+ * impact at `min_distance`; 1 when no pair comes within its gap.
+ *
+ * # Safety
+ * `h` null or a live handle; `x0`, `x1` valid for `3 * vertex_count` doubles; `step` null or
+ * valid for a write.
+ */
+int dhcd_collision_free_stepsize(struct DhcdHierarchy *h,
+                                 const double *x0,
+                                 const double *x1,
+                                 size_t vertex_count,
+                                 double min_distance,
+                                 double rescaling,
+                                 uint32_t threads,
+                                 double *step);
+
+/**
+ * `dhcd_collision_free_stepsize` of the pairs between `a` (moving `a0 -> a1`) and `b`
+ * (`b0 -> b1`), different handles of the same method.
+ *
+ * # Safety
+ * `a`, `b` null or live handles; `a0`, `a1` valid for `3 * a_vertex_count` doubles, `b0`,
+ * `b1` for `3 * b_vertex_count`; `step` null or valid for a write.
+ */
+int dhcd_collision_free_stepsize_pair(struct DhcdHierarchy *a,
+                                      const double *a0,
+                                      const double *a1,
+                                      size_t a_vertex_count,
+                                      struct DhcdHierarchy *b,
+                                      const double *b0,
+                                      const double *b1,
+                                      size_t b_vertex_count,
+                                      double min_distance,
+                                      double rescaling,
+                                      uint32_t threads,
+                                      double *step);
 
 /**
  * A new cancel token, not set, into `*out` (release with `dhcd_cancel_free`).

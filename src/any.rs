@@ -5,7 +5,10 @@ use std::sync::Arc;
 
 use crate::bv::Method;
 use crate::calibration::{BroadPhase, Calibration};
-use crate::contact::{contact_set_with, self_contact_set_with, ContactSet};
+use crate::contact::{
+    collision_free_stepsize_pair, collision_free_stepsize_with, contact_set_with,
+    self_contact_set_with, ContactSet, StepOptions, StepSize,
+};
 use crate::error::Result;
 use crate::hierarchy::{Hierarchy, InvariantError};
 use crate::mesh::Mesh;
@@ -151,6 +154,32 @@ impl AnyHierarchy {
         par: Par,
     ) -> Result<ContactSet> {
         each!(self, h => self_contact_set_with(h, dhat, rest, ws, par))
+    }
+
+    /// The collision-free step size of this object moving by `motion` (see
+    /// [`collision_free_stepsize`](crate::contact::collision_free_stepsize())).
+    pub fn collision_free_stepsize(
+        &self,
+        motion: Motion<'_>,
+        options: &StepOptions,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<StepSize> {
+        each!(self, h => collision_free_stepsize_with(h, motion, options, ws, par))
+    }
+
+    /// The collision-free step size of this object and `other` (pairs between them only);
+    /// an error if the methods differ.
+    pub fn collision_free_stepsize_pair(
+        &self,
+        motion: Motion<'_>,
+        other: &AnyHierarchy,
+        other_motion: Motion<'_>,
+        options: &StepOptions,
+        ws: &mut Workspace,
+        par: Par,
+    ) -> Result<StepSize> {
+        pairwise!(self, other, a, b => collision_free_stepsize_pair(a, motion, b, other_motion, options, ws, par)?)
     }
 
     /// The positions the hierarchy was built with (caller's order).

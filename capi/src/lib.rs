@@ -30,8 +30,15 @@
 //! `dhcd::Par::MAX_THREADS` (1024) is `DHCD_ERR_INVALID_ARGUMENT`. Results never depend on it.
 #![warn(missing_docs)]
 
+mod contact;
 mod control;
 
+pub use contact::{
+    dhcd_collision_free_stepsize, dhcd_collision_free_stepsize_pair, dhcd_contact_set,
+    dhcd_contact_set_free, dhcd_contact_set_gradient, dhcd_contact_set_hessian,
+    dhcd_distance_gradient, dhcd_distance_hessian, dhcd_distance_sq, dhcd_hierarchy_edges,
+    dhcd_self_contact_set, DhcdContactSet, DHCD_CLOSEST_NONE,
+};
 pub use control::{
     dhcd_cancel_free, dhcd_cancel_new, dhcd_cancel_reset, dhcd_cancel_set,
     dhcd_hierarchy_set_control, dhcd_scene_set_control, DhcdCancel, DhcdPoll,
@@ -398,7 +405,9 @@ impl From<Error> for Fail {
             Error::OutputLimit { .. } => DHCD_ERR_OUTPUT_LIMIT,
             Error::OutOfMemory { .. } => DHCD_ERR_OUT_OF_MEMORY,
             Error::Cancelled => DHCD_ERR_CANCELLED,
-            Error::WrongVertexCount { .. } => DHCD_ERR_LENGTH_MISMATCH,
+            Error::WrongVertexCount { .. } | Error::LengthMismatch { .. } => {
+                DHCD_ERR_LENGTH_MISMATCH
+            }
             Error::MethodMismatch { .. } => DHCD_ERR_WRONG_KIND,
             Error::UnknownObject(_) => DHCD_ERR_UNKNOWN_OBJECT,
             Error::RepeatedObject(_) => DHCD_ERR_REPEATED_OBJECT,
@@ -420,6 +429,8 @@ impl From<Error> for Fail {
             | Error::InvalidTimeLimit(_)
             | Error::InvalidMinDistance(_)
             | Error::NonFiniteCcdPoint { .. }
+            | Error::UnknownContactType(_)
+            | Error::InvalidRescaling(_)
             | Error::UnknownPrecision(_) => DHCD_ERR_INVALID_ARGUMENT,
             // `Error` is non-exhaustive: a variant added later is a bad argument until it
             // gets a code of its own.

@@ -2985,3 +2985,192 @@ fn limits_cancellation_and_free_points() {
         unsafe { dhcd_hierarchy_free(hf) };
     }
 }
+
+/// The contact set, its derivatives, the batch geometry, the edge table and the step size
+/// through the C ABI equal the Rust API's; bad arguments are error codes.
+#[test]
+fn contact_set_geometry_and_step_size() {
+    use dhcd::contact::{self, ContactType, StepOptions};
+    let rest = dhcd::shapes::grid(6, 6, 0.1, [0.0; 3]);
+    let folded = dhcd::shapes::fold_x(rest.positions(), 0.3);
+    let pose: Vec<[f64; 3]> = dhcd::shapes::jitter(&folded, [0.004; 3], 2)
+        .iter()
+        .map(|p| p.map(f64::from))
+        .collect();
+    let rest64: Vec<[f64; 3]> = rest.positions().iter().map(|p| p.map(f64::from)).collect();
+    let m = Mesh::new_f64(rest64.clone(), rest.triangles().to_vec()).unwrap();
+    let t: Vec<u32> = m.triangles().iter().flatten().copied().collect();
+    let flat_rest: Vec<f64> = rest64.iter().flatten().copied().collect();
+    let mut h = null_mut();
+    // SAFETY: arrays of the stated lengths; writable output.
+    let rc = unsafe {
+        dhcd_hierarchy_new_f64(
+            DHCD_METHOD_DH,
+            4,
+            flat_rest.as_ptr(),
+            m.vertex_count(),
+            t.as_ptr(),
+            m.triangle_count(),
+            &mut h,
+        )
+    };
+    assert_eq!(rc, DHCD_OK, "{}", last_error());
+    let flat_pose: Vec<f64> = pose.iter().flatten().copied().collect();
+    // SAFETY: a live handle and an array of its vertex count.
+    let rc =
+        unsafe { dhcd_hierarchy_update_positions_f64(h, flat_pose.as_ptr(), m.vertex_count()) };
+    assert_eq!(rc, DHCD_OK, "{}", last_error());
+    let mut rh = dhcd::Hierarchy::<dhcd::bv::Dh>::new(&m, dhcd::Options::default()).unwrap();
+    rh.update_positions_f64(&pose).unwrap();
+    let want = contact::self_contact_set(&rh, 0.06).unwrap();
+    assert!(want.len() > 10);
+    let mut s = DhcdContactSet {
+        vertices: null_mut(),
+        types: null_mut(),
+        distance_sq: null_mut(),
+        weights: null_mut(),
+        mollified: null_mut(),
+        edges: null_mut(),
+        closest: null_mut(),
+        positions: null_mut(),
+        count: 7,
+        counters: no_proximity().counters,
+    };
+    // SAFETY: a live handle, no rest array, writable output.
+    let rc = unsafe { dhcd_self_contact_set(h, 0.06, null(), 0, 2, &mut s) };
+    assert_eq!(rc, DHCD_OK, "{}", last_error());
+    assert_eq!(s.count, want.len());
+    let n = s.count;
+    // SAFETY: the arrays of a filled set hold `count` rows.
+    let (vertices, types, dist, moll, edges) = unsafe {
+        (
+            std::slice::from_raw_parts(s.vertices, 4 * n),
+            std::slice::from_raw_parts(s.types, n),
+            std::slice::from_raw_parts(s.distance_sq, n),
+            std::slice::from_raw_parts(s.mollified, n),
+            std::slice::from_raw_parts(s.edges, 2 * n),
+        )
+    };
+    for (k, c) in want.contacts.iter().enumerate() {
+        let v: Vec<i64> = c
+            .vertices
+            .iter()
+            .map(|&v| if v == contact::NONE { -1 } else { v as i64 })
+            .collect();
+        assert_eq!(&vertices[4 * k..4 * k + 4], &v[..]);
+        assert_eq!(types[k], c.kind as u8);
+        assert_eq!(dist[k], c.distance_sq);
+        assert_eq!(moll[k], c.mollified as u8);
+        let e: Vec<i64> = c
+            .edges
+            .iter()
+            .map(|&e| if e == contact::NONE { -1 } else { e as i64 })
+            .collect();
+        assert_eq!(&edges[2 * k..2 * k + 2], &e[..]);
+    }
+    let mut g = vec![0.0; 12 * n];
+    let mut hs = vec![0.0; 144 * n];
+    // SAFETY: a filled set and outputs of the stated sizes.
+    unsafe {
+        assert_eq!(dhcd_contact_set_gradient(&s, g.as_mut_ptr()), DHCD_OK);
+        assert_eq!(dhcd_contact_set_hessian(&s, hs.as_mut_ptr()), DHCD_OK);
+    }
+    let wg: Vec<f64> = want.gradients().into_iter().flatten().collect();
+    let wh: Vec<f64> = want.hessians().into_iter().flatten().flatten().collect();
+    assert_eq!(g, wg);
+    assert_eq!(hs, wh);
+    // The edge table.
+    let (mut ep, mut ec) = (null(), 0usize);
+    // SAFETY: a live handle and writable outputs; the table lives with the handle.
+    let table = unsafe {
+        assert_eq!(dhcd_hierarchy_edges(h, &mut ep, &mut ec), DHCD_OK);
+        std::slice::from_raw_parts(ep, 2 * ec)
+    };
+    let want_edges: Vec<u32> = rh.tree().edges().iter().flatten().copied().collect();
+    assert_eq!(table, &want_edges[..]);
+    // SAFETY: a filled set, released twice (the second a no-op), then null.
+    unsafe {
+        dhcd_contact_set_free(&mut s);
+        assert!(s.vertices.is_null() && s.count == 0);
+        dhcd_contact_set_free(&mut s);
+        dhcd_contact_set_free(null_mut());
+    }
+    // Bad arguments: negative dhat, a rest array of the wrong length is caught by count.
+    // SAFETY: as above.
+    unsafe {
+        assert_eq!(
+            dhcd_self_contact_set(h, -1.0, null(), 0, 1, &mut s),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+        let short = [0.0f64; 9];
+        assert_eq!(
+            dhcd_self_contact_set(h, 0.06, short.as_ptr(), 3, 1, &mut s),
+            DHCD_ERR_LENGTH_MISMATCH
+        );
+        assert_eq!(
+            dhcd_self_contact_set(h, 0.06, null(), 0, 1, null_mut()),
+            DHCD_ERR_NULL
+        );
+    }
+    // Batch geometry: a point above a triangle.
+    let x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let (mut d, mut gr) = (0.0f64, [0.0f64; 12]);
+    // SAFETY: arrays of one row.
+    unsafe {
+        assert_eq!(
+            dhcd_distance_sq([2u8].as_ptr(), x.as_ptr(), 1, &mut d),
+            DHCD_OK
+        );
+        assert_eq!(
+            dhcd_distance_gradient([2u8].as_ptr(), x.as_ptr(), 1, gr.as_mut_ptr()),
+            DHCD_OK
+        );
+        assert_eq!(
+            dhcd_distance_sq([9u8].as_ptr(), x.as_ptr(), 1, &mut d),
+            DHCD_ERR_INVALID_ARGUMENT
+        );
+    }
+    assert_eq!(d, 1.0);
+    assert_eq!(&gr[..3], &[0.0, 0.0, 2.0]);
+    let _ = ContactType::PointTriangle;
+    // The step size of the fold closing: equal to Rust's.
+    let later: Vec<[f64; 3]> = dhcd::shapes::fold_x(rest.positions(), 0.25)
+        .iter()
+        .map(|p| p.map(f64::from))
+        .collect();
+    let flat_later: Vec<f64> = later.iter().flatten().copied().collect();
+    let want = contact::collision_free_stepsize(
+        &rh,
+        dhcd::Motion::new(&pose, &later),
+        &StepOptions::default(),
+    )
+    .unwrap();
+    let mut step = -1.0;
+    // SAFETY: a live handle, arrays of its vertex count, writable output.
+    unsafe {
+        let rc = dhcd_collision_free_stepsize(
+            h,
+            flat_pose.as_ptr(),
+            flat_later.as_ptr(),
+            m.vertex_count(),
+            0.0,
+            0.8,
+            1,
+            &mut step,
+        );
+        assert_eq!(rc, DHCD_OK, "{}", last_error());
+        assert_eq!(step, want.step);
+        let rc = dhcd_collision_free_stepsize(
+            h,
+            flat_pose.as_ptr(),
+            flat_later.as_ptr(),
+            m.vertex_count(),
+            0.0,
+            1.5,
+            1,
+            &mut step,
+        );
+        assert_eq!(rc, DHCD_ERR_INVALID_ARGUMENT);
+        dhcd_hierarchy_free(h);
+    }
+}

@@ -61,6 +61,7 @@ __all__ = [
     "Scene",
     "ccd",
     "collide",
+    "collision_free_stepsize",
     "contact_segments",
     "contact_set",
     "distance_gradient",
@@ -318,6 +319,38 @@ def contact_set(
 ) -> ContactSet:
     """Every pair of features of ``a`` and ``b`` within ``dhat``, once; vertices numbered
     ``a``'s first, then ``b``'s (offset by ``a.vertex_count``), edges likewise."""
+
+@overload
+def collision_free_stepsize(
+    h: Hierarchy,
+    x0: Positions64,
+    x1: Positions64,
+    min_distance: float = 0.0,
+    rescaling: float = 0.8,
+    threads: int = 1,
+) -> float:
+    """The largest fraction of the step ``x0 -> x1`` (float64 ``(n, 3)``), in ``[0, 1]``,
+    that keeps every vertex-face and edge-edge pair at least ``min_distance + (1 -
+    rescaling) * (d0 - min_distance)`` apart, ``d0`` its distance at ``x0`` (the IPC
+    Toolkit's rule, applied exactly to every pair; ipctk caps that gap at 1e-4). Never past
+    the earliest impact at ``min_distance`` (within 1e-12 below it), 1.0 when no pair comes
+    within its gap. A line search starts at ``alpha = collision_free_stepsize(...)`` and
+    only shrinks it. ``rescaling`` outside ``(0, 1]`` or a bad ``min_distance`` raises
+    ``ValueError``."""
+
+@overload
+def collision_free_stepsize(
+    a: Hierarchy,
+    b: Hierarchy,
+    a0: Positions64,
+    a1: Positions64,
+    b0: Positions64,
+    b1: Positions64,
+    min_distance: float = 0.0,
+    rescaling: float = 0.8,
+    threads: int = 1,
+) -> float:
+    """The step size of the pairs between two meshes (as for one)."""
 
 def distance_sq(
     types: npt.ArrayLike, x: npt.NDArray[np.float64]

@@ -215,12 +215,12 @@ pub(crate) fn contact_set(
     ContactSet::new(py, set)
 }
 
+/// A batch of rows: the types and each row's four vertex slots.
+type Batch = (Vec<ContactType>, Vec<[[f64; 3]; 4]>);
+
 /// The types and positions of a batch: `types` `(K,)` integers 0..=3, `x` float64
 /// `(K, 4, 3)`.
-fn batch_args(
-    types: &Bound<'_, PyAny>,
-    x: &Bound<'_, PyAny>,
-) -> PyResult<(Vec<ContactType>, Vec<[[f64; 3]; 4]>)> {
+fn batch_args(types: &Bound<'_, PyAny>, x: &Bound<'_, PyAny>) -> PyResult<Batch> {
     let np = types.py().import("numpy")?;
     let t = super::array_of_numbers(types, "types")?;
     let t: Vec<i64> = np

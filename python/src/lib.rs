@@ -21,6 +21,7 @@
 
 mod contact;
 mod interrupt;
+mod step;
 
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
@@ -1575,6 +1576,8 @@ mod dhcd_native {
     use super::contact::{
         contact_set, distance_gradient, distance_hessian, distance_sq, self_contact_set, ContactSet,
     };
+    #[pymodule_export]
+    use super::step::collision_free_stepsize;
     #[pymodule_export]
     use super::{
         ccd, collide, contact_segments, edge_edge_ccd, load_mesh, max_pairs, proximity,

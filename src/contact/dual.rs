@@ -138,10 +138,10 @@ impl<const N: usize> Mul for Hess<N> {
             g: std::array::from_fn(|i| self.v * o.g[i] + o.v * self.g[i]),
             h: std::array::from_fn(|i| {
                 std::array::from_fn(|j| {
+                    // The symmetric pair summed first: the result is exactly symmetric.
                     self.v * o.h[i][j]
                         + o.v * self.h[i][j]
-                        + self.g[i] * o.g[j]
-                        + o.g[i] * self.g[j]
+                        + (self.g[i] * o.g[j] + o.g[i] * self.g[j])
                 })
             }),
         }
@@ -160,7 +160,7 @@ impl<const N: usize> Div for Hess<N> {
             g,
             h: std::array::from_fn(|i| {
                 std::array::from_fn(|j| {
-                    (self.h[i][j] - q * o.h[i][j] - g[i] * o.g[j] - o.g[i] * g[j]) / o.v
+                    (self.h[i][j] - q * o.h[i][j] - (g[i] * o.g[j] + o.g[i] * g[j])) / o.v
                 })
             }),
         }

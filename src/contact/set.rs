@@ -56,6 +56,22 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// The squared distance of the row's features at `x` (its vertex slots), by the formula
+    /// of its type, or of its closest features for an edge-edge row.
+    pub fn distance_sq_at(&self, x: &[[f64; 3]; 4]) -> f64 {
+        self.formula().distance_sq(x)
+    }
+
+    /// The gradient of [`Contact::distance_sq_at`] (slot `i`, coordinate `c` at `3 i + c`).
+    pub fn gradient_at(&self, x: &[[f64; 3]; 4]) -> [f64; 12] {
+        self.formula().gradient(x)
+    }
+
+    /// The Hessian of [`Contact::distance_sq_at`].
+    pub fn hessian_at(&self, x: &[[f64; 3]; 4]) -> [[f64; 12]; 12] {
+        self.formula().hessian(x)
+    }
+
     pub(crate) fn formula(&self) -> Formula {
         match self.closest {
             Some(kind) => Formula::of_edge_edge(kind),
