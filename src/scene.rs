@@ -25,6 +25,7 @@ use rayon::prelude::*;
 
 use crate::bv::swept::{box_over_step, f32_up, Step};
 use crate::bv::{BoundingVolume, Method};
+use crate::contact::{self, ContactSet};
 use crate::control::{Budget, Control};
 use crate::counters::Counters;
 use crate::error::{Error, Positions, Result};
@@ -507,10 +508,72 @@ impl Scene {
         })
     }
 
+    /// Every pair of features within `dhat` between every two objects, and inside every
+    /// object with self-collision on, once, as [`crate::contact::self_contact_set`] types
+    /// them, in one global numbering: each object's vertices and edges follow those of the
+    /// objects added before it ([`Scene::vertex_offset`], [`Scene::edge_offset`]). Sorted by
+    /// type, then vertices; every row's columns in the same order whichever object owns a
+    /// vertex. The result does not depend on `par`.
+    pub fn contact_set(&mut self, dhat: f64, par: Par) -> Result<ContactSet> {
+        let rows = self.proximity(dhat, par)?;
+        each!(&self.objects, v => contact_set_of(v, rows))
+    }
+
+    /// Where object `id`'s vertices start in the scene's global numbering (the contact
+    /// set's): the vertex count of the objects added before it and still in the scene.
+    pub fn vertex_offset(&self, id: ObjectId) -> Result<u64> {
+        let i = self.index(id)?;
+        Ok(each!(&self.objects, v => v[..i].iter().map(|o| o.h.tree().vertex_total() as u64).sum()))
+    }
+
+    /// Where object `id`'s edge ids start in the global numbering: the edge count
+    /// ([`crate::RegionTree::edges`]) of the objects before it.
+    pub fn edge_offset(&self, id: ObjectId) -> Result<u64> {
+        let i = self.index(id)?;
+        Ok(each!(&self.objects, v => v[..i].iter().map(|o| o.h.tree().edges().len() as u64).sum()))
+    }
+
     fn index(&self, id: ObjectId) -> Result<usize> {
         each!(&self.objects, v => v.binary_search_by_key(&id.0, |o| o.id))
             .map_err(|_| Error::UnknownObject(id.0))
     }
+}
+
+/// [`Scene::contact_set`] of the proximity `rows` of `objects`.
+fn contact_set_of<K: BoundingVolume>(
+    objects: &[Object<K>],
+    rows: SceneProximity,
+) -> Result<ContactSet> {
+    let (mut vertex_offsets, mut edge_offsets) = (Vec::new(), Vec::new());
+    let (mut vo, mut eo) = (0usize, 0usize);
+    for o in objects {
+        vertex_offsets.push(contact::offset(vo, o.h.tree().vertex_total())?);
+        edge_offsets.push(contact::offset(eo, o.h.tree().edges().len())?);
+        vo += o.h.tree().vertex_total();
+        eo += o.h.tree().edges().len();
+    }
+    let index = |id: ObjectId| {
+        objects
+            .binary_search_by_key(&id.0, |o| o.id)
+            .expect("an object of the scene")
+    };
+    let side =
+        |i: usize| contact::Side::new(&objects[i].h, None, vertex_offsets[i], edge_offsets[i]);
+    let mut set = ContactSet::default();
+    for pair in rows.per_pair {
+        let (ia, ib) = (index(pair.a), index(pair.b));
+        let part = contact::from_rows(pair.proximity, &side(ia)?, &side(ib)?);
+        set.contacts.extend(part.contacts);
+        set.positions.extend(part.positions);
+    }
+    // Object pairs hold disjoint vertices: one global order by (type, vertices).
+    let mut order: Vec<usize> = (0..set.contacts.len()).collect();
+    order.sort_unstable_by_key(|&k| (set.contacts[k].kind, set.contacts[k].vertices));
+    set.contacts = order.iter().map(|&k| set.contacts[k]).collect();
+    set.positions = order.iter().map(|&k| set.positions[k]).collect();
+    set.counters = rows.counters;
+    set.counters.contacts = set.contacts.len() as u64;
+    Ok(set)
 }
 
 /// [`Scene::proximity`] once the distance is checked: every job counted against `budget`.

@@ -444,3 +444,64 @@ fn batch_geometry_checks_its_input() {
         Err(Error::UnknownContactType(7))
     ));
 }
+
+/// A scene's contact set is the contact set of all its objects as one mesh (self-collision
+/// on everywhere), in the global numbering: each object's vertices and edges after those of
+/// the objects added before it.
+#[test]
+fn a_scene_numbers_its_objects_in_order() {
+    use dhcd::scene::Scene;
+    let rest = grid(7, 7, 0.1, [0.0, 0.0, 0.0]);
+    let folded = f64_mesh(
+        &rest,
+        jitter(&fold_x(rest.positions(), 0.35), [0.003; 3], 4),
+    );
+    let below = f64_mesh(
+        &grid(5, 5, 0.15, [0.0; 3]),
+        jitter(
+            grid(5, 5, 0.15, [-0.05, -0.05, -0.03]).positions(),
+            [0.0, 0.0, 0.01],
+            8,
+        ),
+    );
+    let far = f64_mesh(
+        &grid(2, 2, 0.1, [0.0; 3]),
+        grid(2, 2, 0.1, [9.0, 9.0, 9.0]).positions().to_vec(),
+    );
+    let objects = [&folded, &below, &far];
+    // One mesh of all three.
+    let (mut p, mut t) = (Vec::new(), Vec::new());
+    for m in objects {
+        let o = p.len() as u32;
+        t.extend(m.triangles().iter().map(|tri| tri.map(|v| v + o)));
+        p.extend_from_slice(m.positions_f64().unwrap());
+    }
+    let all = Mesh::new_f64(p, t).unwrap();
+    let dhat = 0.06;
+    let h = Hierarchy::<dhcd::bv::Sphere>::new(&all, Options::default()).unwrap();
+    let want = contact::self_contact_set(&h, dhat).unwrap();
+    assert!(want.len() > 10);
+    for par in [Par::Seq, Par::Rayon(2)] {
+        let mut scene = Scene::new(dhcd::Method::Sphere, Options::default());
+        let ids: Vec<_> = objects.iter().map(|m| scene.add(m).unwrap()).collect();
+        for &id in &ids {
+            scene.set_self_collision(id, true).unwrap();
+        }
+        let got = scene.contact_set(dhat, par).unwrap();
+        assert_same(&as_map(&got), &as_map(&want), &format!("scene {par:?}"));
+        assert_eq!(got.contacts, want.contacts);
+        let offsets: Vec<u64> = ids
+            .iter()
+            .map(|&id| scene.vertex_offset(id).unwrap())
+            .collect();
+        assert_eq!(offsets, [0, 64, 100]);
+        let e = scene.edge_offset(ids[2]).unwrap();
+        let e1 = scene.edge_offset(ids[1]).unwrap();
+        assert_eq!(e1, 7 * 8 * 2 + 7 * 7);
+        assert!(e > e1);
+        // Removing an object renumbers the ones after it.
+        scene.remove(ids[0]).unwrap();
+        assert_eq!(scene.vertex_offset(ids[1]).unwrap(), 0);
+        assert!(scene.vertex_offset(ids[0]).is_err());
+    }
+}

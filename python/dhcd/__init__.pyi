@@ -516,6 +516,15 @@ class Scene:
         """Every vertex-face, face-vertex and edge-edge pair within distance ``d`` between
         two objects, and inside each object with self-collision on: rows with object ids
         (see ``Proximity``), sorted. Objects farther apart than ``d`` cost one box test."""
+    def contact_set(self, dhat: float, threads: int = 1) -> ContactSet:
+        """Every pair of features within ``dhat`` between objects and inside objects with
+        self-collision on, once (see ``ContactSet``), in one global numbering: each object's
+        vertices and edges follow those of the objects added before it (``vertex_offset``,
+        ``edge_offset``)."""
+    def vertex_offset(self, id: Union[int, str]) -> int:
+        """Where the object's vertices start in the global numbering of ``contact_set``."""
+    def edge_offset(self, id: Union[int, str]) -> int:
+        """Where the object's edge ids start in the global numbering of ``contact_set``."""
     def ccd(
         self,
         motions: Motions,

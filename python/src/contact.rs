@@ -52,7 +52,7 @@ fn table<T: numpy::Element, const N: usize>(
 }
 
 impl ContactSet {
-    fn new(py: Python<'_>, set: dhcd::ContactSet) -> PyResult<Self> {
+    pub(crate) fn new(py: Python<'_>, set: dhcd::ContactSet) -> PyResult<Self> {
         let c = &set.contacts;
         Ok(Self {
             vertices: table(py, c.iter().map(|c| c.vertices.map(ids)))?,

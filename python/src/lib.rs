@@ -1491,6 +1491,39 @@ impl Scene {
         Proximity::new(py, rows)
     }
 
+    /// Every pair of features within `dhat` between objects and inside objects with
+    /// self-collision on, once (a `ContactSet`), in one global numbering: each object's
+    /// vertices and edges after those of the objects added before it (`vertex_offset`,
+    /// `edge_offset`).
+    #[pyo3(signature = (dhat, threads = None), text_signature = "(self, dhat, threads=1)")]
+    fn contact_set(
+        &mut self,
+        py: Python<'_>,
+        dhat: &Bound<'_, PyAny>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<contact::ContactSet> {
+        let dhat = distance_arg(dhat)?;
+        let par = par(threads)?;
+        let scene = &mut self.scene;
+        let set = interrupt::run(py, par, |control| {
+            scene.set_control(control.clone());
+            scene.contact_set(dhat, par)
+        })?;
+        contact::ContactSet::new(py, set)
+    }
+
+    /// Where object `id`'s vertices start in the global numbering of `contact_set`.
+    fn vertex_offset(&self, id: &Bound<'_, PyAny>) -> PyResult<u64> {
+        let id = self.object(id)?;
+        self.scene.vertex_offset(id).map_err(to_py)
+    }
+
+    /// Where object `id`'s edge ids start in the global numbering of `contact_set`.
+    fn edge_offset(&self, id: &Bound<'_, PyAny>) -> PyResult<u64> {
+        let id = self.object(id)?;
+        self.scene.edge_offset(id).map_err(to_py)
+    }
+
     /// Continuous collision detection of the whole scene over one step: `motions` maps
     /// objects to `(x0, x1)` (float64 `(n, 3)` each); the other objects stay still.
     #[pyo3(

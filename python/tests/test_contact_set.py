@@ -215,3 +215,26 @@ def test_derivatives_equal_ipctk_per_type_functions():
             want_h = np.asarray(hess(x[k]))
             assert np.allclose(g[k, :n], want_g, rtol=1e-9, atol=1e-12), (t, k)
             assert np.allclose(h[k, :n, :n], want_h, rtol=1e-8, atol=1e-10), (t, k)
+
+
+def test_scene_contact_set_is_the_pair_set_in_global_numbering():
+    va, fa = grid(4, 4, 0.25)
+    vb, fb = grid(3, 3, 0.3)
+    va = va.astype(np.float64)
+    vb = vb.astype(np.float64) + np.array([0.05, 0.05, 0.02])
+    scene = dhcd.Scene()
+    ia = scene.add(va, fa, name="a")
+    ib = scene.add(vb, fb)
+    got = scene.contact_set(0.05, threads=2)
+    want = dhcd.contact_set(dhcd.Hierarchy(va, fa), dhcd.Hierarchy(vb, fb), 0.05)
+    assert len(got) == len(want) > 0
+    for col in ("vertices", "type", "distance_sq", "weights", "mollified", "edges"):
+        assert np.array_equal(getattr(got, col), getattr(want, col)), col
+    assert scene.vertex_offset("a") == 0
+    assert scene.vertex_offset(ib) == len(va)
+    assert scene.edge_offset(ib) == len(dhcd.Hierarchy(va, fa).edges())
+    with pytest.raises(ValueError):
+        scene.vertex_offset(99)
+    with pytest.raises(ValueError):
+        scene.contact_set(-1.0)
+    assert ia == 0

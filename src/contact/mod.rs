@@ -25,6 +25,8 @@ pub mod geometry;
 mod set;
 mod step;
 
+pub(crate) use set::{from_rows, offset, Side};
+
 pub use geometry::{distance_gradient, distance_hessian, distance_sq, ContactType};
 pub use set::{
     contact_set, contact_set_with, self_contact_set, self_contact_set_with, Contact, ContactSet,

@@ -389,25 +389,56 @@ impl Gap {
     /// b0, b1]`, at t0): its minimum distance by the rule, from its distance at t0 (the
     /// exact closest features' `f64` distance, rounded up a few ulps so that the kept gap is
     /// never below the rule's).
+    ///
+    /// `None` when the pair cannot reach its gap: its distance at t0 exceeds the gap plus the
+    /// most its features can approach each other (the largest displacement of a vertex of
+    /// each feature, summed: a point of a feature is a fixed convex combination of its
+    /// vertices, so it moves no farther than they do), decided exactly.
     #[inline]
     pub(crate) fn options(
         &self,
         vertex_face: bool,
         x0: &[[f64; 3]; 4],
+        x1: &[[f64; 3]; 4],
         o: CcdOptions,
-    ) -> CcdOptions {
+    ) -> Option<CcdOptions> {
+        use crate::distance::{edge_edge_distance_sq, edge_edge_within};
+        use crate::distance::{point_triangle_distance_sq, point_triangle_within};
         let d0_sq = if vertex_face {
-            crate::distance::point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
+            point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
         } else {
-            crate::distance::edge_edge_distance_sq(x0[0], x0[1], x0[2], x0[3]).0
+            edge_edge_distance_sq(x0[0], x0[1], x0[2], x0[3]).0
         };
         let d0 = d0_sq.sqrt();
         let g = self.min_distance + (1.0 - self.rescaling) * (d0 - self.min_distance);
         let g = (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0);
-        CcdOptions {
-            min_distance: if g.is_finite() { g } else { f64::MAX },
-            ..o
+        let g = if g.is_finite() { g } else { f64::MAX };
+        let moved = |k: usize| {
+            let d = [0, 1, 2].map(|c| x1[k][c] - x0[k][c]);
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        };
+        let (first, second) = if vertex_face {
+            (0..1, 1..4)
+        } else {
+            (0..2, 2..4)
+        };
+        let approach = first.map(moved).fold(0.0, f64::max) + second.map(moved).fold(0.0, f64::max);
+        // Rounded up (each operation above is within a few ulps).
+        let reach = (g + approach) * (1.0 + 16.0 * f64::EPSILON);
+        if reach.is_finite() {
+            let near = if vertex_face {
+                point_triangle_within(x0[0], [x0[1], x0[2], x0[3]], reach).is_some()
+            } else {
+                edge_edge_within(x0[0], x0[1], x0[2], x0[3], reach).is_some()
+            };
+            if !near {
+                return None;
+            }
         }
+        Some(CcdOptions {
+            min_distance: g,
+            ..o
+        })
     }
 }
 
@@ -659,7 +690,10 @@ fn vertex_face_toi<K: BoundingVolume>(
         st.step.x1[c[1]],
         st.step.x1[c[2]],
     ];
-    let options = gap.map_or(*options, |g| g.options(true, &x0, *options));
+    let options = match gap {
+        None => *options,
+        Some(g) => g.options(true, &x0, &x1, *options)?,
+    };
     // Stopped: no answer; the budget has stopped the query, which returns the error.
     ccd::pair_until(true, &x0, &x1, &options, stop).unwrap_or(None)
 }
@@ -675,7 +709,10 @@ fn edge_edge_toi(
 ) -> Option<f64> {
     let x0 = [a[0].0, a[1].0, b[0].0, b[1].0];
     let x1 = [a[0].1, a[1].1, b[0].1, b[1].1];
-    let options = gap.map_or(*options, |g| g.options(false, &x0, *options));
+    let options = match gap {
+        None => *options,
+        Some(g) => g.options(false, &x0, &x1, *options)?,
+    };
     ccd::pair_until(false, &x0, &x1, &options, stop).unwrap_or(None)
 }
 
