@@ -1,6 +1,6 @@
 """An IPC-style implicit step on a small cloth scene, with dhcd doing the collision work.
 
-A 12 x 12 mass-spring sheet falls under gravity onto a fixed, slightly tilted sheet. Each
+A 10 x 10 mass-spring sheet falls under gravity onto a fixed, slightly tilted sheet. Each
 time step minimises the incremental potential
 
     E(x) = 1/2 |x - x_pred|_M^2 + h^2 (springs(x) + kappa * sum_k b(d_k^2(x)))
@@ -12,7 +12,7 @@ a backtracking line search that starts at the collision-free step size
 (`dhcd.collision_free_stepsize`) and only shrinks it. It prints the time spent in dhcd per
 time step, and checks that the cloth reached the floor and no pair ever touched.
 
-Run: python python/examples/ipc_step.py [--steps 30] [--n 12]
+Run: python python/examples/ipc_step.py [--steps 25] [--n 10]
 """
 
 import argparse
@@ -23,8 +23,8 @@ import numpy as np
 import dhcd
 
 ap = argparse.ArgumentParser()
-ap.add_argument("--steps", type=int, default=30)
-ap.add_argument("--n", type=int, default=12)
+ap.add_argument("--steps", type=int, default=25)
+ap.add_argument("--n", type=int, default=10)
 args = ap.parse_args()
 
 
@@ -43,7 +43,7 @@ def sheet(n, size, origin, tilt=0.0):
 
 # The scene: the cloth (free) above the obstacle (fixed), one mesh.
 cloth_v, cloth_f = sheet(args.n, 1.0, (0.0, 0.0, 0.08))
-floor_v, floor_f = sheet(8, 1.6, (-0.3, -0.3, 0.0), tilt=0.05)
+floor_v, floor_f = sheet(6, 1.6, (-0.3, -0.3, 0.0), tilt=0.05)
 nc = len(cloth_v)
 rest = np.vstack([cloth_v, floor_v])
 faces = np.vstack([cloth_f, floor_f + nc])
@@ -63,24 +63,40 @@ rest_len = np.linalg.norm(cloth_v[edges_of_cloth[:, 0]] - cloth_v[edges_of_cloth
 hier = dhcd.Hierarchy(rest, faces)
 
 
-def springs(x):
+def assemble(n, idx, grad, hess_blocks):
+    """Scatter per-element gradients `(m, k)` and Hessian blocks `(m, k, k)` at dof indices
+    `idx` `(m, k)` (negative: unused) into a dense gradient and Hessian of size n."""
+    used = idx >= 0
+    g = np.zeros(n)
+    np.add.at(g, idx[used], grad[used])
+    H = None
+    if hess_blocks is not None:
+        H = np.zeros((n, n))
+        both = used[:, :, None] & used[:, None, :]
+        rows = np.broadcast_to(idx[:, :, None], hess_blocks.shape)
+        cols = np.broadcast_to(idx[:, None, :], hess_blocks.shape)
+        np.add.at(H, (rows[both], cols[both]), hess_blocks[both])
+    return g, H
+
+
+def springs(x, need_hessian=True):
     """Energy, gradient and (projected) Hessian of the cloth's edge springs."""
     d = x[edges_of_cloth[:, 1]] - x[edges_of_cloth[:, 0]]
     length = np.linalg.norm(d, axis=1)
     stretch = length - rest_len
     e = 0.5 * k_spring * np.sum(stretch**2)
     u = d / length[:, None]
-    fvec = (k_spring * stretch)[:, None] * u
-    g = np.zeros_like(x)
-    np.add.at(g, edges_of_cloth[:, 1], fvec)
-    np.add.at(g, edges_of_cloth[:, 0], -fvec)
-    H = np.zeros((x.size, x.size))
-    for (a, b), uu, s, L in zip(edges_of_cloth, u, stretch, length):
-        # k (u u^T + max(s / L, 0) (I - u u^T)): the spring's Hessian, made positive.
-        block = k_spring * (np.outer(uu, uu) + max(s / L, 0.0) * (np.eye(3) - np.outer(uu, uu)))
-        for p, q, sign in ((a, a, 1), (b, b, 1), (a, b, -1), (b, a, -1)):
-            H[3 * p : 3 * p + 3, 3 * q : 3 * q + 3] += sign * block
-    return e, g.ravel(), H
+    f = (k_spring * stretch)[:, None] * u
+    idx = (3 * edges_of_cloth[:, :, None] + np.arange(3)).reshape(-1, 6)
+    blocks = None
+    if need_hessian:
+        # k (u u^T + max(s / L, 0) (I - u u^T)) per spring, in the pattern [[B, -B], [-B, B]].
+        uu = u[:, :, None] * u[:, None, :]
+        c = np.maximum(stretch / length, 0.0)[:, None, None]
+        b = k_spring * (uu + c * (np.eye(3) - uu))
+        blocks = np.block([[b, -b], [-b, b]])
+    g, H = assemble(x.size, idx, np.hstack([-f, f]), blocks)
+    return e, g, H
 
 
 def barrier(s):
@@ -104,25 +120,23 @@ def contact_terms(x, need_hessian):
     s0 = time.perf_counter()
     hier.update(x)
     cs = dhcd.self_contact_set(hier, dhat)
-    grad_s = cs.gradient()
+    grad_s = cs.gradient() if need_hessian else None
     timing["dhcd"] += time.perf_counter() - s0
     b, db, ddb = barrier(cs.distance_sq)
-    e = np.sum(b)
-    g = np.zeros(x.size)
-    H = np.zeros((x.size, x.size)) if need_hessian else None
-    for k in range(len(cs)):
-        used = cs.vertices[k][cs.vertices[k] >= 0]
-        idx = (3 * used[:, None] + np.arange(3)).ravel()
-        gk = grad_s[k, : idx.size]
-        g[idx] += db[k] * gk
-        if need_hessian:
-            H[np.ix_(idx, idx)] += ddb[k] * np.outer(gk, gk)
-    return e, g, H, cs
+    if not need_hessian:
+        return np.sum(b), None, None, cs
+    # Dof indices of each row's four vertex slots (-1 where a slot is unused).
+    v = cs.vertices
+    idx = np.where(np.repeat(v >= 0, 3, axis=1), (3 * v[:, :, None] + np.arange(3)).reshape(-1, 12), -1)
+    # Gauss-Newton: b'' grad(d^2) grad(d^2)^T, positive where b'' is.
+    blocks = ddb[:, None, None] * grad_s[:, :, None] * grad_s[:, None, :]
+    g, H = assemble(x.size, idx, db[:, None] * grad_s, blocks)
+    return np.sum(b), g, H, cs
 
 
 def energy(x, x_pred):
     inertia = 0.5 * mass * np.sum((x[free] - x_pred[free]) ** 2)
-    es, _, _ = springs(x)
+    es, _, _ = springs(x, need_hessian=False)
     eb, _, _, _ = contact_terms(x, False)
     return inertia + h * h * (es + kappa * eb)
 
