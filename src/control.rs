@@ -28,7 +28,8 @@ pub const DEFAULT_MAX_PAIRS: u64 = 1 << 25;
 /// How often a walk task calls [`Control::poll`]: once every this many leaf pairs.
 pub(crate) const POLL_EVERY: u32 = 64;
 
-/// Limits and cancellation of a query (see the [module](self)).
+/// Limits and cancellation of a query: the most result pairs, and a flag or poll function that
+/// stops it (see [`Error::OutputLimit`], [`Error::OutOfMemory`], [`Error::Cancelled`]).
 #[derive(Clone)]
 pub struct Control {
     /// The most result pairs the query may return ([`DEFAULT_MAX_PAIRS`]; `u64::MAX`: no
