@@ -17,11 +17,16 @@
 //! below `1e-6` comes out it tests again at `dmin` alone and scales that time by 0.8. dhcd
 //! applies the rule as stated, exactly, for every pair.
 //!
-//! Which pairs are tested: any pair that reaches its `g` closes by `rescaling (d0 -
+//! Which pairs are tested: the earliest impact at `min_distance` is found first (plain CCD);
+//! the step is at most that time, so the walk then tests only pairs that can reach their gap
+//! by it (the distance at t0 against the most the features can approach by then, decided
+//! exactly). Any pair that reaches its `g` closes by `rescaling (d0 -
 //! min_distance)` within the step, which it cannot do unless `d0 - min_distance <= M /
-//! rescaling`, `M` twice the largest vertex displacement of the step; so every such pair comes
-//! within `min_distance + (1 - rescaling) M / rescaling` of the other, and the walk culls at
-//! that distance.
+//! rescaling`, `M` twice the largest vertex displacement by the first impact `T` (`T` times
+//! that of the step); so every such pair comes within `min_distance + (1 - rescaling) M /
+//! rescaling` of the other, and the walk culls at that distance.
+
+use std::sync::atomic::AtomicU64;
 
 use crate::bv::BoundingVolume;
 use crate::ccd::CcdOptions;
@@ -81,7 +86,7 @@ pub struct StepSize {
 }
 
 /// The rule's culling distance for the motions `steps` (see the [module](self)).
-fn cull_distance(options: &StepOptions, steps: &[Motion<'_>]) -> f64 {
+fn cull_distance(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> f64 {
     let mut largest = 0.0f64;
     for m in steps {
         for (p, q) in m.x0.iter().zip(m.x1) {
@@ -91,7 +96,8 @@ fn cull_distance(options: &StepOptions, steps: &[Motion<'_>]) -> f64 {
     }
     let s = options.rescaling;
     // Rounded up: a few ulps of slack on every operation above.
-    let d = options.min_distance + (1.0 - s) / s * 2.0 * largest;
+    // Pairs need only reach their gap by time `by`: vertices move `by` of their step.
+    let d = options.min_distance + (1.0 - s) / s * 2.0 * largest * by;
     let d = d * (1.0 + 16.0 * f64::EPSILON);
     if d.is_finite() {
         d
@@ -100,11 +106,11 @@ fn cull_distance(options: &StepOptions, steps: &[Motion<'_>]) -> f64 {
     }
 }
 
-fn query_for(options: &StepOptions, steps: &[Motion<'_>]) -> (CcdQuery, Gap) {
+fn query_for(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> (CcdQuery, Gap) {
     let query = CcdQuery {
         options: CcdOptions {
             t_max: 1.0,
-            min_distance: cull_distance(options, steps),
+            min_distance: cull_distance(options, steps, by),
         },
         mode: CcdMode::Earliest,
     };
@@ -113,6 +119,41 @@ fn query_for(options: &StepOptions, steps: &[Motion<'_>]) -> (CcdQuery, Gap) {
         rescaling: options.rescaling,
     };
     (query, gap)
+}
+
+/// The earliest impact at the minimum distance (plain CCD, cheap: culled at that
+/// distance), as the starting bound of the step-size walk: every pair reaches its gap (at
+/// least the minimum distance) no later than it reaches the minimum distance, so the step is
+/// at most this time, and pairs that cannot reach their gap by then are never tested.
+#[allow(clippy::too_many_arguments)]
+fn first_impact<K: BoundingVolume>(
+    a: &Swept<'_, K>,
+    b: &Swept<'_, K>,
+    self_query: bool,
+    options: &StepOptions,
+    budget: &Budget<'_>,
+    ws: &mut Workspace,
+    par: Par,
+) -> Result<AtomicU64> {
+    let query = CcdQuery {
+        options: CcdOptions {
+            t_max: 1.0,
+            min_distance: options.min_distance,
+        },
+        mode: CcdMode::Earliest,
+    };
+    let best = earliest_bound(&query).expect("earliest mode");
+    let (impacts, _) = run(a, b, self_query, &query, Some(&best), budget, None, ws, par)?;
+    Ok(AtomicU64::new(
+        impacts.toi.unwrap_or(f64::INFINITY).to_bits(),
+    ))
+}
+
+/// The latest time a pair that limits the step can reach its gap: the first impact plus
+/// the walk's pruning slack (rounded up), at most 1.
+fn by(best: &AtomicU64) -> f64 {
+    let t = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
+    (t + 8.0 * crate::ccd::TOI_TOLERANCE).next_up().min(1.0)
 }
 
 fn step_of(limiting: Impacts) -> StepSize {
@@ -142,17 +183,17 @@ pub fn collision_free_stepsize_with<K: BoundingVolume>(
     par: Par,
 ) -> Result<StepSize> {
     options.validate()?;
-    let (query, gap) = query_for(options, &[motion]);
     let s = Swept::new(h, motion)?;
-    let best = earliest_bound(&query);
     let control = ws.control.clone();
     let budget = Budget::new(&control);
+    let best = first_impact(&s, &s, true, options, &budget, ws, par)?;
+    let (query, gap) = query_for(options, &[motion], by(&best));
     let (limiting, _) = run(
         &s,
         &s,
         true,
         &query,
-        best.as_ref(),
+        Some(&best),
         &budget,
         Some(gap),
         ws,
@@ -175,16 +216,16 @@ pub fn collision_free_stepsize_pair<K: BoundingVolume>(
     options.validate()?;
     let sa = Swept::new(a, a_motion)?;
     let sb = Swept::new(b, b_motion)?;
-    let (query, gap) = query_for(options, &[a_motion, b_motion]);
-    let best = earliest_bound(&query);
     let control = ws.control.clone();
     let budget = Budget::new(&control);
+    let best = first_impact(&sa, &sb, false, options, &budget, ws, par)?;
+    let (query, gap) = query_for(options, &[a_motion, b_motion], by(&best));
     let (limiting, _) = run(
         &sa,
         &sb,
         false,
         &query,
-        best.as_ref(),
+        Some(&best),
         &budget,
         Some(gap),
         ws,

@@ -390,10 +390,11 @@ impl Gap {
     /// exact closest features' `f64` distance, rounded up a few ulps so that the kept gap is
     /// never below the rule's).
     ///
-    /// `None` when the pair cannot reach its gap: its distance at t0 exceeds the gap plus the
-    /// most its features can approach each other (the largest displacement of a vertex of
-    /// each feature, summed: a point of a feature is a fixed convex combination of its
-    /// vertices, so it moves no farther than they do), decided exactly.
+    /// `None` when the pair cannot reach its gap before `o.t_max`: its distance at t0 exceeds
+    /// the gap plus the most its features can approach each other by then (`t_max` times the
+    /// largest displacement of a vertex of each feature, summed: a point of a feature is a
+    /// fixed convex combination of its vertices, so it moves no farther than they do),
+    /// decided exactly.
     #[inline]
     pub(crate) fn options(
         &self,
@@ -422,7 +423,10 @@ impl Gap {
         } else {
             (0..2, 2..4)
         };
-        let approach = first.map(moved).fold(0.0, f64::max) + second.map(moved).fold(0.0, f64::max);
+        // Within [0, t_max] (in earliest mode the best time so far) a vertex moves `t_max`
+        // of its displacement.
+        let moves = first.map(moved).fold(0.0, f64::max) + second.map(moved).fold(0.0, f64::max);
+        let approach = moves * o.t_max;
         // Rounded up (each operation above is within a few ulps).
         let reach = (g + approach) * (1.0 + 16.0 * f64::EPSILON);
         if reach.is_finite() {
