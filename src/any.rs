@@ -182,11 +182,6 @@ impl AnyHierarchy {
         pairwise!(self, other, a, b => collision_free_stepsize_pair(a, motion, b, other_motion, options, ws, par)?)
     }
 
-    /// The positions the hierarchy was built with (caller's order).
-    pub fn rest_positions(&self) -> &[[f64; 3]] {
-        each!(self, h => h.rest_positions())
-    }
-
     /// Colliding feature pairs between this object moving by `motion` and `other` moving by
     /// `other_motion` over a step (see [`ccd_pair`](crate::ccd_pair())); an error if the
     /// methods differ or the input is invalid.

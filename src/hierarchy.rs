@@ -425,14 +425,6 @@ impl<K: BoundingVolume> Hierarchy<K> {
         &self.rest
     }
 
-    /// The current positions in the caller's vertex order (exact for either precision).
-    pub fn positions_f64(&self) -> Vec<[f64; 3]> {
-        let slot = self.tree.vert_slot();
-        (0..slot.len())
-            .map(|v| self.position_f64(slot[v] as usize))
-            .collect()
-    }
-
     /// The exact current position of internal vertex `v`.
     #[inline]
     #[doc(hidden)]

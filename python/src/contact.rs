@@ -126,19 +126,12 @@ fn hessians(py: Python<'_>, h: Vec<[[f64; 12]; 12]>) -> PyResult<Bound<'_, PyArr
     Ok(a.into_pyarray(py))
 }
 
-/// A rest-position argument: `None`, or a float `(n, 3)` array (converted to float64).
+/// A rest-position argument: `None`, or a real `(n, 3)` array (converted to float64).
 fn rest_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<[f64; 3]>>> {
     let Some(obj) = obj.filter(|o| !o.is_none()) else {
         return Ok(None);
     };
-    let arr = super::array_of_numbers(obj, "rest")?;
-    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
-    if shape.len() != 2 || shape[1] != 3 {
-        let got = arr.getattr("shape")?.repr()?;
-        return Err(value_error(format!(
-            "rest must be an (n, 3) array, got shape {got}"
-        )));
-    }
+    let arr = super::numeric_n3(obj, "rest", super::REAL)?;
     let np = obj.py().import("numpy")?;
     let a: numpy::PyReadonlyArray2<'_, f64> = np
         .call_method1("ascontiguousarray", (arr, "float64"))?

@@ -803,19 +803,56 @@ fn ccd_options(
     Ok(o)
 }
 
-/// A positional argument of `ccd` that must be a `Hierarchy`.
-fn hierarchy_arg<'a, 'py>(
-    obj: &'a Bound<'py, PyAny>,
-    what: &str,
-) -> PyResult<&'a Bound<'py, Hierarchy>> {
-    obj.cast::<Hierarchy>().map_err(|_| {
-        let kind = obj
-            .get_type()
-            .name()
-            .map(|n| n.to_string())
-            .unwrap_or_default();
-        PyTypeError::new_err(format!("ccd: {what} must be a dhcd.Hierarchy, got {kind}"))
-    })
+/// The positional arguments of a query over a step: `(h, x0, x1)` for one mesh, or `(a, b,
+/// a0, a1, b0, b1)` for two different hierarchies, each motion float64 `(n, 3)` at t = 0 and
+/// t = 1; `call` names the query in messages.
+enum StepArgs<'py> {
+    One(Bound<'py, Hierarchy>, [PyReadonlyArray2<'py, f64>; 2]),
+    Two([Bound<'py, Hierarchy>; 2], [PyReadonlyArray2<'py, f64>; 4]),
+}
+
+fn step_args<'py>(args: &Bound<'py, PyTuple>, call: &str) -> PyResult<StepArgs<'py>> {
+    let hierarchy = |k: usize, what: &str| -> PyResult<Bound<'py, Hierarchy>> {
+        let obj = args.get_item(k)?;
+        obj.cast::<Hierarchy>().cloned().map_err(|_| {
+            let kind = obj
+                .get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default();
+            PyTypeError::new_err(format!(
+                "{call}: {what} must be a dhcd.Hierarchy, got {kind}"
+            ))
+        })
+    };
+    let positions = |k: usize, what: &str| ccd_positions(&args.get_item(k)?, what);
+    match args.len() {
+        3 => Ok(StepArgs::One(
+            hierarchy(0, "h")?,
+            [positions(1, "x0")?, positions(2, "x1")?],
+        )),
+        6 => {
+            let (a, b) = (hierarchy(0, "a")?, hierarchy(1, "b")?);
+            if a.is(&b) {
+                return Err(value_error(format!(
+                    "{call} needs two different hierarchies for a pair (use {call}(h, x0, x1) \
+                     for one)"
+                )));
+            }
+            Ok(StepArgs::Two(
+                [a, b],
+                [
+                    positions(2, "a0")?,
+                    positions(3, "a1")?,
+                    positions(4, "b0")?,
+                    positions(5, "b1")?,
+                ],
+            ))
+        }
+        n => Err(PyTypeError::new_err(format!(
+            "{call} takes (h, x0, x1) or (a, b, a0, a1, b0, b1), got {n} positional arguments"
+        ))),
+    }
 }
 
 /// Continuous collision detection over a step: `ccd(h, x0, x1)` for one mesh,
@@ -835,14 +872,8 @@ fn ccd(
 ) -> PyResult<Impacts> {
     let q = ccd_query(min_distance, t_max, earliest)?;
     let par = par(threads)?;
-    match args.len() {
-        3 => {
-            let h = args.get_item(0)?;
-            let h = hierarchy_arg(&h, "h")?;
-            let (x0, x1) = (
-                ccd_positions(&args.get_item(1)?, "x0")?,
-                ccd_positions(&args.get_item(2)?, "x1")?,
-            );
+    match step_args(args, "ccd")? {
+        StepArgs::One(h, [x0, x1]) => {
             let m = Motion::new(rows_of(&x0, "x0")?, rows_of(&x1, "x1")?);
             let mut h = h.try_borrow_mut()?;
             let h = &mut *h;
@@ -852,19 +883,7 @@ fn ccd(
             })?;
             Impacts::new(py, r)
         }
-        6 => {
-            let (a, b) = (args.get_item(0)?, args.get_item(1)?);
-            let (a, b) = (hierarchy_arg(&a, "a")?, hierarchy_arg(&b, "b")?);
-            if a.is(b) {
-                return Err(value_error(
-                    "ccd needs two different hierarchies for a pair (use ccd(h, x0, x1) for one)"
-                        .into(),
-                ));
-            }
-            let names = ["a0", "a1", "b0", "b1"];
-            let x: Vec<PyReadonlyArray2<'_, f64>> = (0..4)
-                .map(|k| ccd_positions(&args.get_item(2 + k)?, names[k]))
-                .collect::<PyResult<_>>()?;
+        StepArgs::Two([a, b], x) => {
             let ma = Motion::new(rows_of(&x[0], "a0")?, rows_of(&x[1], "a1")?);
             let mb = Motion::new(rows_of(&x[2], "b0")?, rows_of(&x[3], "b1")?);
             let (mut a, mut b) = (a.try_borrow_mut()?, b.try_borrow_mut()?);
@@ -875,9 +894,6 @@ fn ccd(
             })?;
             Impacts::new(py, r)
         }
-        n => Err(PyTypeError::new_err(format!(
-            "ccd takes (h, x0, x1) or (a, b, a0, a1, b0, b1), got {n} positional arguments"
-        ))),
     }
 }
 

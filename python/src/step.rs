@@ -3,12 +3,10 @@
 
 use dhcd::contact::StepOptions;
 use dhcd::Motion;
-use numpy::PyReadonlyArray2;
-use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-use super::{ccd_positions, hierarchy_arg, interrupt, par, real_arg, rows_of, to_py, value_error};
+use super::{interrupt, par, real_arg, rows_of, step_args, to_py, StepArgs};
 
 /// The largest fraction of the step `x0 -> x1` (in `[0, 1]`) that keeps every pair of
 /// features at least `min_distance + (1 - rescaling) (d0 - min_distance)` apart, `d0` its
@@ -34,14 +32,8 @@ pub(crate) fn collision_free_stepsize(
     }
     options.validate().map_err(to_py)?;
     let par = par(threads)?;
-    let step = match args.len() {
-        3 => {
-            let h = args.get_item(0)?;
-            let h = hierarchy_arg(&h, "h")?;
-            let (x0, x1) = (
-                ccd_positions(&args.get_item(1)?, "x0")?,
-                ccd_positions(&args.get_item(2)?, "x1")?,
-            );
+    let step = match step_args(args, "collision_free_stepsize")? {
+        StepArgs::One(h, [x0, x1]) => {
             let m = Motion::new(rows_of(&x0, "x0")?, rows_of(&x1, "x1")?);
             let mut h = h.try_borrow_mut()?;
             let h = &mut *h;
@@ -50,20 +42,7 @@ pub(crate) fn collision_free_stepsize(
                 h.h.collision_free_stepsize(m, &options, &mut h.ws, par)
             })?
         }
-        6 => {
-            let (a, b) = (args.get_item(0)?, args.get_item(1)?);
-            let (a, b) = (hierarchy_arg(&a, "a")?, hierarchy_arg(&b, "b")?);
-            if a.is(b) {
-                return Err(value_error(
-                    "collision_free_stepsize needs two different hierarchies for a pair (use \
-                     collision_free_stepsize(h, x0, x1) for one)"
-                        .into(),
-                ));
-            }
-            let names = ["a0", "a1", "b0", "b1"];
-            let x: Vec<PyReadonlyArray2<'_, f64>> = (0..4)
-                .map(|k| ccd_positions(&args.get_item(2 + k)?, names[k]))
-                .collect::<PyResult<_>>()?;
+        StepArgs::Two([a, b], x) => {
             let ma = Motion::new(rows_of(&x[0], "a0")?, rows_of(&x[1], "a1")?);
             let mb = Motion::new(rows_of(&x[2], "b0")?, rows_of(&x[3], "b1")?);
             let (mut a, b) = (a.try_borrow_mut()?, b.try_borrow()?);
@@ -72,12 +51,6 @@ pub(crate) fn collision_free_stepsize(
                 a.ws.control = control.clone();
                 a.h.collision_free_stepsize_pair(ma, &b.h, mb, &options, &mut a.ws, par)
             })?
-        }
-        n => {
-            return Err(PyTypeError::new_err(format!(
-                "collision_free_stepsize takes (h, x0, x1) or (a, b, a0, a1, b0, b1), got {n} \
-                 positional arguments"
-            )))
         }
     };
     Ok(step.step)

@@ -121,6 +121,36 @@ fn query_for(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> (CcdQuery,
     (query, gap)
 }
 
+/// The step size of `a` against `b` (the same for a self query) moving by `motions`: the
+/// first impact at the minimum distance, then the walk at each pair's gap, bounded by it.
+#[allow(clippy::too_many_arguments)]
+fn step_between<K: BoundingVolume>(
+    a: &Swept<'_, K>,
+    b: &Swept<'_, K>,
+    self_query: bool,
+    motions: &[Motion<'_>],
+    options: &StepOptions,
+    ws: &mut Workspace,
+    par: Par,
+) -> Result<StepSize> {
+    let control = ws.control.clone();
+    let budget = Budget::new(&control);
+    let best = first_impact(a, b, self_query, options, &budget, ws, par)?;
+    let (query, gap) = query_for(options, motions, by(&best));
+    let (limiting, _) = run(
+        a,
+        b,
+        self_query,
+        &query,
+        Some(&best),
+        &budget,
+        Some(gap),
+        ws,
+        par,
+    )?;
+    Ok(step_of(limiting))
+}
+
 /// The earliest impact at the minimum distance (plain CCD, cheap: culled at that
 /// distance), as the starting bound of the step-size walk: every pair reaches its gap (at
 /// least the minimum distance) no later than it reaches the minimum distance, so the step is
@@ -184,22 +214,7 @@ pub fn collision_free_stepsize_with<K: BoundingVolume>(
 ) -> Result<StepSize> {
     options.validate()?;
     let s = Swept::new(h, motion)?;
-    let control = ws.control.clone();
-    let budget = Budget::new(&control);
-    let best = first_impact(&s, &s, true, options, &budget, ws, par)?;
-    let (query, gap) = query_for(options, &[motion], by(&best));
-    let (limiting, _) = run(
-        &s,
-        &s,
-        true,
-        &query,
-        Some(&best),
-        &budget,
-        Some(gap),
-        ws,
-        par,
-    )?;
-    Ok(step_of(limiting))
+    step_between(&s, &s, true, &[motion], options, ws, par)
 }
 
 /// The collision-free step size of `a` and `b` moving by their motions (the pairs between
@@ -216,20 +231,5 @@ pub fn collision_free_stepsize_pair<K: BoundingVolume>(
     options.validate()?;
     let sa = Swept::new(a, a_motion)?;
     let sb = Swept::new(b, b_motion)?;
-    let control = ws.control.clone();
-    let budget = Budget::new(&control);
-    let best = first_impact(&sa, &sb, false, options, &budget, ws, par)?;
-    let (query, gap) = query_for(options, &[a_motion, b_motion], by(&best));
-    let (limiting, _) = run(
-        &sa,
-        &sb,
-        false,
-        &query,
-        Some(&best),
-        &budget,
-        Some(gap),
-        ws,
-        par,
-    )?;
-    Ok(step_of(limiting))
+    step_between(&sa, &sb, false, &[a_motion, b_motion], options, ws, par)
 }
