@@ -80,6 +80,7 @@ pub use par::Par;
 pub use precision::Precision;
 pub use scene::{
     ObjectId, PairImpacts, PairProximity, Scene, SceneContacts, SceneImpacts, SceneProximity,
+    SceneStepSize,
 };
 pub use segments::{contact_segments, self_contact_segments, Segment};
 

@@ -25,7 +25,7 @@ use rayon::prelude::*;
 
 use crate::bv::swept::{box_over_step, f32_up, Step};
 use crate::bv::{BoundingVolume, Method};
-use crate::contact::{self, ContactSet};
+use crate::contact::{self, step, ContactSet, StepOptions};
 use crate::control::{Budget, Control};
 use crate::counters::Counters;
 use crate::error::{Error, Positions, Result};
@@ -133,6 +133,18 @@ pub struct SceneImpacts {
     pub counters: Counters,
     /// Object pairs whose boxes over the step were compared in the broad phase.
     pub broad_phase_tests: u64,
+}
+
+/// Result of [`Scene::collision_free_stepsize`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneStepSize {
+    /// The largest fraction of the step, in `[0, 1]`, the rule allows over the whole scene (1:
+    /// no pair comes within its gap).
+    pub step: f64,
+    /// The pairs that reach their gap at `step`, per object pair, as
+    /// [`crate::contact::StepSize::limiting`]: `toi` the least time, `counters` the work of
+    /// both walks, `broad_phase_tests` the box pairs compared by both broad phases.
+    pub limiting: SceneImpacts,
 }
 
 /// One object of the scene.
@@ -463,6 +475,49 @@ impl Scene {
         let parallel = par.is_parallel();
         let budget = Budget::new(&self.control);
         each!(&self.objects, v => par.install(|| ccd_of(v, &slot, query, &budget, parallel)))
+    }
+
+    /// The collision-free step size of the whole scene over one step
+    /// ([`crate::contact::collision_free_stepsize`]'s rule, for every pair between two
+    /// objects and inside every object with self-collision on): the largest fraction of the
+    /// step, in `[0, 1]`, that keeps every pair at least `min_distance + (1 - rescaling)
+    /// (d0 - min_distance)` apart, `d0` its distance at t0. Never past the scene's exact
+    /// earliest impact at `min_distance` ([`Scene::ccd`]); 1 when no pair comes within its gap.
+    ///
+    /// Motions are as in [`Scene::ccd`]: each listed object moves from its `x0` to its `x1`
+    /// (its stored pose is not read), every other object stays at its stored pose, and the
+    /// scene is not changed. The step does not depend on `par`.
+    ///
+    /// Everything is checked before any work: [`Error::UnknownObject`],
+    /// [`Error::RepeatedObject`], the options ([`Error::InvalidMinDistance`],
+    /// [`Error::InvalidRescaling`]), then each listed object's positions in scene order.
+    ///
+    /// ```
+    /// use dhcd::{contact::StepOptions, scene::Scene, shapes, Method, Motion, Options, Par};
+    /// let mut scene = Scene::new(Method::Dh, Options::default());
+    /// let wall = scene.add(&shapes::icosphere(2, 0.5, [0.0; 3]))?;
+    /// let bullet = scene.add(&shapes::icosphere(1, 0.1, [-3.0, 0.0, 0.0]))?;
+    /// let x0 = scene.positions_f64(bullet)?;
+    /// let x1: Vec<[f64; 3]> = x0.iter().map(|p| [p[0] + 6.0, p[1], p[2]]).collect();
+    /// let motion = [(bullet, Motion::new(&x0, &x1))];
+    /// let safe = scene.collision_free_stepsize(&motion, &StepOptions::default(), Par::Seq)?;
+    /// let first = scene.ccd(&motion, &dhcd::CcdQuery::earliest(), Par::Seq)?;
+    /// // The bullet stops short of the wall: it keeps a fifth of its distance at t0.
+    /// assert!(safe.step > 0.0 && safe.step < first.toi.unwrap());
+    /// # let _ = wall;
+    /// # Ok::<(), dhcd::Error>(())
+    /// ```
+    pub fn collision_free_stepsize(
+        &self,
+        motions: &[(ObjectId, Motion<'_>)],
+        options: &StepOptions,
+        par: Par,
+    ) -> Result<SceneStepSize> {
+        let slot = self.slots(motions)?;
+        options.validate()?;
+        let parallel = par.is_parallel();
+        let budget = Budget::new(&self.control);
+        each!(&self.objects, v => par.install(|| step_size_of(v, &slot, options, &budget, parallel)))
     }
 
     /// The object's current positions in its mesh's vertex order, as `f64` (the `f32`
@@ -834,18 +889,15 @@ fn contacts_of<K: BoundingVolume>(objects: &mut [Object<K>], parallel: bool) -> 
     out
 }
 
-/// [`Scene::ccd`] once the ids and options are checked: `motions[i]` is object `i`'s motion
-/// (`None`: still).
-fn ccd_of<K: BoundingVolume>(
+/// Each object's step (checked, in internal order; `None`: still) and box over the step (the
+/// stored root box for a still object), from `motions[i]`, object `i`'s motion: the first
+/// error in scene order.
+fn steps_of<K: BoundingVolume>(
     objects: &[Object<K>],
     motions: &[Option<Motion<'_>>],
-    query: &CcdQuery,
-    budget: &Budget<'_>,
     parallel: bool,
-) -> Result<SceneImpacts> {
-    // Each moving object's step (checked, in internal order) and box over the step; the first
-    // error in scene order.
-    let steps: Vec<(Option<Step>, [[f32; 3]; 2])> = map_objects(objects.len(), parallel, |i| {
+) -> Result<Vec<(Option<Step>, [[f32; 3]; 2])>> {
+    map_objects(objects.len(), parallel, |i| {
         let o = &objects[i];
         let Some(motion) = motions[i] else {
             return Ok((None, o.bounds));
@@ -855,18 +907,26 @@ fn ccd_of<K: BoundingVolume>(
         Ok((Some(step), [[b[0], b[1], b[2]], [b[3], b[4], b[5]]]))
     })
     .into_iter()
-    .collect::<Result<_>>()?;
-    let margin = f32_up(query.options.min_distance);
-    let (jobs, broad_phase_tests) = jobs_of(objects, steps.iter().map(|s| s.1), margin);
-    let mut in_job = vec![false; objects.len()];
-    for &(a, b) in &jobs {
-        in_job[a] = true;
-        in_job[b] = true;
+    .collect()
+}
+
+/// The bounds over the step of every object in `jobs` that has none in `sweeps` yet (fitted
+/// once, shared by all its jobs); a still object's step is its stored pose at both ends.
+fn sweep_jobs<'h, K: BoundingVolume>(
+    objects: &'h [Object<K>],
+    steps: &'h [(Option<Step>, [[f32; 3]; 2])],
+    jobs: &[(usize, usize)],
+    sweeps: &mut Vec<Option<Swept<'h, K>>>,
+    parallel: bool,
+) {
+    sweeps.resize_with(objects.len(), || None);
+    let mut wanted = vec![false; objects.len()];
+    for &(a, b) in jobs {
+        wanted[a] = sweeps[a].is_none();
+        wanted[b] = sweeps[b].is_none();
     }
-    // Each object's bounds over the step, shared by its jobs; a still object's step is its
-    // stored pose at both ends.
-    let sweeps: Vec<Option<Swept<'_, K>>> = map_objects(objects.len(), parallel, |i| {
-        in_job[i].then(|| {
+    let fitted = map_objects(objects.len(), parallel, |i| {
+        wanted[i].then(|| {
             let h = &objects[i].h;
             let step = match &steps[i].0 {
                 Some(step) => Cow::Borrowed(step),
@@ -879,34 +939,49 @@ fn ccd_of<K: BoundingVolume>(
             Swept::of_step(h, step)
         })
     });
-    let best = earliest_bound(query);
-    let results = run_walks(&sweeps, &jobs, parallel, |ws, a, b, par| {
-        let a = a
-            .as_ref()
-            .expect("an object in a job has its bounds over the step");
+    for (slot, new) in sweeps.iter_mut().zip(fitted) {
+        if new.is_some() {
+            *slot = new;
+        }
+    }
+}
+
+/// `walk` on every job over the step (`sweeps` holds the bounds of every object in a job):
+/// its impacts in job order, refits credited to each object's first job. A job stopped by
+/// the budget gives nothing; the caller's `budget.finish()` says why.
+fn swept_walks<K: BoundingVolume>(
+    sweeps: &[Option<Swept<'_, K>>],
+    jobs: &[(usize, usize)],
+    parallel: bool,
+    walk: impl Fn(&mut Workspace, &Swept<'_, K>, &Swept<'_, K>, bool, Par) -> Result<(Impacts, [u64; 2])>
+        + Sync,
+) -> Vec<Impacts> {
+    let results = run_walks(sweeps, jobs, parallel, |ws, a, b, par| {
+        let bounds = "an object in a job has its bounds over the step";
+        let a = a.as_ref().expect(bounds);
         let (b, self_job) = match b {
             None => (a, true),
-            Some(b) => (
-                b.as_ref()
-                    .expect("an object in a job has its bounds over the step"),
-                false,
-            ),
+            Some(b) => (b.as_ref().expect(bounds), false),
         };
-        // A job stopped by the budget gives nothing; `finish` below says why.
-        ccd::run(a, b, self_job, query, best.as_ref(), budget, None, ws, par).unwrap_or_default()
+        walk(ws, a, b, self_job, par).unwrap_or_default()
     });
-    budget.finish()?;
-    let mut impacts = credit_refits(
+    credit_refits(
         results,
-        &jobs,
-        objects.len(),
+        jobs,
+        sweeps.len(),
         |i: &mut Impacts| &mut i.counters,
         |_| 0,
-    );
-    let toi = match best {
-        Some(_) => keep_earliest(&mut impacts),
-        None => impacts.iter().filter_map(|i| i.toi).reduce(f64::min),
-    };
+    )
+}
+
+/// The scene result of per-job `impacts` (in job order) with the least time `toi`.
+fn scene_impacts<K: BoundingVolume>(
+    objects: &[Object<K>],
+    jobs: &[(usize, usize)],
+    impacts: Vec<Impacts>,
+    toi: Option<f64>,
+    broad_phase_tests: u64,
+) -> SceneImpacts {
     let mut out = SceneImpacts {
         toi,
         broad_phase_tests,
@@ -920,5 +995,95 @@ fn ccd_of<K: BoundingVolume>(
             impacts: i,
         });
     }
-    Ok(out)
+    out
+}
+
+/// [`Scene::ccd`] once the ids and options are checked: `motions[i]` is object `i`'s motion
+/// (`None`: still).
+fn ccd_of<K: BoundingVolume>(
+    objects: &[Object<K>],
+    motions: &[Option<Motion<'_>>],
+    query: &CcdQuery,
+    budget: &Budget<'_>,
+    parallel: bool,
+) -> Result<SceneImpacts> {
+    let steps = steps_of(objects, motions, parallel)?;
+    let margin = f32_up(query.options.min_distance);
+    let (jobs, broad_phase_tests) = jobs_of(objects, steps.iter().map(|s| s.1), margin);
+    let mut sweeps = Vec::new();
+    sweep_jobs(objects, &steps, &jobs, &mut sweeps, parallel);
+    let best = earliest_bound(query);
+    let mut impacts = swept_walks(&sweeps, &jobs, parallel, |ws, a, b, self_job, par| {
+        ccd::run(a, b, self_job, query, best.as_ref(), budget, None, ws, par)
+    });
+    budget.finish()?;
+    let toi = match best {
+        Some(_) => keep_earliest(&mut impacts),
+        None => impacts.iter().filter_map(|i| i.toi).reduce(f64::min),
+    };
+    Ok(scene_impacts(
+        objects,
+        &jobs,
+        impacts,
+        toi,
+        broad_phase_tests,
+    ))
+}
+
+/// [`Scene::collision_free_stepsize`] once the ids and options are checked: the first
+/// impact at the minimum distance over every job (one shared bound), then the gap walk over
+/// the jobs whose boxes come within the culling distance, bounded by it (see
+/// [`crate::contact::collision_free_stepsize`]).
+fn step_size_of<K: BoundingVolume>(
+    objects: &[Object<K>],
+    motions: &[Option<Motion<'_>>],
+    options: &StepOptions,
+    budget: &Budget<'_>,
+    parallel: bool,
+) -> Result<SceneStepSize> {
+    let steps = steps_of(objects, motions, parallel)?;
+    let boxes = || steps.iter().map(|s| s.1);
+    let first = step::first_impact_query(options);
+    let (jobs, first_tests) = jobs_of(objects, boxes(), f32_up(first.options.min_distance));
+    let mut sweeps = Vec::new();
+    sweep_jobs(objects, &steps, &jobs, &mut sweeps, parallel);
+    let best = earliest_bound(&first);
+    let mut impacts = swept_walks(&sweeps, &jobs, parallel, |ws, a, b, self_job, par| {
+        ccd::run(a, b, self_job, &first, best.as_ref(), budget, None, ws, par)
+    });
+    budget.finish()?;
+    let first_work = impacts.iter().fold(Counters::default(), |mut c, i| {
+        c += i.counters;
+        c
+    });
+    let best = step::bound_at(keep_earliest(&mut impacts));
+    let moving: Vec<Motion<'_>> = motions.iter().flatten().copied().collect();
+    let (query, gap) = step::query_for(options, &moving, step::by(&best));
+    let (jobs, broad_phase_tests) = jobs_of(objects, boxes(), f32_up(query.options.min_distance));
+    sweep_jobs(objects, &steps, &jobs, &mut sweeps, parallel);
+    let mut limiting = swept_walks(&sweeps, &jobs, parallel, |ws, a, b, self_job, par| {
+        ccd::run(
+            a,
+            b,
+            self_job,
+            &query,
+            Some(&best),
+            budget,
+            Some(gap),
+            ws,
+            par,
+        )
+    });
+    budget.finish()?;
+    let toi = keep_earliest(&mut limiting);
+    let tests = first_tests + broad_phase_tests;
+    let mut limiting = scene_impacts(objects, &jobs, limiting, toi, tests);
+    // The work of both walks; `contacts` counts the limiting pairs.
+    let contacts = limiting.counters.contacts;
+    limiting.counters += first_work;
+    limiting.counters.contacts = contacts;
+    Ok(SceneStepSize {
+        step: step::step_at(toi),
+        limiting,
+    })
 }

@@ -7,6 +7,7 @@ use dhcd::ccd::{self, CcdOptions, TOI_TOLERANCE};
 use dhcd::contact::{collision_free_stepsize, collision_free_stepsize_with, StepOptions};
 use dhcd::distance::{edge_edge_distance_sq, point_triangle_distance_sq};
 use dhcd::shapes::{fold_x, grid, jitter};
+use dhcd::scene::Scene;
 use dhcd::{
     for_each_method, self_ccd, CcdQuery, Error, Hierarchy, Mesh, Motion, Options, Par, Workspace,
 };
@@ -61,6 +62,17 @@ fn a_falling_vertex_stops_at_its_gap() {
 
 /// Every vertex-triangle and edge-edge pair of the mesh, each by exact CCD at its own gap.
 fn brute_force_step(m: &Mesh, x0: &[[f64; 3]], x1: &[[f64; 3]], o: &StepOptions) -> f64 {
+    brute_force_step_of(m, x0, x1, o, &|_| true)
+}
+
+/// [`brute_force_step`] over the pairs whose four vertices `counts`.
+fn brute_force_step_of(
+    m: &Mesh,
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    o: &StepOptions,
+    counts: &dyn Fn([u32; 4]) -> bool,
+) -> f64 {
     let gap = |d0_sq: f64| {
         let g = o.min_distance + (1.0 - o.rescaling) * (d0_sq.sqrt() - o.min_distance);
         (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0)
@@ -69,7 +81,7 @@ fn brute_force_step(m: &Mesh, x0: &[[f64; 3]], x1: &[[f64; 3]], o: &StepOptions)
     let tris = m.triangles();
     for v in 0..x0.len() as u32 {
         for t in tris {
-            if t.contains(&v) {
+            if t.contains(&v) || !counts([v, t[0], t[1], t[2]]) {
                 continue;
             }
             let p0 = [
@@ -102,7 +114,7 @@ fn brute_force_step(m: &Mesh, x0: &[[f64; 3]], x1: &[[f64; 3]], o: &StepOptions)
     edges.dedup();
     for (i, a) in edges.iter().enumerate() {
         for b in &edges[i + 1..] {
-            if a.iter().any(|v| b.contains(v)) {
+            if a.iter().any(|v| b.contains(v)) || !counts([a[0], a[1], b[0], b[1]]) {
                 continue;
             }
             let q = |x: &[[f64; 3]]| {
@@ -211,4 +223,96 @@ fn bad_options_are_typed_errors() {
     let e = collision_free_stepsize(&h, Motion::new(&x0[1..], &x1), &StepOptions::default())
         .unwrap_err();
     assert!(matches!(e, Error::WrongVertexCount { .. }), "{e}");
+}
+
+/// Three objects: the folding sheet (self-collision on), a small sheet falling through it
+/// (self-collision off) and a far still one (self-collision on). The scene's step equals
+/// the brute force over the pairs the scene covers, for every method and thread count, and
+/// is never past the scene's earliest impact.
+#[test]
+fn a_scene_equals_the_brute_force_over_its_pairs() {
+    let rest = grid(6, 6, 0.1, [0.0, 0.0, 0.0]);
+    let fold0 = f64s(&jitter(&fold_x(rest.positions(), 0.28), [0.01; 3], 5));
+    let fold1 = f64s(&jitter(&fold_x(rest.positions(), 0.3), [0.02; 3], 6));
+    let small = grid(2, 2, 0.1, [0.05, 0.15, 0.25]);
+    let fall0 = f64s(small.positions());
+    let fall1: Vec<[f64; 3]> = fall0.iter().map(|p| [p[0], p[1], p[2] - 30.0]).collect();
+    let far = grid(2, 2, 0.1, [10.0, 0.0, 0.0]);
+    let far0 = f64s(far.positions());
+    // The three objects as one mesh, vertices in scene order.
+    let (na, nb) = (fold0.len() as u32, fall0.len() as u32);
+    let shift = |m: &Mesh, by: u32| -> Vec<[u32; 3]> {
+        m.triangles().iter().map(|t| t.map(|v| v + by)).collect()
+    };
+    let mut tris = shift(&rest, 0);
+    tris.extend(shift(&small, na));
+    tris.extend(shift(&far, na + nb));
+    let x0: Vec<[f64; 3]> = [&fold0[..], &fall0, &far0].concat();
+    let x1: Vec<[f64; 3]> = [&fold1[..], &fall1, &far0].concat();
+    let all = Mesh::new_f64(x0.clone(), tris).unwrap();
+    let falling = |v: u32| (na..na + nb).contains(&v);
+    // The falling sheet's self pairs are not the scene's.
+    let scene_pairs = |q: [u32; 4]| !q.iter().all(|&v| falling(v));
+    let only_fold = |q: [u32; 4]| q.iter().all(|&v| v < na);
+    for o in [
+        StepOptions::default(),
+        StepOptions {
+            min_distance: 0.0,
+            rescaling: 0.5,
+        },
+        StepOptions {
+            min_distance: 1e-6,
+            rescaling: 0.9,
+        },
+    ] {
+        let want = brute_force_step_of(&all, &x0, &x1, &o, &scene_pairs);
+        let fold_alone = brute_force_step_of(&all, &x0, &x1, &o, &only_fold);
+        assert!(
+            want < fold_alone,
+            "the falling sheet limits the step ({o:?}: {want} vs {fold_alone})"
+        );
+        for method in dhcd::Method::ALL {
+            let mut scene = Scene::new(method, Options::default());
+            let meshes = [
+                Mesh::new_f64(fold0.clone(), rest.triangles().to_vec()).unwrap(),
+                Mesh::new_f64(fall0.clone(), small.triangles().to_vec()).unwrap(),
+                Mesh::new_f64(far0.clone(), far.triangles().to_vec()).unwrap(),
+            ];
+            let ids: Vec<_> = meshes.iter().map(|m| scene.add(m).unwrap()).collect();
+            scene.set_self_collision(ids[0], true).unwrap();
+            scene.set_self_collision(ids[2], true).unwrap();
+            let motions = [
+                (ids[0], Motion::new(&fold0, &fold1)),
+                (ids[1], Motion::new(&fall0, &fall1)),
+            ];
+            for par in [Par::Seq, Par::Rayon(2)] {
+                let s = scene.collision_free_stepsize(&motions, &o, par).unwrap();
+                assert!(
+                    (s.step - want).abs() <= TOI_TOLERANCE,
+                    "{method:?} {par:?} {o:?}: {} vs brute force {want}",
+                    s.step
+                );
+                assert_eq!(s.limiting.toi.map_or(1.0, |t| t.clamp(0.0, 1.0)), s.step);
+                let q = CcdQuery::earliest().with_min_distance(o.min_distance);
+                if let Some(t) = scene.ccd(&motions, &q, par).unwrap().toi {
+                    assert!(s.step <= t + TOI_TOLERANCE, "{} past the impact {t}", s.step);
+                }
+            }
+            // Bad input: typed errors before any work.
+            let e = scene
+                .collision_free_stepsize(&[motions[0], motions[0]], &o, Par::Seq)
+                .unwrap_err();
+            assert!(matches!(e, Error::RepeatedObject(_)), "{e}");
+            let bad = StepOptions {
+                rescaling: 0.0,
+                ..o
+            };
+            let e = scene.collision_free_stepsize(&motions, &bad, Par::Seq).unwrap_err();
+            assert!(matches!(e, Error::InvalidRescaling(_)), "{e}");
+            let e = scene
+                .collision_free_stepsize(&[(dhcd::ObjectId(99), motions[0].1)], &o, Par::Seq)
+                .unwrap_err();
+            assert!(matches!(e, Error::UnknownObject(99)), "{e}");
+        }
+    }
 }

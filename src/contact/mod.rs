@@ -23,7 +23,7 @@
 mod dual;
 pub mod geometry;
 mod set;
-mod step;
+pub(crate) mod step;
 
 pub(crate) use set::{from_rows, offset, Side};
 

@@ -31,6 +31,7 @@ use std::sync::atomic::AtomicU64;
 use crate::bv::BoundingVolume;
 use crate::ccd::CcdOptions;
 use crate::control::Budget;
+use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
@@ -81,7 +82,8 @@ pub struct StepSize {
     /// within its gap).
     pub step: f64,
     /// The pairs that reach their gap at `step` (within [`crate::ccd::TOI_TOLERANCE`]),
-    /// their times of impact against their own gaps; `counters` the walk's work.
+    /// their times of impact against their own gaps; `counters` the work of both walks (the
+    /// first impact's and the gap walk's), `contacts` the limiting pairs.
     pub limiting: Impacts,
 }
 
@@ -106,7 +108,9 @@ fn cull_distance(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> f64 {
     }
 }
 
-fn query_for(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> (CcdQuery, Gap) {
+/// The gap walk's query (earliest mode, culling at [`cull_distance`] for pairs that must
+/// reach their gap by `by`) and the rule.
+pub(crate) fn query_for(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> (CcdQuery, Gap) {
     let query = CcdQuery {
         options: CcdOptions {
             t_max: 1.0,
@@ -135,9 +139,9 @@ fn step_between<K: BoundingVolume>(
 ) -> Result<StepSize> {
     let control = ws.control.clone();
     let budget = Budget::new(&control);
-    let best = first_impact(a, b, self_query, options, &budget, ws, par)?;
+    let (best, first_work) = first_impact(a, b, self_query, options, &budget, ws, par)?;
     let (query, gap) = query_for(options, motions, by(&best));
-    let (limiting, _) = run(
+    let (mut limiting, _) = run(
         a,
         b,
         self_query,
@@ -148,7 +152,14 @@ fn step_between<K: BoundingVolume>(
         ws,
         par,
     )?;
-    Ok(step_of(limiting))
+    // The work of both walks; `contacts` counts the limiting pairs.
+    let contacts = limiting.counters.contacts;
+    limiting.counters += first_work;
+    limiting.counters.contacts = contacts;
+    Ok(StepSize {
+        step: step_at(limiting.toi),
+        limiting,
+    })
 }
 
 /// The earliest impact at the minimum distance (plain CCD, cheap: culled at that
@@ -164,33 +175,39 @@ fn first_impact<K: BoundingVolume>(
     budget: &Budget<'_>,
     ws: &mut Workspace,
     par: Par,
-) -> Result<AtomicU64> {
-    let query = CcdQuery {
+) -> Result<(AtomicU64, Counters)> {
+    let query = first_impact_query(options);
+    let best = earliest_bound(&query).expect("earliest mode");
+    let (impacts, _) = run(a, b, self_query, &query, Some(&best), budget, None, ws, par)?;
+    Ok((bound_at(impacts.toi), impacts.counters))
+}
+
+/// The plain CCD query of the first impact at the minimum distance.
+pub(crate) fn first_impact_query(options: &StepOptions) -> CcdQuery {
+    CcdQuery {
         options: CcdOptions {
             t_max: 1.0,
             min_distance: options.min_distance,
         },
         mode: CcdMode::Earliest,
-    };
-    let best = earliest_bound(&query).expect("earliest mode");
-    let (impacts, _) = run(a, b, self_query, &query, Some(&best), budget, None, ws, par)?;
-    Ok(AtomicU64::new(
-        impacts.toi.unwrap_or(f64::INFINITY).to_bits(),
-    ))
+    }
+}
+
+/// The gap walk's starting bound: the first impact's time (`None`: no impact, no bound).
+pub(crate) fn bound_at(toi: Option<f64>) -> AtomicU64 {
+    AtomicU64::new(toi.unwrap_or(f64::INFINITY).to_bits())
 }
 
 /// The latest time a pair that limits the step can reach its gap: the first impact plus
 /// the walk's pruning slack (rounded up), at most 1.
-fn by(best: &AtomicU64) -> f64 {
+pub(crate) fn by(best: &AtomicU64) -> f64 {
     let t = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
     (t + 8.0 * crate::ccd::TOI_TOLERANCE).next_up().min(1.0)
 }
 
-fn step_of(limiting: Impacts) -> StepSize {
-    StepSize {
-        step: limiting.toi.map_or(1.0, |t| t.clamp(0.0, 1.0)),
-        limiting,
-    }
+/// The step allowed by the earliest time any pair reaches its gap (`None`: none does).
+pub(crate) fn step_at(toi: Option<f64>) -> f64 {
+    toi.map_or(1.0, |t| t.clamp(0.0, 1.0))
 }
 
 /// The collision-free step size of one mesh moving by `motion` (self contacts), on the
