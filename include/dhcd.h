@@ -230,6 +230,27 @@ typedef struct DhcdContacts {
 } DhcdContacts;
 
 /**
+ * Contacts of `dhcd_scene_contacts`: `count` quadruples `[object_a, tri_a, object_b,
+ * tri_b]` at `pairs[4k..4k+4]`, sorted. `pairs` is null when `count == 0`.
+ */
+typedef struct DhcdSceneContacts {
+  /**
+   * Row-major `[count][4]` array of `[object_a, tri_a, object_b, tri_b]`: `object_a <
+   * object_b`, or `object_a == object_b` and `tri_a < tri_b` for a self-contact; freed by
+   * `dhcd_scene_contacts_free`.
+   */
+  uint64_t *pairs;
+  /**
+   * Number of rows of `pairs`.
+   */
+  size_t count;
+  /**
+   * Work counted by the query, summed over the object pairs queried.
+   */
+  struct DhcdCounters counters;
+} DhcdSceneContacts;
+
+/**
  * Feature pairs within a distance, from `dhcd_proximity` / `dhcd_self_proximity` (release
  * with `dhcd_proximity_free`). Three lists, each of `*_count` rows, sorted by its index
  * rows; every row has its squared distance (`*_distance_sq[k]`) and the type of its closest
@@ -311,101 +332,6 @@ typedef struct DhcdProximity {
 } DhcdProximity;
 
 /**
- * Colliding feature pairs over a step, from `dhcd_ccd` / `dhcd_self_ccd` (release with
- * `dhcd_impacts_free`). Three lists, each of `*_count` rows sorted by its index rows, every
- * row with its time of impact (`*_toi[k]`, in `[0, t_max]`); indices are original vertex
- * and triangle indices; every array is null when its count is 0.
- * - `vertex_face`: `[vertex, triangle]` at `vertex_face[2k..2k+2]`: a vertex of `a` and a
- *   triangle of `b` (self: a vertex and a triangle not containing it);
- * - `face_vertex`: `[triangle of a, vertex of b]` (pair queries only; empty for self);
- * - `edge_edge`: `[a0, a1, b0, b1]` at `edge_edge[4k..4k+4]`, an edge of `a` and one of
- *   `b` (self: two edges sharing no vertex, `(a0, a1) < (b0, b1)`), each as its two
- *   vertices, smaller first.
- *
- * `toi` is the earliest time of impact of the step (the least of the rows' times), or
- * `+inf` when nothing collides. In earliest mode the lists hold only the pairs reaching
- * it. Whether a pair collides is decided exactly for the `double` input; a time of impact
- * is never later than the pair's first contact and at most 1e-12 earlier.
- *
- * `counters.bv_tests` counts the node pairs tested over the step, `bv_updates` the bounds
- * fitted over the step, `prim_tests` the feature pairs given to the exact test,
- * `contacts` the rows of the three lists.
- */
-typedef struct DhcdImpacts {
-  /**
-   * Row-major `[vf_count][2]` array of `[vertex of a, triangle of b]`; freed by
-   * `dhcd_impacts_free`.
-   */
-  uint32_t *vertex_face;
-  /**
-   * Time of impact of each `vertex_face` row, in `[0, t_max]` (`vf_count` doubles); freed
-   * by `dhcd_impacts_free`.
-   */
-  double *vf_toi;
-  /**
-   * Number of rows of `vertex_face`.
-   */
-  size_t vf_count;
-  /**
-   * Row-major `[fv_count][2]` array of `[triangle of a, vertex of b]` (empty for self); freed
-   * by `dhcd_impacts_free`.
-   */
-  uint32_t *face_vertex;
-  /**
-   * Time of impact of each `face_vertex` row, in `[0, t_max]` (`fv_count` doubles); freed
-   * by `dhcd_impacts_free`.
-   */
-  double *fv_toi;
-  /**
-   * Number of rows of `face_vertex`.
-   */
-  size_t fv_count;
-  /**
-   * Row-major `[ee_count][4]` array of `[a0, a1, b0, b1]`, an edge of `a` and one of `b`;
-   * freed by `dhcd_impacts_free`.
-   */
-  uint32_t *edge_edge;
-  /**
-   * Time of impact of each `edge_edge` row, in `[0, t_max]` (`ee_count` doubles); freed
-   * by `dhcd_impacts_free`.
-   */
-  double *ee_toi;
-  /**
-   * Number of rows of `edge_edge`.
-   */
-  size_t ee_count;
-  /**
-   * Earliest time of impact of the step, in `[0, t_max]`; `+inf` when nothing collides.
-   */
-  double toi;
-  /**
-   * Work counted over the step.
-   */
-  struct DhcdCounters counters;
-} DhcdImpacts;
-
-/**
- * Contacts of `dhcd_scene_contacts`: `count` quadruples `[object_a, tri_a, object_b,
- * tri_b]` at `pairs[4k..4k+4]`, sorted. `pairs` is null when `count == 0`.
- */
-typedef struct DhcdSceneContacts {
-  /**
-   * Row-major `[count][4]` array of `[object_a, tri_a, object_b, tri_b]`: `object_a <
-   * object_b`, or `object_a == object_b` and `tri_a < tri_b` for a self-contact; freed by
-   * `dhcd_scene_contacts_free`.
-   */
-  uint64_t *pairs;
-  /**
-   * Number of rows of `pairs`.
-   */
-  size_t count;
-  /**
-   * Work counted by the query, summed over the object pairs queried.
-   */
-  struct DhcdCounters counters;
-} DhcdSceneContacts;
-
-/**
  * Feature pairs within a distance in a scene, from `dhcd_scene_proximity` (release with
  * `dhcd_scene_proximity_free`): every object pair's results (`object_a < object_b`) and
  * every self-collision object's own (`object_a == object_b`), flattened with object ids,
@@ -479,6 +405,80 @@ typedef struct DhcdSceneProximity {
    */
   struct DhcdCounters counters;
 } DhcdSceneProximity;
+
+/**
+ * Colliding feature pairs over a step, from `dhcd_ccd` / `dhcd_self_ccd` (release with
+ * `dhcd_impacts_free`). Three lists, each of `*_count` rows sorted by its index rows, every
+ * row with its time of impact (`*_toi[k]`, in `[0, t_max]`); indices are original vertex
+ * and triangle indices; every array is null when its count is 0.
+ * - `vertex_face`: `[vertex, triangle]` at `vertex_face[2k..2k+2]`: a vertex of `a` and a
+ *   triangle of `b` (self: a vertex and a triangle not containing it);
+ * - `face_vertex`: `[triangle of a, vertex of b]` (pair queries only; empty for self);
+ * - `edge_edge`: `[a0, a1, b0, b1]` at `edge_edge[4k..4k+4]`, an edge of `a` and one of
+ *   `b` (self: two edges sharing no vertex, `(a0, a1) < (b0, b1)`), each as its two
+ *   vertices, smaller first.
+ *
+ * `toi` is the earliest time of impact of the step (the least of the rows' times), or
+ * `+inf` when nothing collides. In earliest mode the lists hold only the pairs reaching
+ * it. Whether a pair collides is decided exactly for the `double` input; a time of impact
+ * is never later than the pair's first contact and at most 1e-12 earlier.
+ *
+ * `counters.bv_tests` counts the node pairs tested over the step, `bv_updates` the bounds
+ * fitted over the step, `prim_tests` the feature pairs given to the exact test,
+ * `contacts` the rows of the three lists.
+ */
+typedef struct DhcdImpacts {
+  /**
+   * Row-major `[vf_count][2]` array of `[vertex of a, triangle of b]`; freed by
+   * `dhcd_impacts_free`.
+   */
+  uint32_t *vertex_face;
+  /**
+   * Time of impact of each `vertex_face` row, in `[0, t_max]` (`vf_count` doubles); freed
+   * by `dhcd_impacts_free`.
+   */
+  double *vf_toi;
+  /**
+   * Number of rows of `vertex_face`.
+   */
+  size_t vf_count;
+  /**
+   * Row-major `[fv_count][2]` array of `[triangle of a, vertex of b]` (empty for self); freed
+   * by `dhcd_impacts_free`.
+   */
+  uint32_t *face_vertex;
+  /**
+   * Time of impact of each `face_vertex` row, in `[0, t_max]` (`fv_count` doubles); freed
+   * by `dhcd_impacts_free`.
+   */
+  double *fv_toi;
+  /**
+   * Number of rows of `face_vertex`.
+   */
+  size_t fv_count;
+  /**
+   * Row-major `[ee_count][4]` array of `[a0, a1, b0, b1]`, an edge of `a` and one of `b`;
+   * freed by `dhcd_impacts_free`.
+   */
+  uint32_t *edge_edge;
+  /**
+   * Time of impact of each `edge_edge` row, in `[0, t_max]` (`ee_count` doubles); freed
+   * by `dhcd_impacts_free`.
+   */
+  double *ee_toi;
+  /**
+   * Number of rows of `edge_edge`.
+   */
+  size_t ee_count;
+  /**
+   * Earliest time of impact of the step, in `[0, t_max]`; `+inf` when nothing collides.
+   */
+  double toi;
+  /**
+   * Work counted over the step.
+   */
+  struct DhcdCounters counters;
+} DhcdImpacts;
 
 /**
  * Colliding feature pairs over a step in a scene, from `dhcd_scene_ccd` (release with
@@ -753,6 +753,15 @@ int dhcd_contact_segments(const struct DhcdHierarchy *a,
 void dhcd_contacts_free(struct DhcdContacts *c);
 
 /**
+ * Releases the array of a `DhcdSceneContacts` and resets it to empty. Null, or an already
+ * released or empty result, is a no-op.
+ *
+ * # Safety
+ * `c` null or a `DhcdSceneContacts` filled by this library and not modified since.
+ */
+void dhcd_scene_contacts_free(struct DhcdSceneContacts *c);
+
+/**
  * Every vertex-triangle and edge-edge pair of `a` and `b` (two hierarchies of the same
  * method) whose closed features are within distance `d` (finite, `>= 0`; else
  * `DHCD_ERR_INVALID_ARGUMENT`), decided exactly, into `*out` (see `DhcdProximity`; release
@@ -790,6 +799,15 @@ int dhcd_self_proximity(struct DhcdHierarchy *h,
  * `p` null or a `DhcdProximity` filled by this library and not modified since.
  */
 void dhcd_proximity_free(struct DhcdProximity *p);
+
+/**
+ * Releases the arrays of a `DhcdSceneProximity` and resets it to empty. Null, or an
+ * already released or empty result, is a no-op.
+ *
+ * # Safety
+ * `p` null or a `DhcdSceneProximity` filled by this library and not modified since.
+ */
+void dhcd_scene_proximity_free(struct DhcdSceneProximity *p);
 
 /**
  * Continuous collision detection of one mesh over a step: every vertex-triangle pair (the
@@ -859,6 +877,15 @@ int dhcd_ccd(struct DhcdHierarchy *a,
  * `p` null or a `DhcdImpacts` filled by this library and not modified since.
  */
 void dhcd_impacts_free(struct DhcdImpacts *p);
+
+/**
+ * Releases the arrays of a `DhcdSceneImpacts` and resets it to empty (`toi` `+inf`). Null,
+ * or an already released or empty result, is a no-op.
+ *
+ * # Safety
+ * `p` null or a `DhcdSceneImpacts` filled by this library and not modified since.
+ */
+void dhcd_scene_impacts_free(struct DhcdSceneImpacts *p);
 
 /**
  * Vertex-face CCD of one pair: `x0` holds the vertex and the triangle's three corners at
@@ -1036,15 +1063,6 @@ int dhcd_scene_step(struct DhcdScene *s,
                     struct DhcdSceneContacts *out);
 
 /**
- * Releases the array of a `DhcdSceneContacts` and resets it to empty. Null, or an already
- * released or empty result, is a no-op.
- *
- * # Safety
- * `c` null or a `DhcdSceneContacts` filled by this library and not modified since.
- */
-void dhcd_scene_contacts_free(struct DhcdSceneContacts *c);
-
-/**
  * Every vertex-triangle and edge-edge pair within distance `d` (finite, `>= 0`; else
  * `DHCD_ERR_INVALID_ARGUMENT`) between every two objects, and inside every object with
  * self-collision on, into `*out` (see `DhcdSceneProximity`; release with
@@ -1058,15 +1076,6 @@ int dhcd_scene_proximity(struct DhcdScene *s,
                          double d,
                          uint32_t threads,
                          struct DhcdSceneProximity *out);
-
-/**
- * Releases the arrays of a `DhcdSceneProximity` and resets it to empty. Null, or an
- * already released or empty result, is a no-op.
- *
- * # Safety
- * `p` null or a `DhcdSceneProximity` filled by this library and not modified since.
- */
-void dhcd_scene_proximity_free(struct DhcdSceneProximity *p);
 
 /**
  * Continuous collision detection of the whole scene over one step: entry `k` moves object
@@ -1099,15 +1108,6 @@ int dhcd_scene_ccd(struct DhcdScene *s,
                    int earliest,
                    uint32_t threads,
                    struct DhcdSceneImpacts *out);
-
-/**
- * Releases the arrays of a `DhcdSceneImpacts` and resets it to empty (`toi` `+inf`). Null,
- * or an already released or empty result, is a no-op.
- *
- * # Safety
- * `p` null or a `DhcdSceneImpacts` filled by this library and not modified since.
- */
-void dhcd_scene_impacts_free(struct DhcdSceneImpacts *p);
 
 /**
  * Every pair of features of one mesh within `dhat` (finite, `>= 0`), once, into `*out` (see

@@ -8,10 +8,12 @@ use std::ffi::c_int;
 use dhcd::contact::{Contact, ContactType, StepOptions, NONE};
 use dhcd::distance::EdgeEdge;
 
-use super::{
-    c_array, c_pairs, free_array, guard, handle, motion, null, par, positions_f64, slice, write,
-    DhcdCounters, DhcdHierarchy, Fail, DHCD_ERR_INVALID_ARGUMENT,
+use crate::error::{guard, null, Fail};
+use crate::hierarchy::DhcdHierarchy;
+use crate::marshal::{
+    c_array, c_pairs, free_array, handle, motion, par, positions_f64, slice, write, DhcdCounters,
 };
+use crate::DHCD_ERR_INVALID_ARGUMENT;
 
 /// No `closest` type: the row is not an edge-edge row.
 pub const DHCD_CLOSEST_NONE: u8 = u8::MAX;

@@ -7,7 +7,10 @@ use std::sync::Arc;
 
 use dhcd::Control;
 
-use super::{guard, handle, null, write, DhcdHierarchy, DhcdScene, Fail};
+use crate::error::{guard, null, Fail};
+use crate::hierarchy::DhcdHierarchy;
+use crate::marshal::{handle, write};
+use crate::scene::DhcdScene;
 
 /// Opaque: a cancel token. `dhcd_cancel_set` (from any thread) stops every query of the
 /// hierarchies and scenes it is given to, which then return `DHCD_ERR_CANCELLED`, until
