@@ -8,7 +8,9 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray3, PyUntyp
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{counters, distance_arg, float64_rows, interrupt, par, to_py, value_error, Hierarchy};
+use crate::arrays::{array_of_numbers, float64_rows, numeric_n3, REAL};
+use crate::hierarchy::Hierarchy;
+use crate::{counters, distance_arg, interrupt, par, to_py, value_error};
 
 /// Every pair of features within `dhat`, once, with the IPC Toolkit's collision type (see
 /// the stub for the columns).
@@ -131,7 +133,7 @@ fn rest_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<[f64; 3]>>> {
     let Some(obj) = obj.filter(|o| !o.is_none()) else {
         return Ok(None);
     };
-    let arr = super::numeric_n3(obj, "rest", super::REAL)?;
+    let arr = numeric_n3(obj, "rest", REAL)?;
     let np = obj.py().import("numpy")?;
     let a: numpy::PyReadonlyArray2<'_, f64> = np
         .call_method1("ascontiguousarray", (arr, "float64"))?
@@ -215,7 +217,7 @@ type Batch = (Vec<ContactType>, Vec<[[f64; 3]; 4]>);
 /// `(K, 4, 3)`.
 fn batch_args(types: &Bound<'_, PyAny>, x: &Bound<'_, PyAny>) -> PyResult<Batch> {
     let np = types.py().import("numpy")?;
-    let t = super::array_of_numbers(types, "types")?;
+    let t = array_of_numbers(types, "types")?;
     let t: Vec<i64> = np
         .call_method1("ascontiguousarray", (t, "int64"))?
         .call_method0("ravel")?

@@ -6,7 +6,9 @@ use dhcd::Motion;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-use super::{interrupt, par, real_arg, rows_of, step_args, to_py, StepArgs};
+use crate::arrays::rows_of;
+use crate::ccd::{step_args, StepArgs};
+use crate::{interrupt, par, real_arg, to_py};
 
 /// The largest fraction of the step `x0 -> x1` (in `[0, 1]`) that keeps every pair of
 /// features at least `min_distance + (1 - rescaling) (d0 - min_distance)` apart, `d0` its
