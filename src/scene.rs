@@ -889,6 +889,9 @@ fn contacts_of<K: BoundingVolume>(objects: &mut [Object<K>], parallel: bool) -> 
     out
 }
 
+/// Each object's step over a query (`None`: still) and its box over the step.
+type ObjectStep = (Option<Step>, [[f32; 3]; 2]);
+
 /// Each object's step (checked, in internal order; `None`: still) and box over the step (the
 /// stored root box for a still object), from `motions[i]`, object `i`'s motion: the first
 /// error in scene order.
@@ -896,7 +899,7 @@ fn steps_of<K: BoundingVolume>(
     objects: &[Object<K>],
     motions: &[Option<Motion<'_>>],
     parallel: bool,
-) -> Result<Vec<(Option<Step>, [[f32; 3]; 2])>> {
+) -> Result<Vec<ObjectStep>> {
     map_objects(objects.len(), parallel, |i| {
         let o = &objects[i];
         let Some(motion) = motions[i] else {
@@ -914,7 +917,7 @@ fn steps_of<K: BoundingVolume>(
 /// once, shared by all its jobs); a still object's step is its stored pose at both ends.
 fn sweep_jobs<'h, K: BoundingVolume>(
     objects: &'h [Object<K>],
-    steps: &'h [(Option<Step>, [[f32; 3]; 2])],
+    steps: &'h [ObjectStep],
     jobs: &[(usize, usize)],
     sweeps: &mut Vec<Option<Swept<'h, K>>>,
     parallel: bool,

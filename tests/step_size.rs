@@ -6,8 +6,8 @@ use dhcd::bv::BoundingVolume;
 use dhcd::ccd::{self, CcdOptions, TOI_TOLERANCE};
 use dhcd::contact::{collision_free_stepsize, collision_free_stepsize_with, StepOptions};
 use dhcd::distance::{edge_edge_distance_sq, point_triangle_distance_sq};
-use dhcd::shapes::{fold_x, grid, jitter};
 use dhcd::scene::Scene;
+use dhcd::shapes::{fold_x, grid, jitter};
 use dhcd::{
     for_each_method, self_ccd, CcdQuery, Error, Hierarchy, Mesh, Motion, Options, Par, Workspace,
 };
@@ -295,7 +295,11 @@ fn a_scene_equals_the_brute_force_over_its_pairs() {
                 assert_eq!(s.limiting.toi.map_or(1.0, |t| t.clamp(0.0, 1.0)), s.step);
                 let q = CcdQuery::earliest().with_min_distance(o.min_distance);
                 if let Some(t) = scene.ccd(&motions, &q, par).unwrap().toi {
-                    assert!(s.step <= t + TOI_TOLERANCE, "{} past the impact {t}", s.step);
+                    assert!(
+                        s.step <= t + TOI_TOLERANCE,
+                        "{} past the impact {t}",
+                        s.step
+                    );
                 }
             }
             // Bad input: typed errors before any work.
@@ -307,7 +311,9 @@ fn a_scene_equals_the_brute_force_over_its_pairs() {
                 rescaling: 0.0,
                 ..o
             };
-            let e = scene.collision_free_stepsize(&motions, &bad, Par::Seq).unwrap_err();
+            let e = scene
+                .collision_free_stepsize(&motions, &bad, Par::Seq)
+                .unwrap_err();
             assert!(matches!(e, Error::InvalidRescaling(_)), "{e}");
             let e = scene
                 .collision_free_stepsize(&[(dhcd::ObjectId(99), motions[0].1)], &o, Par::Seq)
