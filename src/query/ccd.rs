@@ -34,7 +34,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{grown, meet, meeting, ordered_edge, points_box_f64, union_of};
+use super::features::{points_box_f64, Candidates, LeafEdges, LeafTriangles};
 use crate::bv::swept::{f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
@@ -46,7 +46,7 @@ use crate::mesh::check_positions_f64;
 use crate::par::Par;
 use crate::tree::RegionTree;
 use crate::walk::{self, Query, Side, Workspace};
-use dhcd_kernels::overlap::{BoxRows, MAX_BOX_ROW};
+use dhcd_kernels::overlap::BoxRows;
 
 /// One mesh's motion over a step: every vertex's position at t0 and at t1, in the mesh's
 /// vertex order (`f64`, finite and within the `f32` range, as [`crate::Mesh::new_f64`]
@@ -337,16 +337,17 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         std::array::from_fn(|f| &self.tri_rows[f][r.clone()])
     }
 
-    /// Leaf `leaf`'s own edges and their boxes over the step.
-    fn own_edges(&self, leaf: usize) -> (&'h [[u32; 2]], BoxRows<'_>) {
+    /// Leaf `leaf`'s own edges and their boxes over the step, as candidates.
+    fn edges(&self, leaf: usize) -> LeafEdges<'_> {
         let tree = self.tree();
         let rank = tree.leaf_rank(leaf).expect("a leaf");
         let edges = tree.leaf_edges();
         let r = edges.range_of_rank(rank);
-        (
-            edges.of_rank(rank),
-            std::array::from_fn(|f| &self.edge_rows[f][r.clone()]),
-        )
+        LeafEdges {
+            edges: edges.of_rank(rank),
+            rows: std::array::from_fn(|f| &self.edge_rows[f][r.clone()]),
+            order: tree.vert_order(),
+        }
     }
 }
 
@@ -776,7 +777,13 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
             face_vertex,
             edge_edge,
         } = out;
-        self.vertices_vs_triangles(simd, a, x, b, y, counters, |v, t, toi| {
+        let stopped = || budget.stopped();
+        let candidates = Candidates {
+            self_query,
+            margin: self.margin,
+            stopped: &stopped,
+        };
+        self.vertices_vs_triangles(simd, &candidates, a, x, b, y, counters, |v, t, toi| {
             budget.push(
                 vertex_face,
                 VertexImpact {
@@ -787,7 +794,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
             )
         });
         if !(self_query && x == y) {
-            self.vertices_vs_triangles(simd, b, y, a, x, counters, |v, t, toi| {
+            self.vertices_vs_triangles(simd, &candidates, b, y, a, x, counters, |v, t, toi| {
                 if self_query {
                     budget.push(
                         vertex_face,
@@ -809,7 +816,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
                 }
             });
         }
-        self.edges_vs_edges(simd, x, y, counters, edge_edge);
+        self.edges_vs_edges(simd, &candidates, x, y, counters, edge_edge);
         budget.add(out.len() - before);
     }
 
@@ -837,6 +844,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     fn vertices_vs_triangles<S: Simd>(
         &self,
         simd: S,
+        candidates: &Candidates<'_>,
         sv: &Swept<'_, K>,
         x: usize,
         st: &Swept<'_, K>,
@@ -845,39 +853,28 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         mut emit: impl FnMut(usize, usize, f64),
     ) {
         let rows = st.tri_boxes(y);
-        let n = rows[0].len();
-        let near = grown(&union_of(&rows, n), self.margin);
-        let first = st.tree().tri_range(y).start;
-        let corners_of = st.tree().triangles();
-        for v in sv.tree().vert_run(x) {
-            let vbox = points_box_f64([sv.step.x0[v], sv.step.x1[v]]);
-            if !meet(&vbox, &near) {
-                continue;
-            }
-            let probe = grown(&vbox, self.margin);
-            // PERF: mask loops, not closures (see `proximity.rs`).
-            for base in (0..n).step_by(MAX_BOX_ROW) {
-                // A row may hold pairs that take the exact path: stop promptly when asked.
-                if self.budget.stopped() {
-                    return;
+        let tris = LeafTriangles {
+            len: rows[0].len(),
+            rows,
+            first: st.tree().tri_range(y).start,
+            corners: st.tree().triangles(),
+        };
+        let vertex_box = |v: usize| points_box_f64([sv.step.x0[v], sv.step.x1[v]]);
+        candidates.vertices_vs_triangles(
+            simd,
+            sv.tree().vert_run(x),
+            vertex_box,
+            &tris,
+            counters,
+            |v, t| {
+                let stop = || self.budget.poll();
+                let o = self.options_now();
+                if let Some(toi) = vertex_face_toi(sv, v, st, t, &o, self.gap.as_ref(), &stop) {
+                    self.found(toi);
+                    emit(v, t, toi);
                 }
-                let mut bits = meeting(simd, &probe, &rows, base, n);
-                while bits != 0 {
-                    let t = first + base + bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    if self.self_query && corners_of[t].contains(&(v as u32)) {
-                        continue;
-                    }
-                    counters.prim_tests += 1;
-                    let stop = || self.budget.poll();
-                    let o = self.options_now();
-                    if let Some(toi) = vertex_face_toi(sv, v, st, t, &o, self.gap.as_ref(), &stop) {
-                        self.found(toi);
-                        emit(v, t, toi);
-                    }
-                }
-            }
-        }
+            },
+        );
     }
 
     /// The own edges of leaf `x` of A against those of leaf `y` of B (a leaf with itself:
@@ -886,70 +883,33 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     fn edges_vs_edges<S: Simd>(
         &self,
         simd: S,
+        candidates: &Candidates<'_>,
         x: usize,
         y: usize,
         counters: &mut Counters,
         out: &mut Vec<EdgeImpact>,
     ) {
         let (sa, sb) = (self.a, self.b);
-        let same = self.self_query && x == y;
-        let (ea, ra) = sa.own_edges(x);
-        let (eb, rb) = sb.own_edges(y);
-        let near = grown(&union_of(&rb, eb.len()), self.margin);
-        let (oa, ob) = (sa.tree().vert_order(), sb.tree().vert_order());
-        for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
-            let mut near_bits = meeting(simd, &near, &ra, base_a, ea.len());
-            while near_bits != 0 {
-                let i = base_a + near_bits.trailing_zeros() as usize;
-                near_bits &= near_bits - 1;
-                let [u0, u1] = ea[i];
-                let abox = (
-                    [ra[0][i], ra[1][i], ra[2][i]],
-                    [ra[3][i], ra[4][i], ra[5][i]],
+        let (a, b) = (sa.edges(x), sb.edges(y));
+        let same_leaf = self.self_query && x == y;
+        candidates.edges_vs_edges(simd, &a, &b, same_leaf, counters, |ex, ey| {
+            // `ex` is of A (or, in a self query, of the one mesh), `ey` of B; the exact test
+            // takes the edges in the reported order.
+            let px = ex.internal.map(|v| sa.step_at(v as usize));
+            let py = ey.internal.map(|v| sb.step_at(v as usize));
+            let stop = || self.budget.poll();
+            let o = self.options_now();
+            if let Some(toi) = edge_edge_toi(px, py, &o, self.gap.as_ref(), &stop) {
+                self.found(toi);
+                self.budget.push(
+                    out,
+                    EdgeImpact {
+                        a: ex.ids,
+                        b: ey.ids,
+                        toi,
+                    },
                 );
-                let probe = grown(&abox, self.margin);
-                let (a_ids, a_int) = ordered_edge(oa, ea[i]);
-                let pa = a_int.map(|v| sa.step_at(v as usize));
-                let from = if same { i + 1 } else { 0 };
-                for base in (from..eb.len()).step_by(MAX_BOX_ROW) {
-                    if self.budget.stopped() {
-                        return;
-                    }
-                    let mut bits = meeting(simd, &probe, &rb, base, eb.len());
-                    while bits != 0 {
-                        let j = base + bits.trailing_zeros() as usize;
-                        bits &= bits - 1;
-                        let [w0, w1] = eb[j];
-                        if self.self_query && (u0 == w0 || u0 == w1 || u1 == w0 || u1 == w1) {
-                            continue;
-                        }
-                        counters.prim_tests += 1;
-                        let (b_ids, b_int) = ordered_edge(ob, eb[j]);
-                        let pb = b_int.map(|v| sb.step_at(v as usize));
-                        // In a self query the smaller edge first: the exact test takes the
-                        // edges in the reported order.
-                        let swap = self.self_query && b_ids < a_ids;
-                        let (ids_x, ids_y, px, py) = if swap {
-                            (b_ids, a_ids, pb, pa)
-                        } else {
-                            (a_ids, b_ids, pa, pb)
-                        };
-                        let stop = || self.budget.poll();
-                        let o = self.options_now();
-                        if let Some(toi) = edge_edge_toi(px, py, &o, self.gap.as_ref(), &stop) {
-                            self.found(toi);
-                            self.budget.push(
-                                out,
-                                EdgeImpact {
-                                    a: ids_x,
-                                    b: ids_y,
-                                    toi,
-                                },
-                            );
-                        }
-                    }
-                }
             }
-        }
+        });
     }
 }

@@ -1,8 +1,22 @@
-//! Feature boxes and their culling, shared by the queries on features (proximity, CCD):
-//! boxes are `f32`, closed, rounded outward from the positions; a leaf's boxes are six rows
-//! (`lo xyz`, `hi xyz`) tested 64 at a time by [`boxes_meet_with`].
+//! The feature-pair layer under the queries on features (proximity, CCD, and through them
+//! the contact set and the step size): the candidate feature pairs of one leaf pair,
+//! enumerated once, generic over the decision each query makes of a candidate.
+//!
+//! Ownership makes each candidate unique: every vertex belongs to one leaf (its own
+//! vertices, the ones first seen in it) and so does every edge (the leaf of its first
+//! triangle), so a vertex-triangle pair is met only in the leaf pair (vertex's leaf,
+//! triangle's leaf) and an edge pair only in the pair of their leaves, however many
+//! triangles share the features. Inside a leaf pair, features are culled first by the other
+//! leaf's union box grown by the query's margin, then pair by pair by their boxes grown by it
+//! ([`Candidates`]); in a self query, pairs sharing a vertex are skipped. Boxes are `f32`,
+//! closed, rounded outward from the positions; a leaf's boxes are six rows (`lo xyz`, `hi
+//! xyz`) tested 64 at a time by [`boxes_meet_with`].
+
+use std::ops::Range;
 
 use pulp::Simd;
+
+use crate::counters::Counters;
 
 use crate::bv::swept::{f32_down, f32_up};
 use dhcd_kernels::overlap::{boxes_meet_with, BoxRows, MAX_BOX_ROW};
@@ -89,5 +103,143 @@ pub(crate) fn ordered_edge(order: &[u32], [s, t]: [u32; 2]) -> ([u32; 2], [u32; 
         ([os, ot], [s, t])
     } else {
         ([ot, os], [t, s])
+    }
+}
+
+/// A leaf's triangles as candidates: their boxes (the first `len` of six rows), the internal
+/// index of the first, and every triangle's corners (internal indices).
+pub(crate) struct LeafTriangles<'a> {
+    pub(crate) rows: BoxRows<'a>,
+    pub(crate) len: usize,
+    pub(crate) first: usize,
+    pub(crate) corners: &'a [[u32; 3]],
+}
+
+/// A leaf's own edges as candidates (internal vertex indices) with their boxes, and the
+/// internal-to-original vertex order of their mesh.
+pub(crate) struct LeafEdges<'a> {
+    pub(crate) edges: &'a [[u32; 2]],
+    pub(crate) rows: BoxRows<'a>,
+    pub(crate) order: &'a [u32],
+}
+
+/// An edge of a candidate pair: its original vertex indices, smaller first, and its
+/// internal indices in the same order ([`ordered_edge`]).
+#[derive(Clone, Copy)]
+pub(crate) struct CandidateEdge {
+    pub(crate) ids: [u32; 2],
+    pub(crate) internal: [u32; 2],
+}
+
+/// The candidate enumeration of one query: the boxes' growth and whether the two sides are
+/// one mesh. `stopped` is read before each row of 64 boxes, so a query stops promptly when
+/// its budget says so (a row may hold pairs that take the exact path).
+pub(crate) struct Candidates<'c> {
+    pub(crate) self_query: bool,
+    /// The query's distance as an `f32` not below it: the boxes' growth.
+    pub(crate) margin: f32,
+    pub(crate) stopped: &'c dyn Fn() -> bool,
+}
+
+impl Candidates<'_> {
+    /// The vertices `vertices` (internal, of one leaf; `vertex_box(v)` their boxes) against
+    /// the triangles `tris` of another (or the same) leaf: `decide(v, t)` (internal indices)
+    /// for every pair whose grown boxes meet, but a triangle containing the vertex in a self
+    /// query; each counted in `prim_tests`.
+    // PERF: mask loops, not closures around the box tests: a closure may be compiled without
+    // the dispatched target features (the kernel then calls every intrinsic).
+    #[inline(always)]
+    pub(crate) fn vertices_vs_triangles<S: Simd>(
+        &self,
+        simd: S,
+        vertices: Range<usize>,
+        vertex_box: impl Fn(usize) -> FeatureBox,
+        tris: &LeafTriangles<'_>,
+        counters: &mut Counters,
+        mut decide: impl FnMut(usize, usize),
+    ) {
+        let (rows, n) = (&tris.rows, tris.len);
+        let near = grown(&union_of(rows, n), self.margin);
+        for v in vertices {
+            let vbox = vertex_box(v);
+            if !meet(&vbox, &near) {
+                continue;
+            }
+            let probe = grown(&vbox, self.margin);
+            for base in (0..n).step_by(MAX_BOX_ROW) {
+                if (self.stopped)() {
+                    return;
+                }
+                let mut bits = meeting(simd, &probe, rows, base, n);
+                while bits != 0 {
+                    let t = tris.first + base + bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    if self.self_query && tris.corners[t].contains(&(v as u32)) {
+                        continue;
+                    }
+                    counters.prim_tests += 1;
+                    decide(v, t);
+                }
+            }
+        }
+    }
+
+    /// The own edges `a` of one leaf against `b` of another (`same_leaf`: the same leaf of
+    /// a self query, each unordered pair once): `decide(x, y)` for every pair whose grown
+    /// boxes meet, but edges sharing a vertex in a self query; each counted in
+    /// `prim_tests`. `x` is `a`'s edge and `y` `b`'s, but in a self query the edge with the
+    /// smaller original indices comes first (both sides are then one mesh).
+    #[inline(always)]
+    pub(crate) fn edges_vs_edges<S: Simd>(
+        &self,
+        simd: S,
+        a: &LeafEdges<'_>,
+        b: &LeafEdges<'_>,
+        same_leaf: bool,
+        counters: &mut Counters,
+        mut decide: impl FnMut(CandidateEdge, CandidateEdge),
+    ) {
+        let (ea, eb) = (a.edges, b.edges);
+        let (ra, rb) = (&a.rows, &b.rows);
+        let near = grown(&union_of(rb, eb.len()), self.margin);
+        for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
+            let mut near_bits = meeting(simd, &near, ra, base_a, ea.len());
+            while near_bits != 0 {
+                let i = base_a + near_bits.trailing_zeros() as usize;
+                near_bits &= near_bits - 1;
+                let [u0, u1] = ea[i];
+                let abox = (
+                    [ra[0][i], ra[1][i], ra[2][i]],
+                    [ra[3][i], ra[4][i], ra[5][i]],
+                );
+                let probe = grown(&abox, self.margin);
+                let (ids, internal) = ordered_edge(a.order, ea[i]);
+                let x = CandidateEdge { ids, internal };
+                // A leaf with itself: only j > i.
+                let from = if same_leaf { i + 1 } else { 0 };
+                for base in (from..eb.len()).step_by(MAX_BOX_ROW) {
+                    if (self.stopped)() {
+                        return;
+                    }
+                    let mut bits = meeting(simd, &probe, rb, base, eb.len());
+                    while bits != 0 {
+                        let j = base + bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        let [w0, w1] = eb[j];
+                        if self.self_query && (u0 == w0 || u0 == w1 || u1 == w0 || u1 == w1) {
+                            continue;
+                        }
+                        counters.prim_tests += 1;
+                        let (ids, internal) = ordered_edge(b.order, eb[j]);
+                        let y = CandidateEdge { ids, internal };
+                        if self.self_query && y.ids < x.ids {
+                            decide(y, x);
+                        } else {
+                            decide(x, y);
+                        }
+                    }
+                }
+            }
+        }
     }
 }

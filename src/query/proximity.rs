@@ -3,14 +3,10 @@
 //!
 //! The walk is the contact query's with the node test grown by `d` ([`Within`]): two regions
 //! holding features within `d` of each other have volumes within `d`, so every such pair
-//! lies in a leaf pair the walk reaches. Each leaf pair enumerates its features once:
-//! every vertex belongs to one leaf (its own vertices, the ones first seen in it) and so does
-//! every edge (the leaf of its first triangle), so a vertex-triangle pair is met only in the
-//! leaf pair (vertex's leaf, triangle's leaf) and an edge pair only in the pair of their
-//! leaves, however many triangles share the features. Inside a leaf pair, features are first
-//! culled by the other leaf's union box grown by `d`, then pair by pair by their boxes grown
-//! by `d` (boxes in `f32`, rounded outward for `f64` hierarchies), and the pairs left go to
-//! the exact tests of [`crate::distance`].
+//! lies in a leaf pair the walk reaches. Each leaf pair's candidate feature pairs come from
+//! the feature-pair layer ([`super::features`]: each pair once, culled by boxes grown by `d`,
+//! in `f32`, rounded outward for `f64` hierarchies), and go to the exact tests of
+//! [`crate::distance`].
 //!
 //! Results are in the caller's original indices, sorted, and the same for every thread count
 //! and every method. `prim_tests` counts the feature pairs given to the exact test; `contacts`
@@ -18,7 +14,7 @@
 
 use pulp::Simd;
 
-use super::features::{grown, meet, meeting, ordered_edge, points_box, union_of};
+use super::features::{points_box, Candidates, LeafEdges, LeafTriangles};
 use super::{LeafAction, NodeTest, Posed, PosedQuery, Within};
 use crate::bv::BoundingVolume;
 use crate::control::Budget;
@@ -28,7 +24,6 @@ use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
 use crate::walk::{self, Workspace};
-use dhcd_kernels::overlap::{BoxRows, MAX_BOX_ROW};
 
 /// A vertex within the distance of a triangle: in a pair query, a vertex of the first
 /// hierarchy and a triangle of the second (see [`FaceVertex`] for the other way round); in a
@@ -194,10 +189,16 @@ struct Leaf<'h, K: BoundingVolume> {
 }
 
 impl<'h, K: BoundingVolume> Leaf<'h, K> {
-    fn own_edges(&self) -> &'h [[u32; 2]] {
+    /// The leaf's own edges as candidates.
+    fn edges(&self) -> LeafEdges<'h> {
         let tree = self.h.tree();
-        tree.leaf_edges()
-            .of_rank(tree.leaf_rank(self.node).expect("a leaf"))
+        LeafEdges {
+            edges: tree
+                .leaf_edges()
+                .of_rank(tree.leaf_rank(self.node).expect("a leaf")),
+            rows: self.h.leaf_edge_boxes(self.node),
+            order: tree.vert_order(),
+        }
     }
 }
 
@@ -234,8 +235,14 @@ impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features<'_, '_> {
         let res = &mut out.result;
         let budget = self.budget;
         let before = res.vertex_face.len() + res.face_vertex.len() + res.edge_edge.len();
+        let stopped = || budget.stopped();
+        let candidates = Candidates {
+            self_query,
+            margin: self.margin,
+            stopped: &stopped,
+        };
         // Vertices of x against triangles of y, and (but for a leaf with itself) the other way.
-        self.vertices_vs_triangles(simd, lx, ly, self_query, counters, |v, t, d2, kind| {
+        self.vertices_vs_triangles(simd, &candidates, lx, ly, counters, |v, t, d2, kind| {
             budget.push(
                 &mut res.vertex_face,
                 VertexFace {
@@ -247,7 +254,7 @@ impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features<'_, '_> {
             )
         });
         if !(self_query && x == y) {
-            self.vertices_vs_triangles(simd, ly, lx, self_query, counters, |v, t, d2, kind| {
+            self.vertices_vs_triangles(simd, &candidates, ly, lx, counters, |v, t, d2, kind| {
                 if self_query {
                     budget.push(
                         &mut res.vertex_face,
@@ -271,7 +278,7 @@ impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features<'_, '_> {
                 }
             });
         }
-        self.edges_vs_edges(simd, lx, ly, self_query, counters, &mut res.edge_edge);
+        self.edges_vs_edges(simd, &candidates, lx, ly, counters, &mut res.edge_edge);
         let after = res.vertex_face.len() + res.face_vertex.len() + res.edge_edge.len();
         budget.add(after - before);
     }
@@ -300,54 +307,44 @@ impl Features<'_, '_> {
     fn vertices_vs_triangles<S: Simd, K: BoundingVolume>(
         &self,
         simd: S,
+        candidates: &Candidates<'_>,
         lv: Leaf<'_, K>,
         lt: Leaf<'_, K>,
-        self_query: bool,
         counters: &mut Counters,
         mut emit: impl FnMut(u32, u32, f64, PointTriangle),
     ) {
         let (tv, tt) = (lv.h.tree(), lt.h.tree());
-        let tris = lt.h.leaf_tris(simd, lt.node);
-        let soa = &tris.soa;
-        let n = tris.len;
-        let rows: BoxRows = [
-            soa.lo(0),
-            soa.lo(1),
-            soa.lo(2),
-            soa.hi(0),
-            soa.hi(1),
-            soa.hi(2),
-        ];
-        let near = grown(&union_of(&rows, n), self.margin);
+        let leaf_tris = lt.h.leaf_tris(simd, lt.node);
+        let soa = &leaf_tris.soa;
+        let tris = LeafTriangles {
+            rows: [
+                soa.lo(0),
+                soa.lo(1),
+                soa.lo(2),
+                soa.hi(0),
+                soa.hi(1),
+                soa.hi(2),
+            ],
+            len: leaf_tris.len,
+            first: tt.tri_range(lt.node).start,
+            corners: tt.triangles(),
+        };
         let (p, rounded) = (lv.h.points(), lv.h.is_rounded());
-        let first = tt.tri_range(lt.node).start;
-        let corners_of = tt.triangles();
-        for v in tv.vert_run(lv.node) {
-            let vbox = points_box([p.get(v)], rounded);
-            if !meet(&vbox, &near) {
-                continue;
-            }
-            let probe = grown(&vbox, self.margin);
-            let pv = lv.h.position_f64(v);
-            // PERF: mask loops, not closures: a closure may be compiled without the
-            // dispatched target features (the kernel then calls every intrinsic).
-            for base in (0..n).step_by(MAX_BOX_ROW) {
-                let mut bits = meeting(simd, &probe, &rows, base, n);
-                while bits != 0 {
-                    let t = first + base + bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    let corners = corners_of[t];
-                    if self_query && corners.contains(&(v as u32)) {
-                        continue;
-                    }
-                    counters.prim_tests += 1;
-                    let tri = corners.map(|c| lt.h.position_f64(c as usize));
-                    if let Some((d2, kind)) = distance::point_triangle_within(pv, tri, self.d) {
-                        emit(tv.vert_order()[v], tt.tri_order()[t], d2, kind);
-                    }
+        let vertex_box = |v: usize| points_box([p.get(v)], rounded);
+        candidates.vertices_vs_triangles(
+            simd,
+            tv.vert_run(lv.node),
+            vertex_box,
+            &tris,
+            counters,
+            |v, t| {
+                let pv = lv.h.position_f64(v);
+                let tri = tris.corners[t].map(|c| lt.h.position_f64(c as usize));
+                if let Some((d2, kind)) = distance::point_triangle_within(pv, tri, self.d) {
+                    emit(tv.vert_order()[v], tt.tri_order()[t], d2, kind);
                 }
-            }
-        }
+            },
+        );
     }
 
     /// The own edges of leaf `la` against those of `lb` (a leaf with itself: each unordered
@@ -356,68 +353,31 @@ impl Features<'_, '_> {
     fn edges_vs_edges<S: Simd, K: BoundingVolume>(
         &self,
         simd: S,
+        candidates: &Candidates<'_>,
         la: Leaf<'_, K>,
         lb: Leaf<'_, K>,
-        self_query: bool,
         counters: &mut Counters,
         out: &mut Vec<EdgePair>,
     ) {
-        let same = self_query && la.node == lb.node;
-        let (ea, eb) = (la.own_edges(), lb.own_edges());
-        let (ra, rb) = (la.h.leaf_edge_boxes(la.node), lb.h.leaf_edge_boxes(lb.node));
-        let near = grown(&union_of(&rb, eb.len()), self.margin);
-        let (oa, ob) = (la.h.tree().vert_order(), lb.h.tree().vert_order());
-        for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
-            let mut near_bits = meeting(simd, &near, &ra, base_a, ea.len());
-            while near_bits != 0 {
-                let i = base_a + near_bits.trailing_zeros() as usize;
-                near_bits &= near_bits - 1;
-                let [u0, u1] = ea[i];
-                let abox = (
-                    [ra[0][i], ra[1][i], ra[2][i]],
-                    [ra[3][i], ra[4][i], ra[5][i]],
+        let (a, b) = (la.edges(), lb.edges());
+        let same_leaf = candidates.self_query && la.node == lb.node;
+        candidates.edges_vs_edges(simd, &a, &b, same_leaf, counters, |x, y| {
+            // `x` is of `la` (or, in a self query, of the one mesh), `y` of `lb`; the exact
+            // test takes the endpoints in the reported order, so its type names them so.
+            let px = x.internal.map(|v| la.h.position_f64(v as usize));
+            let py = y.internal.map(|v| lb.h.position_f64(v as usize));
+            if let Some((d2, kind)) = distance::edge_edge_within(px[0], px[1], py[0], py[1], self.d)
+            {
+                self.budget.push(
+                    out,
+                    EdgePair {
+                        a: x.ids,
+                        b: y.ids,
+                        distance_sq: d2,
+                        kind,
+                    },
                 );
-                let probe = grown(&abox, self.margin);
-                let (a_ids, a_int) = ordered_edge(oa, ea[i]);
-                let pa = a_int.map(|v| la.h.position_f64(v as usize));
-                // A leaf with itself: only j > i.
-                let from = if same { i + 1 } else { 0 };
-                for base in (from..eb.len()).step_by(MAX_BOX_ROW) {
-                    let mut bits = meeting(simd, &probe, &rb, base, eb.len());
-                    while bits != 0 {
-                        let j = base + bits.trailing_zeros() as usize;
-                        bits &= bits - 1;
-                        let [w0, w1] = eb[j];
-                        if self_query && (u0 == w0 || u0 == w1 || u1 == w0 || u1 == w1) {
-                            continue;
-                        }
-                        counters.prim_tests += 1;
-                        let (b_ids, b_int) = ordered_edge(ob, eb[j]);
-                        let pb = b_int.map(|v| lb.h.position_f64(v as usize));
-                        // In a self query the smaller edge first; the exact test takes the
-                        // endpoints in the reported order, so its type names them as reported.
-                        let swap = self_query && b_ids < a_ids;
-                        let (x, y, px, py) = if swap {
-                            (b_ids, a_ids, pb, pa)
-                        } else {
-                            (a_ids, b_ids, pa, pb)
-                        };
-                        if let Some((d2, kind)) =
-                            distance::edge_edge_within(px[0], px[1], py[0], py[1], self.d)
-                        {
-                            self.budget.push(
-                                out,
-                                EdgePair {
-                                    a: x,
-                                    b: y,
-                                    distance_sq: d2,
-                                    kind,
-                                },
-                            );
-                        }
-                    }
-                }
             }
-        }
+        });
     }
 }
