@@ -547,7 +547,8 @@ typedef struct DhcdSceneImpacts {
 
 /**
  * Every pair of features within `dhat`, once, with the IPC Toolkit's collision type, from
- * `dhcd_self_contact_set` or `dhcd_contact_set` (release with `dhcd_contact_set_free`).
+ * `dhcd_self_contact_set`, `dhcd_contact_set` or `dhcd_scene_contact_set` (release with
+ * `dhcd_contact_set_free`).
  * Row `k` of each array; rows sorted by type, then vertices.
  */
 typedef struct DhcdContactSet {
@@ -1108,6 +1109,65 @@ int dhcd_scene_ccd(struct DhcdScene *s,
                    int earliest,
                    uint32_t threads,
                    struct DhcdSceneImpacts *out);
+
+/**
+ * Every pair of features within `dhat` (finite, `>= 0`) between every two objects, and
+ * inside every object with self-collision on, once, into `*out` (see `DhcdContactSet`;
+ * release with `dhcd_contact_set_free`), in one global numbering: each object's vertices
+ * and edges follow those of the objects added before it and still in the scene
+ * (`dhcd_scene_vertex_offset`, `dhcd_scene_edge_offset`). The mollifier thresholds come
+ * from each object's positions when it was added.
+ *
+ * # Safety
+ * `s` null or a live handle; `out` null or valid for a write.
+ */
+int dhcd_scene_contact_set(struct DhcdScene *s,
+                           double dhat,
+                           uint32_t threads,
+                           struct DhcdContactSet *out);
+
+/**
+ * Where object `id`'s vertices start in the scene's global numbering (that of
+ * `dhcd_scene_contact_set`), into `*out`.
+ *
+ * # Safety
+ * `s` null or a live handle; `out` null or valid for a write.
+ */
+int dhcd_scene_vertex_offset(const struct DhcdScene *s, uint64_t id, uint64_t *out);
+
+/**
+ * Where object `id`'s edge ids start in the scene's global numbering: the edge count
+ * (`dhcd_hierarchy_edges`) of the objects before it, into `*out`.
+ *
+ * # Safety
+ * `s` null or a live handle; `out` null or valid for a write.
+ */
+int dhcd_scene_edge_offset(const struct DhcdScene *s, uint64_t id, uint64_t *out);
+
+/**
+ * The collision-free step size of the whole scene over one step, into `*step`: the largest
+ * fraction in `[0, 1]` of the step that keeps every pair (between two objects, and inside
+ * every object with self-collision on) at least `min_distance + (1 - rescaling) (d0 -
+ * min_distance)` apart, `d0` its distance at t0 (`dhcd_collision_free_stepsize`'s rule).
+ * The motions are as in `dhcd_scene_ccd` (entry `k` moves object `ids[k]`; every other
+ * object stays at its stored pose; the scene does not change). Everything is checked
+ * before any work, as in `dhcd_scene_ccd`; `rescaling` outside `(0, 1]` or a bad
+ * `min_distance` is `DHCD_ERR_INVALID_ARGUMENT`. The step does not depend on `threads`.
+ *
+ * # Safety
+ * As `dhcd_scene_ccd` for `s`, `ids`, `x0`, `x1`, `vertex_counts` and `count`; `step` null
+ * or valid for a write.
+ */
+int dhcd_scene_collision_free_stepsize(struct DhcdScene *s,
+                                       const uint64_t *ids,
+                                       const double *const *x0,
+                                       const double *const *x1,
+                                       const size_t *vertex_counts,
+                                       size_t count,
+                                       double min_distance,
+                                       double rescaling,
+                                       uint32_t threads,
+                                       double *step);
 
 /**
  * Every pair of features of one mesh within `dhat` (finite, `>= 0`), once, into `*out` (see

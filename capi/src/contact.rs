@@ -19,7 +19,8 @@ use crate::DHCD_ERR_INVALID_ARGUMENT;
 pub const DHCD_CLOSEST_NONE: u8 = u8::MAX;
 
 /// Every pair of features within `dhat`, once, with the IPC Toolkit's collision type, from
-/// `dhcd_self_contact_set` or `dhcd_contact_set` (release with `dhcd_contact_set_free`).
+/// `dhcd_self_contact_set`, `dhcd_contact_set` or `dhcd_scene_contact_set` (release with
+/// `dhcd_contact_set_free`).
 /// Row `k` of each array; rows sorted by type, then vertices.
 #[repr(C)]
 #[derive(Debug)]
@@ -53,7 +54,7 @@ pub struct DhcdContactSet {
     pub counters: DhcdCounters,
 }
 
-const NO_CONTACT_SET: DhcdContactSet = DhcdContactSet {
+pub(crate) const NO_CONTACT_SET: DhcdContactSet = DhcdContactSet {
     vertices: std::ptr::null_mut(),
     types: std::ptr::null_mut(),
     distance_sq: std::ptr::null_mut(),
@@ -80,7 +81,7 @@ fn id(v: u32) -> i64 {
 }
 
 /// The one marshalling of a `ContactSet` into C arrays.
-fn contact_set_out(s: dhcd::ContactSet) -> DhcdContactSet {
+pub(crate) fn contact_set_out(s: dhcd::ContactSet) -> DhcdContactSet {
     let c = &s.contacts;
     DhcdContactSet {
         vertices: c_pairs(c.iter().map(|c| c.vertices.map(id)).collect()),

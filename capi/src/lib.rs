@@ -87,10 +87,11 @@ pub use proximity::{
     DhcdProximity, DhcdSceneProximity,
 };
 pub use scene::{
-    dhcd_scene_add, dhcd_scene_add_f64, dhcd_scene_ccd, dhcd_scene_contacts, dhcd_scene_free,
+    dhcd_scene_add, dhcd_scene_add_f64, dhcd_scene_ccd, dhcd_scene_collision_free_stepsize,
+    dhcd_scene_contact_set, dhcd_scene_contacts, dhcd_scene_edge_offset, dhcd_scene_free,
     dhcd_scene_new, dhcd_scene_proximity, dhcd_scene_remove, dhcd_scene_set_self_collision,
     dhcd_scene_step, dhcd_scene_update_many, dhcd_scene_update_positions,
-    dhcd_scene_update_positions_f64, DhcdScene,
+    dhcd_scene_update_positions_f64, dhcd_scene_vertex_offset, DhcdScene,
 };
 
 use std::ffi::c_int;

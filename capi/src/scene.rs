@@ -1,16 +1,18 @@
 //! A scene of many objects: `DhcdScene`, its objects (add, remove, position updates,
 //! self-collision) and its queries. Each query's result type, its conversion from the
 //! library's result and its `*_free` are in the query family's file (`collide`,
-//! `proximity`, `ccd`); a query's entry here parses the arguments ([`updates`],
+//! `proximity`, `ccd`, `contact`); a query's entry here parses the arguments ([`updates`],
 //! [`motions`]), runs the library's scene query and writes that conversion.
 
 use std::ffi::c_int;
 
+use dhcd::contact::StepOptions;
 use dhcd::scene::{ObjectId, Scene};
 use dhcd::{Mesh, Motion};
 
 use crate::ccd::{ccd_query, scene_impacts_out, DhcdSceneImpacts, NO_SCENE_IMPACTS};
 use crate::collide::{scene_contacts_out, DhcdSceneContacts, NO_SCENE_CONTACTS};
+use crate::contact::{contact_set_out, DhcdContactSet, NO_CONTACT_SET};
 use crate::error::{guard, null, Fail};
 use crate::marshal::{
     handle, mesh, mesh_f64, method_of, motion, options, par, positions, positions_f64, slice, write,
@@ -449,5 +451,114 @@ pub unsafe extern "C" fn dhcd_scene_ccd(
         let p = s.scene.ccd(&motions, &q, par)?;
         // SAFETY: caller's contract on `out` (written above).
         unsafe { write(out, scene_impacts_out(p), "out") }
+    })
+}
+
+/// Every pair of features within `dhat` (finite, `>= 0`) between every two objects, and
+/// inside every object with self-collision on, once, into `*out` (see `DhcdContactSet`;
+/// release with `dhcd_contact_set_free`), in one global numbering: each object's vertices
+/// and edges follow those of the objects added before it and still in the scene
+/// (`dhcd_scene_vertex_offset`, `dhcd_scene_edge_offset`). The mollifier thresholds come
+/// from each object's positions when it was added.
+///
+/// # Safety
+/// `s` null or a live handle; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_contact_set(
+    s: *mut DhcdScene,
+    dhat: f64,
+    threads: u32,
+    out: *mut DhcdContactSet,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract on `out`: empty until there is a result.
+        unsafe { write(out, NO_CONTACT_SET, "out")? };
+        // SAFETY: caller's contract.
+        let s = unsafe { handle(s, "scene")? };
+        let c = s.scene.contact_set(dhat, par(threads)?)?;
+        // SAFETY: as above.
+        unsafe { write(out, contact_set_out(c), "out") }
+    })
+}
+
+/// Where object `id`'s vertices start in the scene's global numbering (that of
+/// `dhcd_scene_contact_set`), into `*out`.
+///
+/// # Safety
+/// `s` null or a live handle; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_vertex_offset(
+    s: *const DhcdScene,
+    id: u64,
+    out: *mut u64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: null or a live handle (caller's contract); only read.
+        let s = unsafe { s.as_ref() }.ok_or_else(|| null("scene"))?;
+        let offset = s.scene.vertex_offset(ObjectId(id))?;
+        // SAFETY: caller's contract on `out`.
+        unsafe { write(out, offset, "out") }
+    })
+}
+
+/// Where object `id`'s edge ids start in the scene's global numbering: the edge count
+/// (`dhcd_hierarchy_edges`) of the objects before it, into `*out`.
+///
+/// # Safety
+/// `s` null or a live handle; `out` null or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dhcd_scene_edge_offset(
+    s: *const DhcdScene,
+    id: u64,
+    out: *mut u64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: null or a live handle (caller's contract); only read.
+        let s = unsafe { s.as_ref() }.ok_or_else(|| null("scene"))?;
+        let offset = s.scene.edge_offset(ObjectId(id))?;
+        // SAFETY: caller's contract on `out`.
+        unsafe { write(out, offset, "out") }
+    })
+}
+
+/// The collision-free step size of the whole scene over one step, into `*step`: the largest
+/// fraction in `[0, 1]` of the step that keeps every pair (between two objects, and inside
+/// every object with self-collision on) at least `min_distance + (1 - rescaling) (d0 -
+/// min_distance)` apart, `d0` its distance at t0 (`dhcd_collision_free_stepsize`'s rule).
+/// The motions are as in `dhcd_scene_ccd` (entry `k` moves object `ids[k]`; every other
+/// object stays at its stored pose; the scene does not change). Everything is checked
+/// before any work, as in `dhcd_scene_ccd`; `rescaling` outside `(0, 1]` or a bad
+/// `min_distance` is `DHCD_ERR_INVALID_ARGUMENT`. The step does not depend on `threads`.
+///
+/// # Safety
+/// As `dhcd_scene_ccd` for `s`, `ids`, `x0`, `x1`, `vertex_counts` and `count`; `step` null
+/// or valid for a write.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn dhcd_scene_collision_free_stepsize(
+    s: *mut DhcdScene,
+    ids: *const u64,
+    x0: *const *const f64,
+    x1: *const *const f64,
+    vertex_counts: *const usize,
+    count: usize,
+    min_distance: f64,
+    rescaling: f64,
+    threads: u32,
+    step: *mut f64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: caller's contract.
+        let s = unsafe { handle(s, "scene")? };
+        let par = par(threads)?;
+        // SAFETY: caller's contract on the arrays.
+        let motions = unsafe { motions(ids, x0, x1, vertex_counts, count)? };
+        let o = StepOptions {
+            min_distance,
+            rescaling,
+        };
+        let r = s.scene.collision_free_stepsize(&motions, &o, par)?;
+        // SAFETY: caller's contract on `step`.
+        unsafe { write(step, r.step, "step") }
     })
 }

@@ -3174,3 +3174,159 @@ fn contact_set_geometry_and_step_size() {
         dhcd_hierarchy_free(h);
     }
 }
+
+/// The scene's contact set, offsets and step size through the C ABI equal the Rust scene's:
+/// a folded sheet with self-collision on and a small sheet falling onto it.
+#[test]
+fn scene_contact_set_offsets_and_step_size() {
+    use dhcd::contact::StepOptions;
+    let rest = dhcd::shapes::grid(6, 6, 0.1, [0.0; 3]);
+    let sheet: Vec<[f64; 3]> =
+        dhcd::shapes::jitter(&dhcd::shapes::fold_x(rest.positions(), 0.3), [0.004; 3], 2)
+            .iter()
+            .map(|p| p.map(f64::from))
+            .collect();
+    let small = dhcd::shapes::grid(2, 2, 0.1, [0.05, 0.15, 0.02]);
+    let drop0: Vec<[f64; 3]> = f64s(small.positions());
+    let drop1: Vec<[f64; 3]> = drop0.iter().map(|p| [p[0], p[1], p[2] - 1.0]).collect();
+    let meshes = [
+        Mesh::new_f64(sheet.clone(), rest.triangles().to_vec()).unwrap(),
+        Mesh::new_f64(drop0.clone(), small.triangles().to_vec()).unwrap(),
+    ];
+    for method in METHODS {
+        let mut rust = dhcd::Scene::new(method_of(method), options4());
+        let mut s = null_mut();
+        // SAFETY: live handles, arrays of the stated lengths, writable outputs.
+        unsafe {
+            assert_eq!(dhcd_scene_new(method, 4, &mut s), DHCD_OK);
+            for (k, m) in meshes.iter().enumerate() {
+                let p: Vec<f64> = m
+                    .positions_f64()
+                    .unwrap()
+                    .iter()
+                    .flatten()
+                    .copied()
+                    .collect();
+                let t: Vec<u32> = m.triangles().iter().flatten().copied().collect();
+                let mut id = u64::MAX;
+                let on = i32::from(k == 0);
+                let rc = dhcd_scene_add_f64(
+                    s,
+                    p.as_ptr(),
+                    m.vertex_count(),
+                    t.as_ptr(),
+                    m.triangle_count(),
+                    on,
+                    &mut id,
+                );
+                assert_eq!(rc, DHCD_OK, "{}", last_error());
+                let rid = rust.add(m).unwrap();
+                rust.set_self_collision(rid, k == 0).unwrap();
+                assert_eq!(id, rid.0);
+            }
+            // Offsets: the second object's vertices and edges follow the first's.
+            for (id, vertices, edges) in [
+                (0u64, 0u64, 0u64),
+                (
+                    1,
+                    49,
+                    rust.tree(dhcd::ObjectId(0)).unwrap().edges().len() as u64,
+                ),
+            ] {
+                let (mut v, mut e) = (u64::MAX, u64::MAX);
+                assert_eq!(dhcd_scene_vertex_offset(s, id, &mut v), DHCD_OK);
+                assert_eq!(dhcd_scene_edge_offset(s, id, &mut e), DHCD_OK);
+                assert_eq!((v, e), (vertices, edges));
+            }
+            let mut v = 7u64;
+            assert_eq!(
+                dhcd_scene_vertex_offset(s, 9, &mut v),
+                DHCD_ERR_UNKNOWN_OBJECT
+            );
+            assert_eq!(v, 7, "written only on success");
+            // The contact set.
+            let want = rust.contact_set(0.05, dhcd::Par::Seq).unwrap();
+            assert!(want.len() > 10);
+            let mut c = std::mem::zeroed::<DhcdContactSet>();
+            let rc = dhcd_scene_contact_set(s, 0.05, 2, &mut c);
+            assert_eq!(rc, DHCD_OK, "{}", last_error());
+            assert_eq!(c.count, want.len());
+            let (vertices, types) = (part(c.vertices, 4 * c.count), part(c.types, c.count));
+            for (k, w) in want.contacts.iter().enumerate() {
+                let wv = w.vertices.map(|v| {
+                    if v == dhcd::contact::NONE {
+                        -1
+                    } else {
+                        i64::from(v)
+                    }
+                });
+                assert_eq!(&vertices[4 * k..4 * k + 4], &wv[..]);
+                assert_eq!(types[k], w.kind as u8);
+            }
+            // Rows between the objects name the second object's vertices from 49 on.
+            assert!(vertices.iter().any(|&v| v >= 49));
+            dhcd_contact_set_free(&mut c);
+            assert!(c.vertices.is_null() && c.count == 0);
+            assert_eq!(
+                dhcd_scene_contact_set(s, -1.0, 1, &mut c),
+                DHCD_ERR_INVALID_ARGUMENT
+            );
+            // The step size: the falling sheet limits it.
+            let (b0, b1) = (flat64(&drop0), flat64(&drop1));
+            let motion = [(dhcd::ObjectId(1), dhcd::Motion::new(&drop0, &drop1))];
+            for (d, r) in [(0.0, 0.8), (1e-3, 0.5)] {
+                let o = StepOptions {
+                    min_distance: d,
+                    rescaling: r,
+                };
+                let want = rust
+                    .collision_free_stepsize(&motion, &o, dhcd::Par::Seq)
+                    .unwrap();
+                assert!(want.step < 1.0);
+                for threads in [1u32, 2] {
+                    let mut step = -1.0;
+                    let rc = dhcd_scene_collision_free_stepsize(
+                        s,
+                        &1,
+                        &b0.as_ptr(),
+                        &b1.as_ptr(),
+                        &drop0.len(),
+                        1,
+                        d,
+                        r,
+                        threads,
+                        &mut step,
+                    );
+                    assert_eq!(rc, DHCD_OK, "{}", last_error());
+                    assert_eq!(step, want.step);
+                }
+            }
+            let mut step = -1.0;
+            for (ids, r, code) in [
+                ([1u64, 1], 0.8, DHCD_ERR_REPEATED_OBJECT),
+                ([1, 5], 0.8, DHCD_ERR_UNKNOWN_OBJECT),
+                ([1, 0], 0.0, DHCD_ERR_INVALID_ARGUMENT),
+            ] {
+                let x0s = [b0.as_ptr(), b0.as_ptr()];
+                let x1s = [b1.as_ptr(), b1.as_ptr()];
+                let counts = [drop0.len(), drop0.len()];
+                let one = usize::from(code == DHCD_ERR_INVALID_ARGUMENT);
+                let rc = dhcd_scene_collision_free_stepsize(
+                    s,
+                    ids.as_ptr(),
+                    x0s.as_ptr(),
+                    x1s.as_ptr(),
+                    counts.as_ptr(),
+                    2 - one,
+                    0.0,
+                    r,
+                    1,
+                    &mut step,
+                );
+                assert_eq!(rc, code, "{}", last_error());
+                assert_eq!(step, -1.0, "written only on success");
+            }
+            dhcd_scene_free(s);
+        }
+    }
+}
