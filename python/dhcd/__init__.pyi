@@ -545,6 +545,20 @@ class Scene:
         repeated id, a wrong shape, dtype or vertex count, a non-finite coordinate, a
         negative ``min_distance``) raises ``ValueError`` before any work. The result does not
         depend on ``threads`` (the work counters of earliest mode may)."""
+    def collision_free_stepsize(
+        self,
+        motions: Motions,
+        *,
+        min_distance: float = 0.0,
+        rescaling: float = 0.8,
+        threads: int = 1,
+    ) -> float:
+        """The collision-free step size of the whole scene over one step
+        (``collision_free_stepsize``'s rule, for every pair between two objects and inside
+        every object with self-collision on): ``motions`` as in ``ccd``. Never past the
+        scene's earliest impact at ``min_distance``; 1.0 when no pair comes within its gap.
+        Bad input raises ``ValueError`` before any work, as in ``ccd``, and for
+        ``rescaling`` outside ``(0, 1]``."""
     def __len__(self) -> int: ...
 
 MeshLike = Union[Any, Tuple[Vertices, Faces]]

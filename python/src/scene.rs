@@ -16,6 +16,7 @@ use crate::arrays::{ccd_positions, faces, rows_of, Positions, Vertices};
 use crate::ccd::{ccd_query, Impacts};
 use crate::collide::Contacts;
 use crate::proximity::{scene_proximity_rows, Proximity};
+use crate::step::step_options;
 use crate::{contact, distance_arg, int_arg, interrupt, method, options, par, to_py, value_error};
 
 /// Many deformable objects of one method; object ids are ints from 0 up, never reused.
@@ -422,6 +423,33 @@ impl Scene {
             scene.ccd(&motions, &q, par)
         })?;
         Impacts::of_scene(py, r)
+    }
+
+    /// The collision-free step size of the whole scene over one step: `motions` as in
+    /// `ccd`; the largest fraction of the step that keeps every pair at least
+    /// `min_distance + (1 - rescaling) (d0 - min_distance)` apart.
+    #[pyo3(
+        signature = (motions, *, min_distance = None, rescaling = None, threads = None),
+        text_signature = "(self, motions, *, min_distance=0.0, rescaling=0.8, threads=1)"
+    )]
+    fn collision_free_stepsize(
+        &mut self,
+        py: Python<'_>,
+        motions: &Bound<'_, PyAny>,
+        min_distance: Option<&Bound<'_, PyAny>>,
+        rescaling: Option<&Bound<'_, PyAny>>,
+        threads: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<f64> {
+        let options = step_options(min_distance, rescaling)?;
+        let par = par(threads)?;
+        let arrays = self.motions(motions)?;
+        let motions = as_motions(&arrays)?;
+        let scene = &mut self.scene;
+        let r = interrupt::run(py, par, |control| {
+            scene.set_control(control.clone());
+            scene.collision_free_stepsize(&motions, &options, par)
+        })?;
+        Ok(r.step)
     }
 
     fn __len__(&self) -> usize {

@@ -1,5 +1,6 @@
 //! The collision-free step size of a line search: `collision_free_stepsize(h, x0, x1)` for
-//! one mesh, `collision_free_stepsize(a, b, a0, a1, b0, b1)` for two.
+//! one mesh, `collision_free_stepsize(a, b, a0, a1, b0, b1)` for two (`Scene` has its own,
+//! in `scene.rs`, with the same keyword arguments).
 
 use dhcd::contact::StepOptions;
 use dhcd::Motion;
@@ -9,6 +10,22 @@ use pyo3::types::PyTuple;
 use crate::arrays::rows_of;
 use crate::ccd::{step_args, StepArgs};
 use crate::{interrupt, par, real_arg, to_py};
+
+/// The step-size rule's keyword arguments (`None`: the defaults), checked.
+pub(crate) fn step_options(
+    min_distance: Option<&Bound<'_, PyAny>>,
+    rescaling: Option<&Bound<'_, PyAny>>,
+) -> PyResult<StepOptions> {
+    let mut options = StepOptions::default();
+    if let Some(d) = min_distance {
+        options.min_distance = real_arg(d, "min_distance")?;
+    }
+    if let Some(r) = rescaling {
+        options.rescaling = real_arg(r, "rescaling")?;
+    }
+    options.validate().map_err(to_py)?;
+    Ok(options)
+}
 
 /// The largest fraction of the step `x0 -> x1` (in `[0, 1]`) that keeps every pair of
 /// features at least `min_distance + (1 - rescaling) (d0 - min_distance)` apart, `d0` its
@@ -25,14 +42,7 @@ pub(crate) fn collision_free_stepsize(
     rescaling: Option<&Bound<'_, PyAny>>,
     threads: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<f64> {
-    let mut options = StepOptions::default();
-    if let Some(d) = min_distance {
-        options.min_distance = real_arg(d, "min_distance")?;
-    }
-    if let Some(r) = rescaling {
-        options.rescaling = real_arg(r, "rescaling")?;
-    }
-    options.validate().map_err(to_py)?;
+    let options = step_options(min_distance, rescaling)?;
     let par = par(threads)?;
     let step = match step_args(args, "collision_free_stepsize")? {
         StepArgs::One(h, [x0, x1]) => {

@@ -63,3 +63,36 @@ def test_pair_form_and_bad_input():
         dhcd.collision_free_stepsize(h, x0)
     with pytest.raises(ValueError):
         dhcd.collision_free_stepsize(a, a, x0[:3], x1[:3], x0[:3], x1[:3])
+
+
+def test_scene_form_equals_the_pair_form():
+    x0, x1, faces = falling_vertex()
+    a = dhcd.Hierarchy(x0[:3], faces[:1])
+    b = dhcd.Hierarchy(x0[3:], faces[1:] - 3)
+    want = dhcd.collision_free_stepsize(a, b, x0[:3], x1[:3], x0[3:], x1[3:], rescaling=0.5)
+    for method in ("dh", "sphere", "aabb"):
+        scene = dhcd.Scene(method)
+        tri = scene.add(x0[:3], faces[:1], name="triangle")
+        falling = scene.add(x0[3:], faces[1:] - 3)
+        motions = {falling: (x0[3:], x1[3:])}
+        for threads in (1, 2):
+            s = scene.collision_free_stepsize(motions, rescaling=0.5, threads=threads)
+            assert s == want
+        # d0 = 1, gap 0.5: z = 0.5 at t = 0.25.
+        assert 0.25 - 2e-12 <= want <= 0.25
+        # Nothing moves: 1.
+        assert scene.collision_free_stepsize({}) == 1.0
+        # The triangle rises to meet the vertex: both move, ids by name.
+        up = x0[:3].copy()
+        up[:, 2] += 1.0
+        both = [("triangle", (x0[:3], up)), (falling, (x0[3:], x1[3:]))]
+        s = scene.collision_free_stepsize(both)
+        assert 0.0 < s < 0.4
+        assert s <= scene.ccd(both, earliest=True).toi + 1e-12
+        for bad in (dict(rescaling=0.0), dict(rescaling=2.0), dict(min_distance=-1.0)):
+            with pytest.raises(ValueError):
+                scene.collision_free_stepsize(motions, **bad)
+        with pytest.raises(ValueError):
+            scene.collision_free_stepsize({tri + 7: (x0[:3], x1[:3])})
+        with pytest.raises(ValueError):
+            scene.collision_free_stepsize({falling: (x0[3:], x1[:2])})
