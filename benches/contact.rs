@@ -1,0 +1,198 @@
+//! What a barrier solver calls each Newton iteration and line search: the contact set
+//! (`self_contact_set`) and the collision-free step size (`collision_free_stepsize`), `f64`,
+//! one thread, DH (the methods are within a few percent of each other on these queries), at
+//! IPC's default contact distance `dhat` = 1e-3 x the bounding-box diagonal. Beside each, the
+//! raw self-proximity at the same `dhat` (what the contact set types and merges) and the
+//! earliest impact (the first of the step size's two walks).
+//!
+//! Cases:
+//! - the real frame steps of `../shared/data/real-frames/` (N -> N+1), when the folder is
+//!   there (else one line says they are skipped);
+//! - procedural 40 x 40 sheets (3,200 triangles), always: a wavy sheet moving a small step,
+//!   the same sheet folded over itself with its layers closing in, and a flat sheet sliding
+//!   in its own plane (contact set only: its step size is the degenerate case of the issue
+//!   "At the floor", seconds per call).
+//!
+//! Ids: `contact/<query>/<case>`, `<query>` one of `contact_set`, `proximity`, `step_size`,
+//! `earliest`. The setup checks what it times: the step size is in `[0, 1]` and never past the
+//! earliest impact, and the contact set is not empty where the case has contacts.
+//!
+//! `cargo bench --bench contact` (all); `cargo bench --bench contact -- 'contact/.*/sheet'`.
+
+mod frames;
+
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use dhcd::bv::Dh;
+use dhcd::contact::{self, StepOptions};
+use dhcd::io::{self, Limits};
+use dhcd::shapes::{fold_x, grid, jitter, wave};
+use dhcd::{CcdQuery, Hierarchy, Mesh, Motion, Options, Par, Precision, Workspace};
+use frames::frame_pairs;
+
+/// IPC's default contact distance, relative to the bounding-box diagonal.
+const RELATIVE: f64 = 1e-3;
+
+fn diagonal(p: &[[f64; 3]]) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for q in p {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+fn f64s(p: &[[f32; 3]]) -> Vec<[f64; 3]> {
+    p.iter().map(|q| q.map(f64::from)).collect()
+}
+
+/// One case: the rest mesh, the step's two poses, and whether its step size is timed.
+struct Case {
+    name: String,
+    rest: Mesh,
+    x0: Vec<[f64; 3]>,
+    x1: Vec<[f64; 3]>,
+    step_size: bool,
+}
+
+fn sheets() -> Vec<Case> {
+    let rest = grid(40, 40, 1.0 / 40.0, [0.0; 3]);
+    let wavy = |t: f32| f64s(&wave(rest.positions(), t, 0.02, [0.0; 3]));
+    // Folded at x = 0.5 with the upper layer lifted by `h`: the layers close in over the step.
+    let folded = |h: f32| {
+        let p: Vec<[f32; 3]> = fold_x(rest.positions(), 0.5)
+            .iter()
+            .zip(rest.positions())
+            .map(|(f, r)| {
+                if r[0] > 0.5 {
+                    [f[0], f[1], f[2] + h]
+                } else {
+                    *f
+                }
+            })
+            .collect();
+        f64s(&jitter(&p, [0.0005; 3], 3))
+    };
+    let flat = f64s(rest.positions());
+    let slid: Vec<[f64; 3]> = flat
+        .iter()
+        .map(|p| [p[0] + 0.01, p[1] + 0.005, p[2]])
+        .collect();
+    let mesh =
+        |x: &[[f64; 3]]| Mesh::new_f64(x.to_vec(), rest.triangles().to_vec()).expect("a sheet");
+    vec![
+        Case {
+            name: "wavy-sheet".into(),
+            rest: mesh(&wavy(0.0)),
+            x0: wavy(0.0),
+            x1: wavy(0.05),
+            step_size: true,
+        },
+        Case {
+            name: "folded-sheet".into(),
+            rest: mesh(&folded(0.03)),
+            x0: folded(0.03),
+            x1: folded(0.0),
+            step_size: true,
+        },
+        Case {
+            name: "flat-sheet-sliding".into(),
+            rest: mesh(&flat),
+            x0: flat.clone(),
+            x1: slid,
+            step_size: false,
+        },
+    ]
+}
+
+fn real_frames() -> Vec<Case> {
+    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
+    if !dir.is_dir() {
+        eprintln!(
+            "contact bench: real frames SKIPPED: no data folder at {}",
+            dir.display()
+        );
+        return Vec::new();
+    }
+    frame_pairs(&dir)
+        .into_iter()
+        .map(|(first, second)| {
+            let load = |f: &str| {
+                let path = dir.join(format!("{f}.ply"));
+                io::load_as(&path, &Limits::default(), Precision::F64)
+                    .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+            };
+            let (m0, m1) = (load(&first), load(&second));
+            Case {
+                x0: m0.positions_f64().expect("f64").to_vec(),
+                x1: m1.positions_f64().expect("f64").to_vec(),
+                rest: m0,
+                name: first,
+                step_size: true,
+            }
+        })
+        .collect()
+}
+
+fn contact(c: &mut Criterion) {
+    for case in sheets().into_iter().chain(real_frames()) {
+        let dhat = RELATIVE * diagonal(&case.x0);
+        let mut h = Hierarchy::<Dh>::new(&case.rest, Options::default()).expect("hierarchy");
+        h.update_positions_f64(&case.x0).expect("a pose");
+        let mut ws = Workspace::default();
+        let set = contact::self_contact_set_with(&h, dhat, None, &mut ws, Par::Seq).expect("set");
+        eprintln!("{}: {} contacts at dhat {dhat:.3e}", case.name, set.len());
+        let name = &case.name;
+        c.bench_function(&format!("contact/contact_set/{name}"), |b| {
+            b.iter(|| {
+                let s =
+                    contact::self_contact_set_with(&h, dhat, None, &mut ws, Par::Seq).expect("set");
+                black_box(s.len())
+            })
+        });
+        c.bench_function(&format!("contact/proximity/{name}"), |b| {
+            b.iter(|| {
+                let p = dhcd::self_proximity_with(&h, dhat, &mut ws, Par::Seq).expect("rows");
+                black_box(p.counters.contacts)
+            })
+        });
+        if !case.step_size {
+            continue;
+        }
+        let motion = Motion::new(&case.x0, &case.x1);
+        let o = StepOptions::default();
+        let step = contact::collision_free_stepsize_with(&h, motion, &o, &mut ws, Par::Seq)
+            .expect("a step");
+        let toi = dhcd::self_ccd_with(&h, motion, &CcdQuery::earliest(), &mut ws, Par::Seq)
+            .expect("a step")
+            .toi;
+        assert!((0.0..=1.0).contains(&step.step));
+        assert!(toi.is_none_or(|t| step.step <= t + dhcd::ccd::TOI_TOLERANCE));
+        eprintln!("{name}: step {} (earliest impact {toi:?})", step.step);
+        c.bench_function(&format!("contact/step_size/{name}"), |b| {
+            b.iter(|| {
+                let s = contact::collision_free_stepsize_with(&h, motion, &o, &mut ws, Par::Seq)
+                    .expect("a step");
+                black_box(s.step)
+            })
+        });
+        c.bench_function(&format!("contact/earliest/{name}"), |b| {
+            b.iter(|| {
+                let i = dhcd::self_ccd_with(&h, motion, &CcdQuery::earliest(), &mut ws, Par::Seq)
+                    .expect("a step");
+                black_box(i.toi)
+            })
+        });
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10);
+    targets = contact
+}
+criterion_main!(benches);
