@@ -16,15 +16,8 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use dhcd::io::{self, Limits};
-use dhcd::{AnyHierarchy, CcdQuery, Method, Motion, Options, Par, Precision, Workspace};
-use frames::frame_pairs;
-
-fn load(dir: &Path, frame: &str) -> dhcd::Mesh {
-    let path = dir.join(format!("{frame}.ply"));
-    io::load_as(&path, &Limits::default(), Precision::F64)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
+use dhcd::{AnyHierarchy, CcdQuery, Method, Motion, Options, Par, Workspace};
+use frames::{frame_pairs, load_f64};
 
 fn ccd(c: &mut Criterion) {
     let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
@@ -36,7 +29,7 @@ fn ccd(c: &mut Criterion) {
         return;
     }
     for (first, second) in frame_pairs(&dir) {
-        let (m0, m1) = (load(&dir, &first), load(&dir, &second));
+        let (m0, m1) = (load_f64(&dir, &first), load_f64(&dir, &second));
         let motion = Motion::new(
             m0.positions_f64().expect("f64"),
             m1.positions_f64().expect("f64"),

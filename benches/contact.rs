@@ -27,24 +27,9 @@ use std::path::{Path, PathBuf};
 use criterion::{criterion_group, criterion_main, Criterion};
 use dhcd::bv::Dh;
 use dhcd::contact::{self, StepOptions};
-use dhcd::io::{self, Limits};
 use dhcd::shapes::{fold_x, grid, jitter, wave};
-use dhcd::{CcdQuery, Hierarchy, Mesh, Motion, Options, Par, Precision, Workspace};
-use frames::frame_pairs;
-
-/// IPC's default contact distance, relative to the bounding-box diagonal.
-const RELATIVE: f64 = 1e-3;
-
-fn diagonal(p: &[[f64; 3]]) -> f64 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for q in p {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
-    }
-    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
-}
+use dhcd::{CcdQuery, Hierarchy, Mesh, Motion, Options, Par, Workspace};
+use frames::{diagonal, frame_pairs, load_f64, RELATIVE_DHAT};
 
 fn f64s(p: &[[f32; 3]]) -> Vec<[f64; 3]> {
     p.iter().map(|q| q.map(f64::from)).collect()
@@ -121,12 +106,7 @@ fn real_frames() -> Vec<Case> {
     frame_pairs(&dir)
         .into_iter()
         .map(|(first, second)| {
-            let load = |f: &str| {
-                let path = dir.join(format!("{f}.ply"));
-                io::load_as(&path, &Limits::default(), Precision::F64)
-                    .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-            };
-            let (m0, m1) = (load(&first), load(&second));
+            let (m0, m1) = (load_f64(&dir, &first), load_f64(&dir, &second));
             Case {
                 x0: m0.positions_f64().expect("f64").to_vec(),
                 x1: m1.positions_f64().expect("f64").to_vec(),
@@ -140,7 +120,7 @@ fn real_frames() -> Vec<Case> {
 
 fn contact(c: &mut Criterion) {
     for case in sheets().into_iter().chain(real_frames()) {
-        let dhat = RELATIVE * diagonal(&case.x0);
+        let dhat = RELATIVE_DHAT * diagonal(&case.x0);
         let mut h = Hierarchy::<Dh>::new(&case.rest, Options::default()).expect("hierarchy");
         h.update_positions_f64(&case.x0).expect("a pose");
         let mut ws = Workspace::default();

@@ -15,29 +15,8 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use dhcd::io::{self, Limits};
-use dhcd::{AnyHierarchy, Method, Options, Par, Precision, Workspace};
-use frames::frame_pairs;
-
-/// IPC's default contact distance, relative to the bounding-box diagonal.
-const RELATIVE: f64 = 1e-3;
-
-fn load(dir: &Path, frame: &str) -> dhcd::Mesh {
-    let path = dir.join(format!("{frame}.ply"));
-    io::load_as(&path, &Limits::default(), Precision::F64)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-fn diagonal(p: &[[f64; 3]]) -> f64 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for q in p {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
-    }
-    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
-}
+use dhcd::{AnyHierarchy, Method, Options, Par, Workspace};
+use frames::{diagonal, frame_pairs, load_f64, RELATIVE_DHAT};
 
 fn proximity(c: &mut Criterion) {
     let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
@@ -49,12 +28,12 @@ fn proximity(c: &mut Criterion) {
         return;
     }
     for (first, second) in frame_pairs(&dir) {
-        let (rest, next) = (load(&dir, &first), load(&dir, &second));
+        let (rest, next) = (load_f64(&dir, &first), load_f64(&dir, &second));
         let frames = [
             rest.positions_f64().expect("f64").to_vec(),
             next.positions_f64().expect("f64").to_vec(),
         ];
-        let d = RELATIVE * diagonal(&frames[0]);
+        let d = RELATIVE_DHAT * diagonal(&frames[0]);
         let mut reference = None;
         for method in Method::ALL {
             let mut h = AnyHierarchy::new(method, &rest, Options::default()).expect("hierarchy");

@@ -1055,10 +1055,7 @@ fn step_size_of<K: BoundingVolume>(
         ccd::run(a, b, self_job, &first, best.as_ref(), budget, None, ws, par)
     });
     budget.finish()?;
-    let first_work = impacts.iter().fold(Counters::default(), |mut c, i| {
-        c += i.counters;
-        c
-    });
+    let first_work: Counters = impacts.iter().map(|i| i.counters).sum();
     let best = step::bound_at(keep_earliest(&mut impacts));
     let moving: Vec<Motion<'_>> = motions.iter().flatten().copied().collect();
     let (query, gap) = step::query_for(options, &moving, step::by(&best));
@@ -1081,10 +1078,7 @@ fn step_size_of<K: BoundingVolume>(
     let toi = keep_earliest(&mut limiting);
     let tests = first_tests + broad_phase_tests;
     let mut limiting = scene_impacts(objects, &jobs, limiting, toi, tests);
-    // The work of both walks; `contacts` counts the limiting pairs.
-    let contacts = limiting.counters.contacts;
-    limiting.counters += first_work;
-    limiting.counters.contacts = contacts;
+    step::add_first_walk(&mut limiting.counters, first_work);
     Ok(SceneStepSize {
         step: step::step_at(toi),
         limiting,

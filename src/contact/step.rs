@@ -152,10 +152,7 @@ fn step_between<K: BoundingVolume>(
         ws,
         par,
     )?;
-    // The work of both walks; `contacts` counts the limiting pairs.
-    let contacts = limiting.counters.contacts;
-    limiting.counters += first_work;
-    limiting.counters.contacts = contacts;
+    add_first_walk(&mut limiting.counters, first_work);
     Ok(StepSize {
         step: step_at(limiting.toi),
         limiting,
@@ -203,6 +200,14 @@ pub(crate) fn bound_at(toi: Option<f64>) -> AtomicU64 {
 pub(crate) fn by(best: &AtomicU64) -> f64 {
     let t = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
     (t + 8.0 * crate::ccd::TOI_TOLERANCE).next_up().min(1.0)
+}
+
+/// The gap walk's counters plus the first walk's work: the step size's counters hold both
+/// walks' work, and `contacts` still counts the limiting pairs.
+pub(crate) fn add_first_walk(counters: &mut Counters, first_walk: Counters) {
+    let contacts = counters.contacts;
+    *counters += first_walk;
+    counters.contacts = contacts;
 }
 
 /// The step allowed by the earliest time any pair reaches its gap (`None`: none does).

@@ -24,7 +24,7 @@ use dhcd_kernels::overlap::{boxes_meet_with, BoxRows, MAX_BOX_ROW};
 pub(crate) type FeatureBox = ([f32; 3], [f32; 3]);
 
 /// The union of the first `n` boxes of `rows` (empty: `+inf..-inf`).
-pub(crate) fn union_of(rows: &BoxRows, n: usize) -> FeatureBox {
+fn union_of(rows: &BoxRows, n: usize) -> FeatureBox {
     let lo = |k: usize| rows[k][..n].iter().fold(f32::INFINITY, |m, &x| m.min(x));
     let hi = |k: usize| {
         rows[3 + k][..n]
@@ -37,13 +37,7 @@ pub(crate) fn union_of(rows: &BoxRows, n: usize) -> FeatureBox {
 /// The bits of boxes `base..base + 64` of the first `n` of `rows` that meet `probe` (bit
 /// `j` for box `base + j`).
 #[inline(always)]
-pub(crate) fn meeting<S: Simd>(
-    simd: S,
-    probe: &FeatureBox,
-    rows: &BoxRows,
-    base: usize,
-    n: usize,
-) -> u64 {
+fn meeting<S: Simd>(simd: S, probe: &FeatureBox, rows: &BoxRows, base: usize, n: usize) -> u64 {
     let m = (n - base).min(MAX_BOX_ROW);
     let part: BoxRows = std::array::from_fn(|f| &rows[f][base..]);
     boxes_meet_with(simd, probe.0, probe.1, part, m)
@@ -51,13 +45,13 @@ pub(crate) fn meeting<S: Simd>(
 
 /// Whether two closed boxes meet.
 #[inline(always)]
-pub(crate) fn meet(a: &FeatureBox, b: &FeatureBox) -> bool {
+fn meet(a: &FeatureBox, b: &FeatureBox) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
 }
 
 /// `b` grown by `m` along every axis, rounded outward.
 #[inline(always)]
-pub(crate) fn grown(b: &FeatureBox, m: f32) -> FeatureBox {
+fn grown(b: &FeatureBox, m: f32) -> FeatureBox {
     (
         b.0.map(|x| (x - m).next_down()),
         b.1.map(|x| (x + m).next_up()),
@@ -97,7 +91,7 @@ pub(crate) fn points_box_f64<const N: usize>(p: [[f64; 3]; N]) -> FeatureBox {
 /// An edge (internal vertex indices) as its original indices, smaller first, and its
 /// internal indices in that same order. `order` maps internal to original indices.
 #[inline(always)]
-pub(crate) fn ordered_edge(order: &[u32], [s, t]: [u32; 2]) -> ([u32; 2], [u32; 2]) {
+fn ordered_edge(order: &[u32], [s, t]: [u32; 2]) -> ([u32; 2], [u32; 2]) {
     let (os, ot) = (order[s as usize], order[t as usize]);
     if os < ot {
         ([os, ot], [s, t])
