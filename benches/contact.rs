@@ -2,8 +2,9 @@
 //! (`self_contact_set`) and the collision-free step size (`collision_free_stepsize`), `f64`,
 //! one thread, DH (the methods are within a few percent of each other on these queries), at
 //! IPC's default contact distance `dhat` = 1e-3 x the bounding-box diagonal. Beside each, the
-//! raw self-proximity at the same `dhat` (what the contact set types and merges) and the
-//! earliest impact (the first of the step size's two walks).
+//! raw self-proximity at the same `dhat` (what the contact set types), the earliest impact
+//! (the first of the step size's two walks), and the gradients and Hessians of every
+//! contact's squared distance (sets of at most 50,000 contacts).
 //!
 //! Cases:
 //! - the real frame steps of `../shared/data/real-frames/` (N -> N+1), when the folder is
@@ -13,8 +14,8 @@
 //!   in its own plane (contact set only: its step size is the degenerate case of the issue
 //!   "At the floor", seconds per call).
 //!
-//! Ids: `contact/<query>/<case>`, `<query>` one of `contact_set`, `proximity`, `step_size`,
-//! `earliest`. The setup checks what it times: the step size is in `[0, 1]` and never past the
+//! Ids: `contact/<query>/<case>`, `<query>` one of `contact_set`, `proximity`, `gradients`,
+//! `hessians`, `step_size`, `earliest`. The setup checks what it times: the step size is in `[0, 1]` and never past the
 //! earliest impact, and the contact set is not empty where the case has contacts.
 //!
 //! `cargo bench --bench contact` (all); `cargo bench --bench contact -- 'contact/.*/sheet'`.
@@ -140,6 +141,16 @@ fn contact(c: &mut Criterion) {
                 black_box(p.counters.contacts)
             })
         });
+        // The derivatives of every contact (a Hessian is 1,152 bytes: only sets that fit
+        // a few tens of MB).
+        if set.len() <= 50_000 {
+            c.bench_function(&format!("contact/gradients/{name}"), |b| {
+                b.iter(|| black_box(set.gradients().len()))
+            });
+            c.bench_function(&format!("contact/hessians/{name}"), |b| {
+                b.iter(|| black_box(set.hessians().len()))
+            });
+        }
         if !case.step_size {
             continue;
         }

@@ -38,7 +38,9 @@ use crate::precision::Precision;
 use crate::query::ccd::{self, checked_step, earliest_bound, keep_earliest, Swept};
 use crate::query::contacts::contacts;
 use crate::query::proximity::{self, check_distance};
-use crate::query::{CcdQuery, Contacts, Impacts, Motion, Overlap, Posed, Proximity, Within};
+use crate::query::{
+    CcdQuery, Contacts, Impacts, Motion, NodeTest, Overlap, Posed, Proximity, Within,
+};
 use crate::segments::{segment, OriginalCorners, Segment};
 use crate::walk::Workspace;
 
@@ -571,7 +573,7 @@ impl Scene {
     /// vertex. The result does not depend on `par`.
     pub fn contact_set(&mut self, dhat: f64, par: Par) -> Result<ContactSet> {
         let rows = self.proximity(dhat, par)?;
-        each!(&self.objects, v => contact_set_of(v, rows))
+        each!(&self.objects, v => contact_set_of(v, rows, par))
     }
 
     /// Where object `id`'s vertices start in the scene's global numbering (the contact
@@ -598,6 +600,7 @@ impl Scene {
 fn contact_set_of<K: BoundingVolume>(
     objects: &[Object<K>],
     rows: SceneProximity,
+    par: Par,
 ) -> Result<ContactSet> {
     let (mut vertex_offsets, mut edge_offsets) = (Vec::new(), Vec::new());
     let (mut vo, mut eo) = (0usize, 0usize);
@@ -617,7 +620,7 @@ fn contact_set_of<K: BoundingVolume>(
     let mut set = ContactSet::default();
     for pair in rows.per_pair {
         let (ia, ib) = (index(pair.a), index(pair.b));
-        let part = contact::from_rows(pair.proximity, &side(ia)?, &side(ib)?);
+        let part = contact::from_rows(pair.proximity, &side(ia)?, &side(ib)?, ia == ib, par);
         set.contacts.extend(part.contacts);
         set.positions.extend(part.positions);
     }
@@ -639,20 +642,13 @@ fn proximity_of<K: BoundingVolume>(
     parallel: bool,
 ) -> Result<SceneProximity> {
     let within = Within::distance(d);
-    let boxes = objects.iter().map(|o| o.bounds);
-    let (jobs, broad_phase_tests) = jobs_of(objects, boxes, within.margin);
-    let results = run_jobs(
+    let (jobs, results, broad_phase_tests) = posed_walks(
         objects,
-        &jobs,
+        within,
+        within.margin,
         parallel,
-        |ws, a, b, par| {
-            let posed = match b {
-                None => Posed::single(a, within),
-                Some(b) => Posed::pair(a, b, within),
-            };
-            // A job stopped by the budget gives nothing; `finish` below says why.
-            proximity::run(posed, d, budget, ws, par).unwrap_or_default()
-        },
+        // A job stopped by the budget gives nothing; `finish` below says why.
+        |posed, ws, par| proximity::run(posed, d, budget, ws, par).unwrap_or_default(),
         |p: &mut Proximity| &mut p.counters,
     );
     budget.finish()?;
@@ -776,6 +772,37 @@ fn jobs_of<K: BoundingVolume>(
     (jobs, tests)
 }
 
+/// The jobs of a query on the current poses (the objects' root boxes grown by `margin`)
+/// and `query`'s result on each job's posed hierarchies (`node_test` deciding which nodes
+/// go on), by [`run_jobs`]: the jobs, their results in job order, and the broad phase's
+/// box tests. Every query on the poses (contacts, proximity, and through it the contact
+/// set) is one `query` here.
+fn posed_walks<K: BoundingVolume, T: NodeTest + Copy + Sync, R: Send>(
+    objects: &mut [Object<K>],
+    node_test: T,
+    margin: f32,
+    parallel: bool,
+    query: impl Fn(Posed<'_, K, T>, &mut Workspace, Par) -> (R, [u64; 2]) + Sync,
+    counters: impl Fn(&mut R) -> &mut Counters,
+) -> (Vec<(usize, usize)>, Vec<R>, u64) {
+    let boxes = objects.iter().map(|o| o.bounds);
+    let (jobs, broad_phase_tests) = jobs_of(objects, boxes, margin);
+    let results = run_jobs(
+        objects,
+        &jobs,
+        parallel,
+        |ws, a, b, par| {
+            let posed = match b {
+                None => Posed::single(a, node_test),
+                Some(b) => Posed::pair(a, b, node_test),
+            };
+            query(posed, ws, par)
+        },
+        counters,
+    );
+    (jobs, results, broad_phase_tests)
+}
+
 /// Runs `query` on every job at once on the shared hierarchies (the lazy refit fits each
 /// group once, whoever needs it first; each query may also split its own walk on the same
 /// pool), and credits each object's refits (the nodes fitted on it in every job, plus its
@@ -853,18 +880,12 @@ fn credit_refits<R>(
 }
 
 fn contacts_of<K: BoundingVolume>(objects: &mut [Object<K>], parallel: bool) -> SceneContacts {
-    let (jobs, broad_phase_tests) = jobs_of(objects, objects.iter().map(|o| o.bounds), 0.0);
-    let results = run_jobs(
+    let (jobs, results, broad_phase_tests) = posed_walks(
         objects,
-        &jobs,
+        Overlap,
+        0.0,
         parallel,
-        |ws, a, b, par| {
-            let posed = match b {
-                None => Posed::single(a, Overlap),
-                Some(b) => Posed::pair(a, b, Overlap),
-            };
-            contacts(posed, ws, par)
-        },
+        |posed, ws, par| contacts(posed, ws, par),
         |c: &mut Contacts| &mut c.counters,
     );
     let mut out = SceneContacts {

@@ -9,7 +9,9 @@ use dhcd::bv::BoundingVolume;
 use dhcd::contact::{
     self, contact_set_with, self_contact_set_with, ContactSet, ContactType, MOLLIFIER_FACTOR, NONE,
 };
-use dhcd::distance::{edge_edge_within, point_triangle_within, EdgeEdge, PointTriangle};
+use dhcd::distance::{
+    edge_edge_within, point_line_distance_sq, point_triangle_within, EdgeEdge, PointTriangle,
+};
 use dhcd::shapes::{fold_x, grid, jitter, wave};
 use dhcd::{for_each_method, Error, Hierarchy, Mesh, Options, Par, Workspace};
 use num_rational::BigRational;
@@ -86,6 +88,12 @@ impl Obj {
     }
 }
 
+/// A point-edge contact's value: the corner-edge formula from the edge's first vertex,
+/// whichever pair found it.
+fn point_edge_value(p: [f64; 3], e0: [f64; 3], e1: [f64; 3]) -> f64 {
+    point_line_distance_sq(p, e0, e1)
+}
+
 fn insert(set: &mut BTreeMap<Key, Row>, key: Key, row: Row) {
     match set.get_mut(&key) {
         Some(old) if old.distance_sq <= row.distance_sq => {}
@@ -121,11 +129,16 @@ fn oracle(a: &Obj, b: &Obj, same: bool, dhat: f64) -> BTreeMap<Key, Row> {
                     PointTriangle::Face => ((2, [gv, g[0], g[1], g[2]]), [NONE; 2]),
                     _ => {
                         let (i, j) = (k - 3, (k - 2) % 3);
-                        (
-                            (1, [gv, g[i].min(g[j]), g[i].max(g[j]), NONE]),
-                            [f.edge(t[i], t[j]), NONE],
-                        )
+                        let (i, j) = if g[i] < g[j] { (i, j) } else { (j, i) };
+                        ((1, [gv, g[i], g[j], NONE]), [f.edge(t[i], t[j]), NONE])
                     }
+                };
+                let d = match key.0 {
+                    1 => {
+                        let (i, j) = (key.1[1] - f.vo, key.1[2] - f.vo);
+                        point_edge_value(p.x[v as usize], f.x[i as usize], f.x[j as usize])
+                    }
+                    _ => d,
                 };
                 let row = Row {
                     edges,
@@ -170,6 +183,15 @@ fn oracle(a: &Obj, b: &Obj, same: bool, dhat: f64) -> BTreeMap<Key, Row> {
                     EdgeEdge::Ea1Eb => ((1, [g[1], g[2], g[3], NONE]), [idb, NONE], None),
                     EdgeEdge::EaEb => unreachable!(),
                 }
+            };
+            let at = |v: u32| {
+                x[g.iter()
+                    .position(|&w| w == v)
+                    .expect("a vertex of the pair")]
+            };
+            let d = match key {
+                (1, [v, e0, e1, _]) => point_edge_value(at(v), at(e0), at(e1)),
+                _ => d,
             };
             let row = Row {
                 edges,

@@ -7,8 +7,8 @@
 //! Also: every type on a hand-built case, the stated value bounds against the exact value.
 
 use dhcd::distance::{
-    edge_edge_distance_sq, edge_edge_within, point_triangle_distance_sq, point_triangle_within,
-    EdgeEdge, PointTriangle,
+    edge_edge_distance_sq, edge_edge_within, point_line_distance_sq, point_triangle_distance_sq,
+    point_triangle_within, EdgeEdge, PointTriangle,
 };
 use num_bigint::BigInt;
 use num_rational::BigRational as Q;
@@ -396,6 +396,22 @@ proptest! {
         prop_assume!(finite(&pts));
         let [a0, a1, b0, b1] = pts;
         check_ee([&a0, &a1, &b0, &b1], &extra)?;
+    }
+
+    /// The point-edge contact's value: the squared distance to the line, within the
+    /// corner-edge bound, at every scale.
+    #[test]
+    fn point_line_is_within_the_corner_edge_bound(pts in points::<3>()) {
+        prop_assume!(finite(&pts));
+        let [p, e0, e1] = pts;
+        let got = point_line_distance_sq(p, e0, e1);
+        let (e, w) = (sub(&r3(&e1), &r3(&e0)), sub(&r3(&p), &r3(&e0)));
+        if e0 == e1 {
+            prop_assert!(got.is_nan());
+        } else {
+            let exact = norm2(&cross(&e, &w)) / norm2(&e);
+            prop_assert!(line_ok(got, &exact, &w), "{p:?} {e0:?} {e1:?}: {got} against {exact}");
+        }
     }
 
     /// Points on the triangle's features and in its plane (affine combinations with simple

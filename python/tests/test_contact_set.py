@@ -191,6 +191,36 @@ def test_equals_ipctk_on_a_folded_sheet():
         )
 
 
+REAL_FRAMES = os.path.join(os.path.dirname(__file__), "../../../shared/data/real-frames")
+
+
+def test_equals_ipctk_on_the_real_frames():
+    """Every real frame, dhat = 1e-3 x the bounding-box diagonal, the frame as its own rest
+    pose: the same contacts, types, mollified flags and edge ids as NormalCollisions.build
+    (benches/scripts/contact-set-vs-ipctk.py times the same comparison)."""
+    ipctk = ipctk_or_skip()
+    if not os.path.isdir(REAL_FRAMES):
+        pytest.skip(f"no real frames at {REAL_FRAMES} (they come with ../shared)")
+    paths = sorted(p for p in os.listdir(REAL_FRAMES) if p.endswith(".ply"))
+    assert paths
+    for name in paths:
+        pose, faces = dhcd.load_mesh(os.path.join(REAL_FRAMES, name), precision="f64")
+        dhat = 1e-3 * float(np.linalg.norm(pose.max(0) - pose.min(0)))
+        h = dhcd.Hierarchy(pose, faces)
+        cs = dhcd.self_contact_set(h, dhat, threads=2)
+        ours = {
+            (int(t), *map(int, v)): (bool(m), int(e[0]), int(e[1]))
+            for t, v, m, e in zip(cs.type, cs.vertices, cs.mollified, cs.edges)
+        }
+        theirs = ipctk_set(ipctk, pose, pose, faces, h.edges(), dhat)
+        # No pair of these frames is within rounding of dhat or of a type boundary.
+        assert ours == theirs, (
+            name,
+            sorted(set(ours.items()) - set(theirs.items()))[:5],
+            sorted(set(theirs.items()) - set(ours.items()))[:5],
+        )
+
+
 def test_derivatives_equal_ipctk_per_type_functions():
     ipctk = ipctk_or_skip()
     rng = np.random.default_rng(3)

@@ -14,11 +14,17 @@
 use super::geometry::{ContactType, Formula};
 use crate::bv::BoundingVolume;
 use crate::counters::Counters;
-use crate::distance::{edges_cross_sq_below, EdgeEdge, PointTriangle};
+use rayon::prelude::*;
+
+use crate::distance::{
+    edge_edge_distance_sq, edges_cross_sq_below, point_line_distance_sq,
+    point_triangle_distance_sq, EdgeEdge, PointTriangle,
+};
 use crate::error::{Error, Positions, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
 use crate::query::proximity::{self, Proximity};
+use crate::tree::MeshTables;
 use crate::walk::Workspace;
 
 /// No vertex or edge in this slot.
@@ -42,7 +48,8 @@ pub struct Contact {
     /// plus its offset): point-edge `[e, NONE]`, edge-edge `[a, b]`; `[NONE, NONE]` otherwise.
     pub edges: [u32; 2],
     /// Squared distance of the closest features (exact decision, the value within the bound
-    /// of [`crate::distance`]).
+    /// of [`crate::distance`]): a point-edge contact's is
+    /// [`crate::distance::point_line_distance_sq`]`(v, e0, e1)`, whichever row found it.
     pub distance_sq: f64,
     /// Edge-edge rows only: the edges are nearly parallel (the IPC Toolkit multiplies their
     /// barrier by a mollifier).
@@ -146,7 +153,7 @@ pub fn self_contact_set_with<K: BoundingVolume>(
 ) -> Result<ContactSet> {
     let side = Side::new(h, rest, 0, 0)?;
     let rows = proximity::self_proximity_with(h, dhat, ws, par)?;
-    Ok(from_rows(rows, &side, &side))
+    Ok(from_rows(rows, &side, &side, true, par))
 }
 
 /// Every contact between `a` and `b` within `dhat`. Vertices are numbered `a`'s first, then
@@ -183,7 +190,7 @@ pub fn contact_set_with<K: BoundingVolume>(
         offset(a.tree().edges().len(), b.tree().edges().len())?,
     )?;
     let rows = proximity::proximity_with(a, b, dhat, ws, par)?;
-    Ok(from_rows(rows, &sa, &sb))
+    Ok(from_rows(rows, &sa, &sb, false, par))
 }
 
 /// An offset `first` before `then` more, if both fit the `u32` numbering.
@@ -198,6 +205,7 @@ pub(crate) fn offset(first: usize, then: usize) -> Result<u32> {
 /// One object of a contact set: its hierarchy, rest pose and place in the numbering.
 pub(crate) struct Side<'h, K: BoundingVolume> {
     h: &'h Hierarchy<K>,
+    tables: &'h MeshTables,
     rest: &'h [[f64; 3]],
     vertex_offset: u32,
     edge_offset: u32,
@@ -219,224 +227,407 @@ impl<'h, K: BoundingVolume> Side<'h, K> {
         };
         Ok(Self {
             h,
+            tables: h.tree().tables(),
             rest,
             vertex_offset,
             edge_offset,
         })
     }
 
+    fn tables(&self) -> &'h MeshTables {
+        self.tables
+    }
+
+    /// Vertex `v`'s exact position (`v` in the caller's indices).
     fn position(&self, v: u32) -> [f64; 3] {
         self.h
             .position_f64(self.h.tree().vert_slot()[v as usize] as usize)
     }
 
-    fn corners(&self, t: u32) -> [u32; 3] {
-        self.h.tree().tables().triangles[t as usize]
+    /// The local index of global vertex `g`, if this side has it.
+    fn local(&self, g: u32) -> Option<u32> {
+        let v = g.wrapping_sub(self.vertex_offset);
+        ((v as usize) < self.h.tree().vertex_total()).then_some(v)
     }
 
-    fn edge(&self, u: u32, v: u32) -> u32 {
-        self.h.tree().edge_id(u, v).expect("an edge of a triangle") + self.edge_offset
-    }
-
-    fn rest_len_sq(&self, u: u32, v: u32) -> f64 {
+    fn rest_len_sq(&self, [u, v]: [u32; 2]) -> f64 {
         let (p, q) = (self.rest[u as usize], self.rest[v as usize]);
         (0..3).map(|c| (p[c] - q[c]) * (p[c] - q[c])).sum()
     }
 }
 
-/// A contact under construction: the type, the vertices as (side, index) and what the row
-/// knew.
-struct Draft {
-    kind: ContactType,
-    /// Global vertex numbers (offsets applied).
-    vertices: [u32; 4],
-    edges: [u32; 2],
-    distance_sq: f64,
-    mollified: bool,
-    closest: Option<EdgeEdge>,
-    positions: [[f64; 3]; 4],
+/// One side of a query.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Which {
+    A,
+    B,
 }
 
-/// The contact of a vertex `v` of side `p` near triangle `t` of side `f`.
-fn vertex_face<K: BoundingVolume>(
-    p: &Side<'_, K>,
-    v: u32,
-    f: &Side<'_, K>,
-    t: u32,
-    distance_sq: f64,
-    kind: PointTriangle,
-) -> Draft {
-    let c = f.corners(t);
-    let gv = v + p.vertex_offset;
-    let g = c.map(|w| w + f.vertex_offset);
-    let mut d = Draft {
-        kind: ContactType::PointTriangle,
-        vertices: [gv, g[0], g[1], g[2]],
-        edges: [NONE; 2],
-        distance_sq,
-        mollified: false,
-        closest: None,
-        positions: [
-            p.position(v),
-            f.position(c[0]),
-            f.position(c[1]),
-            f.position(c[2]),
-        ],
-    };
-    let k = kind as usize;
-    match kind {
-        PointTriangle::Vertex0 | PointTriangle::Vertex1 | PointTriangle::Vertex2 => {
-            let (p, q) = (d.positions[0], d.positions[1 + k]);
-            d.kind = ContactType::PointPoint;
-            (d.vertices, d.positions) = if gv < g[k] {
-                ([gv, g[k], NONE, NONE], [p, q, [0.0; 3], [0.0; 3]])
+/// A proximity row, named by its features: a vertex of side `side` and a triangle of the
+/// other side (the same side in a self query), or two edges (ids: side A's first, or the
+/// smaller first in a self query).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Row {
+    VertexFace { side: Which, v: u32, t: u32 },
+    EdgeEdge { a: u32, b: u32 },
+}
+
+/// A contact's identity: its type and global vertices ([`Contact::vertices`]).
+type Key = (ContactType, [u32; 4]);
+
+/// The two sides of a query (the same side twice in a self query), and the rules naming
+/// each row's contact and each contact's one producer.
+///
+/// A point-triangle contact has one row (its vertex and triangle), an edge-edge contact one
+/// row (its edges). A point-edge or point-point contact may be met by several rows, all at
+/// the same exact distance: a vertex near an edge is near both of the edge's triangles, and
+/// near the edges at its ends. Exactly one of them emits it, its **producer**: the first,
+/// in the order below, of the rows of the query whose exact type is that contact:
+///
+/// - point-edge `(v, e)`: `v` against the triangles of `e` (ascending), then the edges at
+///   `v` (ascending) against `e`;
+/// - point-point `(v, w)`, `v < w`: `v` against the triangles at `w`, `w` against the
+///   triangles at `v`, then the edges at `v` against the edges at `w`.
+///
+/// A row is one of the query's when the query meets it: in a self query, never a triangle
+/// containing its vertex nor edges sharing a vertex. Types are exact and tie-broken one way
+/// ([`crate::distance`]), so every row of a contact names the same producer.
+struct Sides<'s, 'h, K: BoundingVolume> {
+    a: &'s Side<'h, K>,
+    b: &'s Side<'h, K>,
+    self_query: bool,
+}
+
+impl<K: BoundingVolume> Sides<'_, '_, K> {
+    fn side(&self, w: Which) -> &Side<'_, K> {
+        match w {
+            Which::A => self.a,
+            Which::B => self.b,
+        }
+    }
+
+    /// The side of the triangles a vertex of side `w` is tested against.
+    fn faces_of(&self, w: Which) -> Which {
+        match (self.self_query, w) {
+            (true, _) | (false, Which::B) => Which::A,
+            (false, Which::A) => Which::B,
+        }
+    }
+
+    /// The side and local index of global vertex `g`.
+    fn local(&self, g: u32) -> (Which, u32) {
+        match self.a.local(g) {
+            Some(v) => (Which::A, v),
+            None => (Which::B, self.b.local(g).expect("a vertex of the query")),
+        }
+    }
+
+    fn position(&self, g: u32) -> [f64; 3] {
+        let (w, v) = self.local(g);
+        self.side(w).position(v)
+    }
+
+    /// The global id of the edge joining global vertices `g0` and `g1` (one side's).
+    fn edge(&self, g0: u32, g1: u32) -> u32 {
+        let ((w, u), (_, v)) = (self.local(g0), self.local(g1));
+        let s = self.side(w);
+        s.tables().edge_id(u, v).expect("an edge of a triangle") + s.edge_offset
+    }
+
+    /// The contact of vertex `v` of side `p` and triangle `t`, whose closest features are
+    /// `kind`.
+    fn vertex_face_key(&self, p: Which, v: u32, t: u32, kind: PointTriangle) -> Key {
+        let (sp, sf) = (self.side(p), self.side(self.faces_of(p)));
+        let gv = v + sp.vertex_offset;
+        let g = sf.tables().triangles[t as usize].map(|w| w + sf.vertex_offset);
+        let k = kind as usize;
+        match kind {
+            PointTriangle::Vertex0 | PointTriangle::Vertex1 | PointTriangle::Vertex2 => (
+                ContactType::PointPoint,
+                [gv.min(g[k]), gv.max(g[k]), NONE, NONE],
+            ),
+            PointTriangle::Edge0 | PointTriangle::Edge1 | PointTriangle::Edge2 => {
+                let (i, j) = (g[k - 3], g[(k - 2) % 3]);
+                (ContactType::PointEdge, [gv, i.min(j), i.max(j), NONE])
+            }
+            PointTriangle::Face => (ContactType::PointTriangle, [gv, g[0], g[1], g[2]]),
+        }
+    }
+
+    /// The contact of edges `g` (global vertices, each edge's smaller first, in row order)
+    /// whose closest features are `kind`, `mollified` or not.
+    fn edge_edge_key(g: [u32; 4], kind: EdgeEdge, mollified: bool) -> Key {
+        let point_point = |i: usize, j: usize| {
+            (
+                ContactType::PointPoint,
+                [g[i].min(g[j]), g[i].max(g[j]), NONE, NONE],
+            )
+        };
+        let point_edge =
+            |p: usize, e: usize| (ContactType::PointEdge, [g[p], g[e], g[e + 1], NONE]);
+        if mollified {
+            return (ContactType::EdgeEdge, g);
+        }
+        match kind {
+            EdgeEdge::EaEb => (ContactType::EdgeEdge, g),
+            EdgeEdge::Ea0Eb0 => point_point(0, 2),
+            EdgeEdge::Ea0Eb1 => point_point(0, 3),
+            EdgeEdge::Ea1Eb0 => point_point(1, 2),
+            EdgeEdge::Ea1Eb1 => point_point(1, 3),
+            EdgeEdge::EaEb0 => point_edge(2, 0),
+            EdgeEdge::EaEb1 => point_edge(3, 0),
+            EdgeEdge::Ea0Eb => point_edge(0, 2),
+            EdgeEdge::Ea1Eb => point_edge(1, 2),
+        }
+    }
+
+    /// Edges `a` and `b` (global vertices, each edge's smaller first, in row order) at
+    /// positions `x` are nearly parallel by IPC's rest-length threshold.
+    fn mollified(&self, g: [u32; 4], x: [[f64; 3]; 4]) -> bool {
+        let rest = |i: usize| {
+            let ((w, u), (_, v)) = (self.local(g[i]), self.local(g[i + 1]));
+            self.side(w).rest_len_sq([u, v])
+        };
+        edges_cross_sq_below(x, MOLLIFIER_FACTOR * rest(0) * rest(2))
+    }
+
+    /// The row of vertex `v` of side `p` and triangle `t`, if the query has it and its
+    /// contact is `key`.
+    fn vertex_face_producing(&self, p: Which, v: u32, t: u32, key: &Key, row: Row) -> Option<Row> {
+        let me = Row::VertexFace { side: p, v, t };
+        if me == row {
+            // The row asking: its contact is `key`.
+            return Some(me);
+        }
+        let (sp, sf) = (self.side(p), self.side(self.faces_of(p)));
+        let c = sf.tables().triangles[t as usize];
+        if self.self_query && c.contains(&v) {
+            return None;
+        }
+        let (_, kind) = point_triangle_distance_sq(sp.position(v), c.map(|w| sf.position(w)));
+        (self.vertex_face_key(p, v, t, kind) == *key).then_some(me)
+    }
+
+    /// The row of edge `x` of side `px` and edge `y` of side `py`, if the query has it and
+    /// its contact is `key`.
+    fn edge_edge_producing(
+        &self,
+        (px, x): (Which, u32),
+        (py, y): (Which, u32),
+        key: &Key,
+        row: Row,
+    ) -> Option<Row> {
+        let ((pa, a), (pb, b)) = match (self.self_query, px) {
+            (true, _) => ((Which::A, x.min(y)), (Which::A, x.max(y))),
+            (false, Which::A) => ((px, x), (py, y)),
+            (false, Which::B) => ((py, y), (px, x)),
+        };
+        let me = Row::EdgeEdge { a, b };
+        if me == row {
+            return Some(me);
+        }
+        let (sa, sb) = (self.side(pa), self.side(pb));
+        let (ea, eb) = (sa.tables().edges[a as usize], sb.tables().edges[b as usize]);
+        if self.self_query && (ea.contains(&eb[0]) || ea.contains(&eb[1])) {
+            return None;
+        }
+        let g = [
+            ea[0] + sa.vertex_offset,
+            ea[1] + sa.vertex_offset,
+            eb[0] + sb.vertex_offset,
+            eb[1] + sb.vertex_offset,
+        ];
+        let x = g.map(|g| self.position(g));
+        let (_, kind) = edge_edge_distance_sq(x[0], x[1], x[2], x[3]);
+        // Only a point-edge or point-point key is looked for: an edge-edge row gives one
+        // when its closest features are not interior to both edges and it is not mollified.
+        if kind == EdgeEdge::EaEb || Self::edge_edge_key(g, kind, false) != *key {
+            return None;
+        }
+        (!self.mollified(g, x)).then_some(me)
+    }
+
+    /// The producer of a point-point or point-edge contact (see [`Sides`]); `None` for the
+    /// other types (their one row) and if no row of the query has it.
+    fn producer(&self, key: &Key, row: Row) -> Option<Row> {
+        let [g0, g1, g2, _] = key.1;
+        match key.0 {
+            ContactType::PointEdge => {
+                let (pv, v) = self.local(g0);
+                let ((pe, e0), (_, e1)) = (self.local(g1), self.local(g2));
+                let se = self.side(pe);
+                let e = se.tables().edge_id(e0, e1).expect("an edge of a triangle");
+                let mut faces = se.tables().edge_triangles.of(e).iter();
+                let mut edges = self.side(pv).tables().vertex_edges.of(v).iter();
+                faces
+                    .find_map(|&t| self.vertex_face_producing(pv, v, t, key, row))
+                    .or_else(|| {
+                        edges.find_map(|&x| self.edge_edge_producing((pv, x), (pe, e), key, row))
+                    })
+            }
+            ContactType::PointPoint => {
+                let ((pv, v), (pw, w)) = (self.local(g0), self.local(g1));
+                let (tv, tw) = (self.side(pv).tables(), self.side(pw).tables());
+                let (faces_at_v, faces_at_w) =
+                    (tv.vertex_triangles.of(v), tw.vertex_triangles.of(w));
+                let (edges_at_v, edges_at_w) = (tv.vertex_edges.of(v), tw.vertex_edges.of(w));
+                faces_at_w
+                    .iter()
+                    .find_map(|&t| self.vertex_face_producing(pv, v, t, key, row))
+                    .or_else(|| {
+                        faces_at_v
+                            .iter()
+                            .find_map(|&t| self.vertex_face_producing(pw, w, t, key, row))
+                    })
+                    .or_else(|| {
+                        edges_at_v.iter().find_map(|&x| {
+                            edges_at_w
+                                .iter()
+                                .find_map(|&y| self.edge_edge_producing((pv, x), (pw, y), key, row))
+                        })
+                    })
+            }
+            ContactType::PointTriangle | ContactType::EdgeEdge => None,
+        }
+    }
+
+    /// Whether `row` emits its contact `key`: always for point-triangle and edge-edge
+    /// contacts, only from their producer for the others.
+    fn emits(&self, row: impl FnOnce() -> Row, key: &Key) -> bool {
+        match key.0 {
+            ContactType::PointTriangle | ContactType::EdgeEdge => true,
+            ContactType::PointPoint | ContactType::PointEdge => {
+                let row = row();
+                let producer = self.producer(key, row);
+                debug_assert!(producer.is_some(), "a row of {key:?} names no producer");
+                producer.is_none_or(|p| p == row)
+            }
+        }
+    }
+
+    /// The contact of `key` found by a row at squared distance `distance_sq` (`closest`:
+    /// an edge-edge row's type), if this row emits it.
+    fn contact(
+        &self,
+        key: Key,
+        distance_sq: f64,
+        mollified: bool,
+        closest: Option<EdgeEdge>,
+    ) -> (Contact, [[f64; 3]; 4]) {
+        let (kind, vertices) = key;
+        let positions = vertices.map(|g| {
+            if g == NONE {
+                [0.0; 3]
             } else {
-                ([g[k], gv, NONE, NONE], [q, p, [0.0; 3], [0.0; 3]])
-            };
-        }
-        PointTriangle::Edge0 | PointTriangle::Edge1 | PointTriangle::Edge2 => {
-            let (i, j) = (k - 3, (k - 2) % 3);
-            let (i, j) = if g[i] < g[j] { (i, j) } else { (j, i) };
-            d.kind = ContactType::PointEdge;
-            d.vertices = [gv, g[i], g[j], NONE];
-            d.edges = [f.edge(c[i], c[j]), NONE];
-            d.positions = [
-                d.positions[0],
-                d.positions[1 + i],
-                d.positions[1 + j],
-                [0.0; 3],
-            ];
-        }
-        PointTriangle::Face => {}
+                self.position(g)
+            }
+        });
+        let edges = match kind {
+            ContactType::PointEdge => [self.edge(vertices[1], vertices[2]), NONE],
+            ContactType::EdgeEdge => [
+                self.edge(vertices[0], vertices[1]),
+                self.edge(vertices[2], vertices[3]),
+            ],
+            ContactType::PointPoint | ContactType::PointTriangle => [NONE; 2],
+        };
+        // A point-edge contact's rows measure it from different ends of the edge; its value
+        // is one formula's, whichever row emits it.
+        let distance_sq = match kind {
+            ContactType::PointEdge => {
+                let [p, e0, e1, _] = positions;
+                point_line_distance_sq(p, e0, e1)
+            }
+            _ => distance_sq,
+        };
+        let mut c = Contact {
+            kind,
+            vertices,
+            edges,
+            distance_sq,
+            mollified,
+            closest: closest.filter(|_| kind == ContactType::EdgeEdge),
+            weights: [0.0; 4],
+        };
+        c.weights = c.formula().weights(&positions);
+        (c, positions)
     }
-    d
+
+    /// Row `i` of `rows` (vertex-face rows, then face-vertex rows, then edge-edge rows) as
+    /// the contact it emits, if it emits one.
+    fn convert(&self, rows: &Proximity, i: usize) -> Option<(Contact, [[f64; 3]; 4])> {
+        let (nv, nf) = (rows.vertex_face.len(), rows.face_vertex.len());
+        let vertex_face = |side: Which, v: u32, t: u32, kind, distance_sq| {
+            let key = self.vertex_face_key(side, v, t, kind);
+            self.emits(|| Row::VertexFace { side, v, t }, &key)
+                .then(|| self.contact(key, distance_sq, false, None))
+        };
+        if i < nv {
+            let r = &rows.vertex_face[i];
+            return vertex_face(Which::A, r.vertex, r.triangle, r.kind, r.distance_sq);
+        }
+        if i < nv + nf {
+            let r = &rows.face_vertex[i - nv];
+            return vertex_face(Which::B, r.vertex, r.triangle, r.kind, r.distance_sq);
+        }
+        let r = &rows.edge_edge[i - nv - nf];
+        let (sa, sb) = (self.a, self.b);
+        let g = [
+            r.a[0] + sa.vertex_offset,
+            r.a[1] + sa.vertex_offset,
+            r.b[0] + sb.vertex_offset,
+            r.b[1] + sb.vertex_offset,
+        ];
+        let x = [
+            sa.position(r.a[0]),
+            sa.position(r.a[1]),
+            sb.position(r.b[0]),
+            sb.position(r.b[1]),
+        ];
+        let mollified = self.mollified(g, x);
+        let key = Self::edge_edge_key(g, r.kind, mollified);
+        let id = |s: &Side<'_, K>, e: [u32; 2]| s.tables().edge_id(e[0], e[1]).expect("an edge");
+        let row = || Row::EdgeEdge {
+            a: id(sa, r.a),
+            b: id(sb, r.b),
+        };
+        self.emits(row, &key)
+            .then(|| self.contact(key, r.distance_sq, mollified, Some(r.kind)))
+    }
 }
 
-/// The contact of edge `a` of side `sa` and edge `b` of side `sb`.
-fn edge_edge<K: BoundingVolume>(
-    sa: &Side<'_, K>,
-    a: [u32; 2],
-    sb: &Side<'_, K>,
-    b: [u32; 2],
-    distance_sq: f64,
-    kind: EdgeEdge,
-) -> Draft {
-    let x = [
-        sa.position(a[0]),
-        sa.position(a[1]),
-        sb.position(b[0]),
-        sb.position(b[1]),
-    ];
-    let g = [
-        a[0] + sa.vertex_offset,
-        a[1] + sa.vertex_offset,
-        b[0] + sb.vertex_offset,
-        b[1] + sb.vertex_offset,
-    ];
-    let threshold = MOLLIFIER_FACTOR * sa.rest_len_sq(a[0], a[1]) * sb.rest_len_sq(b[0], b[1]);
-    let mollified = edges_cross_sq_below(x, threshold);
-    let mut d = Draft {
-        kind: ContactType::EdgeEdge,
-        vertices: g,
-        edges: [sa.edge(a[0], a[1]), sb.edge(b[0], b[1])],
-        distance_sq,
-        mollified,
-        closest: Some(kind),
-        positions: x,
-    };
-    if mollified || kind == EdgeEdge::EaEb {
-        return d;
-    }
-    // The closest features: a corner pair, or a corner and the other edge.
-    let point_point = |i: usize, j: usize, d: &mut Draft| {
-        let (i, j) = if g[i] < g[j] { (i, j) } else { (j, i) };
-        d.kind = ContactType::PointPoint;
-        d.vertices = [g[i], g[j], NONE, NONE];
-        d.positions = [x[i], x[j], [0.0; 3], [0.0; 3]];
-        d.edges = [NONE; 2];
-    };
-    let point_edge = |p: usize, e: [usize; 2], edge: u32, d: &mut Draft| {
-        d.kind = ContactType::PointEdge;
-        d.vertices = [g[p], g[e[0]], g[e[1]], NONE];
-        d.positions = [x[p], x[e[0]], x[e[1]], [0.0; 3]];
-        d.edges = [edge, NONE];
-    };
-    let (ea, eb) = (d.edges[0], d.edges[1]);
-    match kind {
-        EdgeEdge::Ea0Eb0 => point_point(0, 2, &mut d),
-        EdgeEdge::Ea0Eb1 => point_point(0, 3, &mut d),
-        EdgeEdge::Ea1Eb0 => point_point(1, 2, &mut d),
-        EdgeEdge::Ea1Eb1 => point_point(1, 3, &mut d),
-        EdgeEdge::EaEb0 => point_edge(2, [0, 1], ea, &mut d),
-        EdgeEdge::EaEb1 => point_edge(3, [0, 1], ea, &mut d),
-        EdgeEdge::Ea0Eb => point_edge(0, [2, 3], eb, &mut d),
-        EdgeEdge::Ea1Eb => point_edge(1, [2, 3], eb, &mut d),
-        EdgeEdge::EaEb => unreachable!("returned above"),
-    }
-    d.closest = None;
-    d
-}
-
-/// The contact set of proximity `rows` between sides `a` and `b` (the same side for a self
-/// query).
+/// The contact set of proximity `rows` between sides `a` and `b` (the same side, and
+/// `self_query`, for a self query): each row's contact, once (from its producer, see
+/// [`Sides`]), sorted by `(kind, vertices)`; rows converted in parallel if `par` says so.
 pub(crate) fn from_rows<K: BoundingVolume>(
     rows: Proximity,
     a: &Side<'_, K>,
     b: &Side<'_, K>,
+    self_query: bool,
+    par: Par,
 ) -> ContactSet {
-    let mut drafts: Vec<Draft> =
-        Vec::with_capacity(rows.vertex_face.len() + rows.face_vertex.len() + rows.edge_edge.len());
-    for r in &rows.vertex_face {
-        drafts.push(vertex_face(
-            a,
-            r.vertex,
-            b,
-            r.triangle,
-            r.distance_sq,
-            r.kind,
-        ));
-    }
-    for r in &rows.face_vertex {
-        drafts.push(vertex_face(
-            b,
-            r.vertex,
-            a,
-            r.triangle,
-            r.distance_sq,
-            r.kind,
-        ));
-    }
-    for r in &rows.edge_edge {
-        drafts.push(edge_edge(a, r.a, b, r.b, r.distance_sq, r.kind));
-    }
-    // One contact per (type, vertices): the duplicates are the point-point and point-edge
-    // contacts several rows found; they are the same features, so the same distance up to
-    // the rounding of the formula each row used (the least is kept).
-    drafts.sort_unstable_by(|x, y| {
-        (x.kind, x.vertices)
-            .cmp(&(y.kind, y.vertices))
-            .then(x.distance_sq.total_cmp(&y.distance_sq))
-    });
-    drafts.dedup_by(|later, kept| later.kind == kept.kind && later.vertices == kept.vertices);
+    let sides = Sides { a, b, self_query };
+    let n = rows.vertex_face.len() + rows.face_vertex.len() + rows.edge_edge.len();
+    let found: Vec<(Contact, [[f64; 3]; 4])> = if par.is_parallel() {
+        par.install(|| {
+            (0..n)
+                .into_par_iter()
+                .with_min_len(1024)
+                .filter_map(|i| sides.convert(&rows, i))
+                .collect()
+        })
+    } else {
+        (0..n).filter_map(|i| sides.convert(&rows, i)).collect()
+    };
+    let mut order: Vec<(Key, u32)> = (0u32..)
+        .zip(&found)
+        .map(|(i, (c, _))| ((c.kind, c.vertices), i))
+        .collect();
+    order.sort_unstable();
     let mut set = ContactSet {
-        contacts: Vec::with_capacity(drafts.len()),
-        positions: Vec::with_capacity(drafts.len()),
+        contacts: order.iter().map(|&(_, i)| found[i as usize].0).collect(),
+        positions: order.iter().map(|&(_, i)| found[i as usize].1).collect(),
         counters: rows.counters,
     };
-    for d in drafts {
-        let mut c = Contact {
-            kind: d.kind,
-            vertices: d.vertices,
-            edges: d.edges,
-            distance_sq: d.distance_sq,
-            mollified: d.mollified,
-            closest: d.closest,
-            weights: [0.0; 4],
-        };
-        c.weights = c.formula().weights(&d.positions);
-        set.contacts.push(c);
-        set.positions.push(d.positions);
-    }
     set.counters.contacts = set.contacts.len() as u64;
     set
 }

@@ -510,6 +510,27 @@ pub(crate) fn distance(e: [[f64; 3]; 4]) -> (f64, Ee) {
     }
     .unwrap_or((f64::NAN, Ee::Ea0Eb0))
 }
+/// The squared distance from `p` to the line through `e0` and `e1` by the corner-edge
+/// formula `|e x w|^2 / |e|^2` (`e = e1 - e0`, `w = p - e0`: the value of type `Ea0Eb` for the
+/// segments `[p, p]` and `[e0, e1]`), within that type's bound, and correctly rounded where
+/// the formula's analysis does not hold; `NaN` for non-finite input or `e0 == e1`.
+pub(crate) fn point_line_distance_sq(p: [f64; 3], e0: [f64; 3], e1: [f64; 3]) -> f64 {
+    let (e, w) = (sub3(&e1, &e0), sub3(&p, &e0));
+    let m = hmax(&sub3(
+        &max3(&max3(&e0, &e1), &p),
+        &min3(&min3(&e0, &e1), &p),
+    ));
+    if !m.is_finite() || e == [0.0; 3] {
+        return f64::NAN;
+    }
+    if scale_of(m) == Some(0) {
+        if let Some(v) = float_value(&line_parts(&e, &w), [&e, &w], None) {
+            return v;
+        }
+    }
+    Exact::new(&p, &p, &e0, &e1, 0.0).distance(Ee::Ea0Eb)
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::arith::count::Count;

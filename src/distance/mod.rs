@@ -212,6 +212,15 @@ pub fn edge_edge_distance_sq(
     edge_edge::distance([a0, a1, b0, b1])
 }
 
+/// Squared distance from the point `p` to the line through `e0` and `e1`: the value of a
+/// point-edge contact (the corner-edge formula `|e x w|^2 / |e|^2`, `e = e1 - e0`,
+/// `w = p - e0`, with its bound in the [module doc](self), correctly rounded where that
+/// analysis does not hold). `NaN` when `e0 == e1` or an input is not finite.
+#[inline]
+pub fn point_line_distance_sq(p: [f64; 3], e0: [f64; 3], e1: [f64; 3]) -> f64 {
+    edge_edge::point_line_distance_sq(p, e0, e1)
+}
+
 /// `Some((distance_sq, type))` iff the distance between `p` and the closed triangle `t` is
 /// `<= d`, decided exactly for the `f64` inputs and the `f64` `d`; `None` otherwise (and for
 /// negative or NaN `d`, or non-finite coordinates). The value and type are those of

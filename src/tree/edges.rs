@@ -83,6 +83,51 @@ pub(crate) struct MeshTables {
     pub(crate) edges: Vec<[u32; 2]>,
     /// Every triangle's corners (caller's indices and order), by the caller's triangle index.
     pub(crate) triangles: Vec<[u32; 3]>,
+    /// Each vertex's edges (ids, ascending).
+    pub(crate) vertex_edges: Adjacency,
+    /// Each vertex's triangles (caller's indices, ascending).
+    pub(crate) vertex_triangles: Adjacency,
+    /// Each edge's triangles (caller's indices, ascending).
+    pub(crate) edge_triangles: Adjacency,
+}
+
+/// A list per key, flattened: key `k`'s items are `items[start[k]..start[k + 1]]`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Adjacency {
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Adjacency {
+    /// The lists of `keys` keys from `(key, item)` links, each list in the links' order
+    /// (a counting sort: two passes over `links`).
+    fn build<I: Iterator<Item = (u32, u32)>>(keys: usize, links: impl Fn() -> I) -> Self {
+        let mut start = vec![0u32; keys + 1];
+        for (k, _) in links() {
+            start[k as usize + 1] += 1;
+        }
+        for k in 0..keys {
+            start[k + 1] += start[k];
+        }
+        let mut next = start.clone();
+        let mut items = vec![0u32; start[keys] as usize];
+        for (k, item) in links() {
+            items[next[k as usize] as usize] = item;
+            next[k as usize] += 1;
+        }
+        Self { start, items }
+    }
+
+    /// The number of keys.
+    fn keys(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// Key `k`'s items.
+    #[inline]
+    pub(crate) fn of(&self, k: u32) -> &[u32] {
+        &self.items[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
+    }
 }
 
 impl MeshTables {
@@ -99,14 +144,50 @@ impl MeshTables {
             .collect();
         edges.sort_unstable();
         edges.dedup();
-        Self { edges, triangles }
+        let vertices = tree.vertex_total();
+        let vertex_edges = Adjacency::build(vertices, || {
+            (0u32..)
+                .zip(&edges)
+                .flat_map(|(e, &[u, v])| [(u, e), (v, e)])
+        });
+        let vertex_triangles = Adjacency::build(vertices, || {
+            (0u32..)
+                .zip(&triangles)
+                .flat_map(|(t, c)| c.map(|v| (v, t)))
+        });
+        let edge_id = |u: u32, v: u32| {
+            let (u, v) = (u.min(v), u.max(v));
+            vertex_edges
+                .of(u)
+                .iter()
+                .copied()
+                .find(|&e| edges[e as usize][1] == v)
+                .expect("an edge of a triangle")
+        };
+        let edge_triangles = Adjacency::build(edges.len(), || {
+            (0u32..)
+                .zip(&triangles)
+                .flat_map(move |(t, c)| (0..3).map(move |k| (edge_id(c[k], c[(k + 1) % 3]), t)))
+        });
+        Self {
+            edges,
+            triangles,
+            vertex_edges,
+            vertex_triangles,
+            edge_triangles,
+        }
     }
 
-    /// The id of the edge `(u, v)` (either order), if the mesh has it.
+    /// The id of the edge `(u, v)` (either order), if the mesh has it: a scan of the edges
+    /// at the smaller end.
     pub(crate) fn edge_id(&self, u: u32, v: u32) -> Option<u32> {
-        self.edges
-            .binary_search(&[u.min(v), u.max(v)])
-            .ok()
-            .map(|i| i as u32)
+        let (u, v) = (u.min(v), u.max(v));
+        if u as usize >= self.vertex_edges.keys() {
+            return None;
+        }
+        let at = self.vertex_edges.of(u);
+        at.iter()
+            .copied()
+            .find(|&e| self.edges[e as usize] == [u, v])
     }
 }

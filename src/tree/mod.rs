@@ -18,6 +18,7 @@
 
 mod build;
 mod edges;
+pub(crate) use edges::MeshTables;
 mod shared;
 mod validate;
 
