@@ -9,7 +9,8 @@
 //! and otherwise the point-point or point-edge contact of its closest features. These are
 //! the IPC Toolkit's rules (`NormalCollisions::build`). A point-point or point-edge contact
 //! found by several rows (a vertex near an edge is near both its triangles, and near the
-//! edges at its ends) is kept once.
+//! edges at its ends) is emitted once, by the one row the rules of [`Sides`] name its
+//! producer; no duplicate is made, so none is removed.
 
 use super::geometry::{ContactType, Formula};
 use crate::bv::BoundingVolume;
