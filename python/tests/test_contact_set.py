@@ -142,33 +142,31 @@ def ipctk_or_skip():
     return ipctk
 
 
+def ipctk_row(ipctk, c, i, mesh, pose):
+    """Collision `i` of ipctk's NormalCollisions `c` as ((type, vertices), (mollified, edge
+    ids)). Its own frame: `c[i]` refers into `c`'s storage, so it must be released while `c`
+    is alive (a local of the caller's frame could outlive `c` when the frame is cleared)."""
+    col = c[i]
+    ids = [int(v) for v in col.vertex_ids(mesh.edges, mesh.faces)]
+    if c.is_vertex_vertex(i):
+        return (0, min(ids[:2]), max(ids[:2]), -1, -1), (False, -1, -1)
+    if c.is_edge_vertex(i):
+        return (1, *ids[:3], -1), (False, col.edge_id, -1)
+    if c.is_edge_edge(i):
+        e0, e1 = col.edge0_id, col.edge1_id
+        if e0 > e1:
+            e0, e1, ids = e1, e0, ids[2:] + ids[:2]
+        moll = bool(ipctk.edge_edge_cross_squarednorm(*pose[ids]) < col.eps_x)
+        return (3, *ids), (moll, e0, e1)
+    return (2, *ids), (False, -1, -1)
+
+
 def ipctk_set(ipctk, rest, pose, faces, edges, dhat):
     """ipctk's NormalCollisions as (type, vertices) -> (mollified, edge ids)."""
     mesh = ipctk.CollisionMesh(rest, edges.astype(np.int32), faces.astype(np.int32))
     c = ipctk.NormalCollisions()
     c.build(mesh, pose, dhat)
-    out = {}
-    for i in range(len(c)):
-        col = c[i]
-        ids = [int(v) for v in col.vertex_ids(mesh.edges, mesh.faces)]
-        if c.is_vertex_vertex(i):
-            key = (0, min(ids[:2]), max(ids[:2]), -1, -1)
-            val = (False, -1, -1)
-        elif c.is_edge_vertex(i):
-            key = (1, *ids[:3], -1)
-            val = (False, col.edge_id, -1)
-        elif c.is_edge_edge(i):
-            e0, e1 = col.edge0_id, col.edge1_id
-            if e0 > e1:
-                e0, e1, ids = e1, e0, ids[2:] + ids[:2]
-            key = (3, *ids)
-            moll = bool(ipctk.edge_edge_cross_squarednorm(*pose[ids]) < col.eps_x)
-            val = (moll, e0, e1)
-        else:
-            key = (2, *ids)
-            val = (False, -1, -1)
-        out[key] = val
-    return out
+    return dict(ipctk_row(ipctk, c, i, mesh, pose) for i in range(len(c)))
 
 
 def test_equals_ipctk_on_a_folded_sheet():
