@@ -15,8 +15,8 @@
 //!   "At the floor", seconds per call).
 //!
 //! Ids: `contact/<query>/<case>`, `<query>` one of `contact_set`, `proximity`, `gradients`,
-//! `hessians`, `step_size`, `earliest`. The setup checks what it times: the step size is in `[0, 1]` and never past the
-//! earliest impact, and the contact set is not empty where the case has contacts.
+//! `hessians`, `step_size`, `earliest`. The setup checks what it times (the step size is in
+//! `[0, 1]` and never past the earliest impact) and prints each case's contact count.
 //!
 //! `cargo bench --bench contact` (all); `cargo bench --bench contact -- 'contact/.*/sheet'`.
 

@@ -142,6 +142,14 @@ def ipctk_or_skip():
     return ipctk
 
 
+def as_dict(cs):
+    """A contact set as (type, vertices) -> (mollified, edge ids), the form of ipctk_set."""
+    return {
+        (int(t), *map(int, v)): (bool(m), int(e[0]), int(e[1]))
+        for t, v, m, e in zip(cs.type, cs.vertices, cs.mollified, cs.edges)
+    }
+
+
 def ipctk_row(ipctk, c, i, mesh, pose):
     """Collision `i` of ipctk's NormalCollisions `c` as ((type, vertices), (mollified, edge
     ids)). Its own frame: `c[i]` refers into `c`'s storage, so it must be released while `c`
@@ -176,10 +184,7 @@ def test_equals_ipctk_on_a_folded_sheet():
     edges = h.edges()
     for dhat in (0.03, 0.08, 0.15):
         cs = dhcd.self_contact_set(h, dhat)
-        ours = {
-            (int(t), *map(int, v)): (bool(m), int(e[0]), int(e[1]))
-            for t, v, m, e in zip(cs.type, cs.vertices, cs.mollified, cs.edges)
-        }
+        ours = as_dict(cs)
         theirs = ipctk_set(ipctk, rest, pose, faces, edges, dhat)
         # ipctk decides types and activity in floating point (strict < dhat); dhcd exactly
         # (<= dhat). On this sheet no pair is within rounding of a boundary.
@@ -206,10 +211,7 @@ def test_equals_ipctk_on_the_real_frames():
         dhat = 1e-3 * float(np.linalg.norm(pose.max(0) - pose.min(0)))
         h = dhcd.Hierarchy(pose, faces)
         cs = dhcd.self_contact_set(h, dhat, threads=2)
-        ours = {
-            (int(t), *map(int, v)): (bool(m), int(e[0]), int(e[1]))
-            for t, v, m, e in zip(cs.type, cs.vertices, cs.mollified, cs.edges)
-        }
+        ours = as_dict(cs)
         theirs = ipctk_set(ipctk, pose, pose, faces, h.edges(), dhat)
         # No pair of these frames is within rounding of dhat or of a type boundary.
         assert ours == theirs, (

@@ -235,10 +235,6 @@ impl<'h, K: BoundingVolume> Side<'h, K> {
         })
     }
 
-    fn tables(&self) -> &'h MeshTables {
-        self.tables
-    }
-
     /// Vertex `v`'s exact position (`v` in the caller's indices).
     fn position(&self, v: u32) -> [f64; 3] {
         self.h
@@ -249,6 +245,11 @@ impl<'h, K: BoundingVolume> Side<'h, K> {
     fn local(&self, g: u32) -> Option<u32> {
         let v = g.wrapping_sub(self.vertex_offset);
         ((v as usize) < self.h.tree().vertex_total()).then_some(v)
+    }
+
+    /// Edge `e` (local vertices) in the global numbering.
+    fn global(&self, e: [u32; 2]) -> [u32; 2] {
+        e.map(|v| v + self.vertex_offset)
     }
 
     fn rest_len_sq(&self, [u, v]: [u32; 2]) -> f64 {
@@ -332,7 +333,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
     fn edge(&self, g0: u32, g1: u32) -> u32 {
         let ((w, u), (_, v)) = (self.local(g0), self.local(g1));
         let s = self.side(w);
-        s.tables().edge_id(u, v).expect("an edge of a triangle") + s.edge_offset
+        s.tables.edge_id(u, v).expect("an edge of a triangle") + s.edge_offset
     }
 
     /// The contact of vertex `v` of side `p` and triangle `t`, whose closest features are
@@ -340,7 +341,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
     fn vertex_face_key(&self, p: Which, v: u32, t: u32, kind: PointTriangle) -> Key {
         let (sp, sf) = (self.side(p), self.side(self.faces_of(p)));
         let gv = v + sp.vertex_offset;
-        let g = sf.tables().triangles[t as usize].map(|w| w + sf.vertex_offset);
+        let g = sf.tables.triangles[t as usize].map(|w| w + sf.vertex_offset);
         let k = kind as usize;
         match kind {
             PointTriangle::Vertex0 | PointTriangle::Vertex1 | PointTriangle::Vertex2 => (
@@ -353,6 +354,12 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
             }
             PointTriangle::Face => (ContactType::PointTriangle, [gv, g[0], g[1], g[2]]),
         }
+    }
+
+    /// Edge `ea` of side `sa` and `eb` of side `sb` (local vertices), in the global numbering.
+    fn global_edges(sa: &Side<'_, K>, ea: [u32; 2], sb: &Side<'_, K>, eb: [u32; 2]) -> [u32; 4] {
+        let ([a0, a1], [b0, b1]) = (sa.global(ea), sb.global(eb));
+        [a0, a1, b0, b1]
     }
 
     /// The contact of edges `g` (global vertices, each edge's smaller first, in row order)
@@ -401,7 +408,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
             return Some(me);
         }
         let (sp, sf) = (self.side(p), self.side(self.faces_of(p)));
-        let c = sf.tables().triangles[t as usize];
+        let c = sf.tables.triangles[t as usize];
         if self.self_query && c.contains(&v) {
             return None;
         }
@@ -428,16 +435,11 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
             return Some(me);
         }
         let (sa, sb) = (self.side(pa), self.side(pb));
-        let (ea, eb) = (sa.tables().edges[a as usize], sb.tables().edges[b as usize]);
+        let (ea, eb) = (sa.tables.edges[a as usize], sb.tables.edges[b as usize]);
         if self.self_query && (ea.contains(&eb[0]) || ea.contains(&eb[1])) {
             return None;
         }
-        let g = [
-            ea[0] + sa.vertex_offset,
-            ea[1] + sa.vertex_offset,
-            eb[0] + sb.vertex_offset,
-            eb[1] + sb.vertex_offset,
-        ];
+        let g = Self::global_edges(sa, ea, sb, eb);
         let x = g.map(|g| self.position(g));
         let (_, kind) = edge_edge_distance_sq(x[0], x[1], x[2], x[3]);
         // Only a point-edge or point-point key is looked for: an edge-edge row gives one
@@ -457,9 +459,9 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
                 let (pv, v) = self.local(g0);
                 let ((pe, e0), (_, e1)) = (self.local(g1), self.local(g2));
                 let se = self.side(pe);
-                let e = se.tables().edge_id(e0, e1).expect("an edge of a triangle");
-                let mut faces = se.tables().edge_triangles.of(e).iter();
-                let mut edges = self.side(pv).tables().vertex_edges.of(v).iter();
+                let e = se.tables.edge_id(e0, e1).expect("an edge of a triangle");
+                let mut faces = se.tables.edge_triangles.of(e).iter();
+                let mut edges = self.side(pv).tables.vertex_edges.of(v).iter();
                 faces
                     .find_map(|&t| self.vertex_face_producing(pv, v, t, key, row))
                     .or_else(|| {
@@ -468,7 +470,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
             }
             ContactType::PointPoint => {
                 let ((pv, v), (pw, w)) = (self.local(g0), self.local(g1));
-                let (tv, tw) = (self.side(pv).tables(), self.side(pw).tables());
+                let (tv, tw) = (self.side(pv).tables, self.side(pw).tables);
                 let (faces_at_v, faces_at_w) =
                     (tv.vertex_triangles.of(v), tw.vertex_triangles.of(w));
                 let (edges_at_v, edges_at_w) = (tv.vertex_edges.of(v), tw.vertex_edges.of(w));
@@ -572,12 +574,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
         }
         let r = &rows.edge_edge[i - nv - nf];
         let (sa, sb) = (self.a, self.b);
-        let g = [
-            r.a[0] + sa.vertex_offset,
-            r.a[1] + sa.vertex_offset,
-            r.b[0] + sb.vertex_offset,
-            r.b[1] + sb.vertex_offset,
-        ];
+        let g = Self::global_edges(sa, r.a, sb, r.b);
         let x = [
             sa.position(r.a[0]),
             sa.position(r.a[1]),
@@ -586,7 +583,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
         ];
         let mollified = self.mollified(g, x);
         let key = Self::edge_edge_key(g, r.kind, mollified);
-        let id = |s: &Side<'_, K>, e: [u32; 2]| s.tables().edge_id(e[0], e[1]).expect("an edge");
+        let id = |s: &Side<'_, K>, e: [u32; 2]| s.tables.edge_id(e[0], e[1]).expect("an edge");
         let row = || Row::EdgeEdge {
             a: id(sa, r.a),
             b: id(sb, r.b),

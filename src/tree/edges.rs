@@ -101,7 +101,10 @@ pub(crate) struct Adjacency {
 impl Adjacency {
     /// The lists of `keys` keys from `(key, item)` links, each list in the links' order
     /// (a counting sort: two passes over `links`).
-    fn build<I: Iterator<Item = (u32, u32)>>(keys: usize, links: impl Fn() -> I) -> Self {
+    pub(crate) fn build<I: Iterator<Item = (u32, u32)>>(
+        keys: usize,
+        links: impl Fn() -> I,
+    ) -> Self {
         let mut start = vec![0u32; keys + 1];
         for (k, _) in links() {
             start[k as usize + 1] += 1;
@@ -155,15 +158,8 @@ impl MeshTables {
                 .zip(&triangles)
                 .flat_map(|(t, c)| c.map(|v| (v, t)))
         });
-        let edge_id = |u: u32, v: u32| {
-            let (u, v) = (u.min(v), u.max(v));
-            vertex_edges
-                .of(u)
-                .iter()
-                .copied()
-                .find(|&e| edges[e as usize][1] == v)
-                .expect("an edge of a triangle")
-        };
+        let edge_id =
+            |u, v| edge_between(&edges, &vertex_edges, u, v).expect("an edge of a triangle");
         let edge_triangles = Adjacency::build(edges.len(), || {
             (0u32..)
                 .zip(&triangles)
@@ -178,16 +174,22 @@ impl MeshTables {
         }
     }
 
-    /// The id of the edge `(u, v)` (either order), if the mesh has it: a scan of the edges
-    /// at the smaller end.
+    /// The id of the edge `(u, v)` (either order), if the mesh has it.
     pub(crate) fn edge_id(&self, u: u32, v: u32) -> Option<u32> {
-        let (u, v) = (u.min(v), u.max(v));
-        if u as usize >= self.vertex_edges.keys() {
-            return None;
-        }
-        let at = self.vertex_edges.of(u);
-        at.iter()
-            .copied()
-            .find(|&e| self.edges[e as usize] == [u, v])
+        edge_between(&self.edges, &self.vertex_edges, u, v)
     }
+}
+
+/// The id of the edge `(u, v)` (either order) among `edges` (each smaller vertex first),
+/// if there is one: a scan of the edges at the smaller end (`vertex_edges`).
+fn edge_between(edges: &[[u32; 2]], vertex_edges: &Adjacency, u: u32, v: u32) -> Option<u32> {
+    let (u, v) = (u.min(v), u.max(v));
+    if u as usize >= vertex_edges.keys() {
+        return None;
+    }
+    vertex_edges
+        .of(u)
+        .iter()
+        .copied()
+        .find(|&e| edges[e as usize] == [u, v])
 }

@@ -13,6 +13,7 @@
 //! to build; a mesh over [`BUILD_BUDGET`] (a fan of thousands of triangles around one
 //! vertex) gets none, and its leaf pairs are counted directly (`count_direct`).
 
+use super::edges::Adjacency;
 use super::RegionTree;
 
 /// Largest `sum over vertices of valence^2` for which the table is built, per triangle,
@@ -35,26 +36,14 @@ impl SharedPairs {
         let tris = tree.triangles();
         let vertices = tree.vertex_total();
         // Triangles around each vertex (a mesh's corners are distinct).
-        let mut around_start = vec![0u32; vertices + 1];
-        for tri in tris {
-            for &v in tri {
-                around_start[v as usize + 1] += 1;
-            }
-        }
-        let squares: u64 = around_start.iter().map(|&n| u64::from(n).pow(2)).sum();
+        let around = Adjacency::build(vertices, || {
+            (0u32..).zip(tris).flat_map(|(t, tri)| tri.map(|v| (v, t)))
+        });
+        let squares: u64 = (0..vertices as u32)
+            .map(|v| (around.of(v).len() as u64).pow(2))
+            .sum();
         if squares > BUILD_BUDGET.0 * tris.len() as u64 + BUILD_BUDGET.1 {
             return None;
-        }
-        for v in 0..vertices {
-            around_start[v + 1] += around_start[v];
-        }
-        let mut around = vec![0u32; around_start[vertices] as usize];
-        let mut fill = around_start.clone();
-        for (t, tri) in tris.iter().enumerate() {
-            for &v in tri {
-                around[fill[v as usize] as usize] = t as u32;
-                fill[v as usize] += 1;
-            }
         }
         let leaves: Vec<usize> = tree.leaves().collect();
         let mut tri_leaf = vec![0u32; tris.len()];
@@ -77,8 +66,7 @@ impl SharedPairs {
             table.start.push(table.leaf.len() as u32);
             for t in tree.tri_range(n) {
                 for &v in &tris[t] {
-                    let v = v as usize;
-                    for &u in &around[around_start[v] as usize..around_start[v + 1] as usize] {
+                    for &u in around.of(v) {
                         let u = u as usize;
                         // Within one leaf, each pair once (when its first triangle is `t`).
                         let y = tri_leaf[u] as usize;
