@@ -356,6 +356,11 @@ fn decide(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], d: &Diffs, t_max: f64, test: S
     if (0..4).all(|k| b[k] > e[k]) || (0..4).all(|k| b[k] < -e[k]) {
         return Verdict::Miss;
     }
+    // Every coefficient may be 0 (f identically 0: coplanar motion): every piece of the
+    // subdivision would have coefficients that may all be 0 too, so isolation cannot succeed.
+    if (0..4).all(|k| b[k].abs() <= e[k]) {
+        return Verdict::Unknown;
+    }
     roots_and_test(x0, x1, b, e, t_max, test)
 }
 
@@ -495,22 +500,16 @@ fn roots_and_test(
     Verdict::Miss
 }
 
-/// The vertex-face filter (stages 0-2).
+/// The vertex-face filter (stages 1-2; the caller has run stage 0).
 #[inline]
 pub(crate) fn vertex_face(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
-    if vf_boxes_apart(x0, x1, 0.0) {
-        return Verdict::Miss;
-    }
     let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
     decide(x0, x1, &[at(x0), at(x1)], t_max, vf_static)
 }
 
-/// The edge-edge filter (stages 0-2).
+/// The edge-edge filter (stages 1-2; the caller has run stage 0).
 #[inline]
 pub(crate) fn edge_edge(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
-    if ee_boxes_apart(x0, x1, 0.0) {
-        return Verdict::Miss;
-    }
     let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
     decide(x0, x1, &[at(x0), at(x1)], t_max, ee_static)
 }

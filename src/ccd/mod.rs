@@ -86,7 +86,17 @@
 //! decided on the wider certified interval and only the time is narrowed exactly (the
 //! integer cubic bisected at dyadic points). Everything else (touching, roots at t = 0 or
 //! `t_max`, double roots, vertex-on-edge, coplanar motion, coordinate differences beyond
-//! 2^200) goes to the exact path. The filter allocates nothing.
+//! 2^200) is left undecided. The filter allocates nothing.
+//!
+//! **Planar filter next** (`planar.rs`), for what the first left undecided: the features
+//! projected on the plane of two coordinate axes, certified apart over pieces of the time
+//! interval by a separating-axis test in interval-bounded floats; and, when all eight
+//! points share one coordinate exactly (motion in one axis plane, where `f` is
+//! identically 0 and the 3D predicate is the 2D one), contact certified at a time after
+//! every earlier piece was certified apart, which gives the time within `2^-40`. A sheet
+//! lying on a floor and sliding, folding flat or sliding over another sheet is decided
+//! there, but for contacts at a single instant (touching without entering) and at 0 or
+//! `t_max`. Only what neither filter decides goes to the exact path.
 //!
 //! **Minimum distance `delta > 0`**: the same exact engine on the formula "distance <=
 //! delta": the vertex within delta of the face's plane with its foot in the
@@ -120,6 +130,7 @@ mod exact;
 mod filter;
 mod interval;
 mod near;
+mod planar;
 mod ring;
 
 use crate::error::{Error, Result};
@@ -296,19 +307,35 @@ fn query(
     if !valid {
         return Ok(None);
     }
+    let vf = kind == exact::Kind::VertexFace;
+    let delta = options.min_distance;
+    // Stage 0, the swept boxes, on the input as given: comparisons, exact at every scale.
+    // Most pairs end here, before paying for the scaling below.
+    let apart = if vf {
+        filter::vf_boxes_apart(x0, x1, delta)
+    } else {
+        filter::ee_boxes_apart(x0, x1, delta)
+    };
+    if apart {
+        return Ok(None);
+    }
+    // A time limit below 1 (the earliest-time mode's pruning): the boxes over [0, t_max],
+    // far smaller than over the whole step when t_max is small. Their rounding bound holds
+    // for coordinates below 2^1000 (no overflow), at any scale.
+    if options.t_max < 1.0
+        && max_magnitude(x0, x1) <= BOXES_UNTIL_MAX
+        && filter::boxes_apart_until(kind, x0, x1, options.t_max, delta)
+    {
+        return Ok(None);
+    }
     // One power-of-two scaling (when it is exact) brings the largest coordinate near 1:
     // contacts and times do not change, and the float filters never overflow or drown in
     // their underflow terms.
-    let unit = to_unit_scale(x0, x1, options.min_distance);
+    let unit = to_unit_scale(x0, x1, delta);
     let (x0, x1, delta) = match &unit {
         Some((y0, y1, d)) => (y0, y1, *d),
-        None => (x0, x1, options.min_distance),
+        None => (x0, x1, delta),
     };
-    // A time limit below 1 (the earliest-time mode's pruning): the boxes over [0, t_max]
-    // first, which are far smaller than over the whole step when t_max is small.
-    if options.t_max < 1.0 && filter::boxes_apart_until(kind, x0, x1, options.t_max, delta) {
-        return Ok(None);
-    }
     if delta == 0.0 {
         let verdict = match kind {
             exact::Kind::VertexFace => filter::vertex_face(x0, x1, options.t_max),
@@ -318,23 +345,45 @@ fn query(
             filter::Verdict::Miss => Ok(None),
             filter::Verdict::Hit(t) => Ok(Some(t)),
             filter::Verdict::Refine(lo, hi) => exact::refine_root(x0, x1, lo, hi, stop).map(Some),
-            filter::Verdict::Unknown => exact::solve(kind, x0, x1, options.t_max, 0.0, stop),
+            filter::Verdict::Unknown => undecided(kind, x0, x1, options.t_max, stop),
         }
     } else {
-        let apart = match kind {
-            exact::Kind::VertexFace => filter::vf_boxes_apart(x0, x1, delta),
-            exact::Kind::EdgeEdge => filter::ee_boxes_apart(x0, x1, delta),
-        };
-        if apart {
-            return Ok(None);
-        }
-        let vf = kind == exact::Kind::VertexFace;
         match near::decide(vf, x0, x1, options.t_max, delta) {
             filter::Verdict::Miss => Ok(None),
             filter::Verdict::Hit(t) => Ok(Some(t)),
             _ => exact::solve(kind, x0, x1, options.t_max, delta, stop),
         }
     }
+}
+
+/// A query (with `min_distance = 0`) the main filter left undecided: the planar filter, then
+/// the exact path. Out of line: rare, and kept out of the hot loop of the walks.
+#[cold]
+#[inline(never)]
+fn undecided(
+    kind: exact::Kind,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    t_max: f64,
+    stop: exact::Stop<'_>,
+) -> std::result::Result<Option<f64>, exact::Stopped> {
+    match planar::decide(kind == exact::Kind::VertexFace, x0, x1, t_max) {
+        filter::Verdict::Miss => Ok(None),
+        filter::Verdict::Hit(t) => Ok(Some(t)),
+        _ => exact::solve(kind, x0, x1, t_max, 0.0, stop),
+    }
+}
+
+/// Coordinates up to this magnitude keep [`filter::boxes_apart_until`]'s arithmetic finite.
+const BOXES_UNTIL_MAX: f64 = 1.071_508_607_186_267_3e301; // 2^1000
+
+/// The largest coordinate magnitude of a query.
+#[inline(always)]
+fn max_magnitude(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> f64 {
+    x0.iter()
+        .chain(x1)
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 /// `x` times `2^k`, computed in at most two exact steps, if the result is exact.
@@ -356,11 +405,7 @@ fn to_unit_scale(
     x1: &[[f64; 3]; 4],
     delta: f64,
 ) -> Option<([[f64; 3]; 4], [[f64; 3]; 4], f64)> {
-    let m = x0
-        .iter()
-        .chain(x1)
-        .flatten()
-        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let m = max_magnitude(x0, x1);
     if m == 0.0 {
         return None;
     }
