@@ -6,12 +6,15 @@ lifted off the plane by a fixed wave, so no feature is coplanar), the yardstick 
 issue "At the floor".
 
 usage: python benches/scripts/degenerate-vs-ipctk.py [--n 16 32 64] [--repeat 3]
-           [--kinds slide fold collapse line slide2] [--no-ipctk]
+           [--kinds slide fold collapse line slide2] [--no-ipctk] [--ipctk-timeout 60]
+ipctk runs in a child process stopped after --ipctk-timeout seconds (its Tight Inclusion
+narrow phase takes minutes on some of these motions); such a cell reads "> 60 s".
 Needs a venv with dhcd, numpy and (unless --no-ipctk) ipctk==1.6.1 (see
 contact-set-vs-ipctk.py). Prints one markdown table.
 """
 import argparse
 import importlib.util
+import multiprocessing
 import os
 import time
 
@@ -24,6 +27,7 @@ ap.add_argument("--n", type=int, nargs="+", default=[16, 32, 64])
 ap.add_argument("--repeat", type=int, default=3)
 ap.add_argument("--kinds", nargs="+", default=["slide", "fold", "collapse", "line", "slide2"])
 ap.add_argument("--no-ipctk", action="store_true")
+ap.add_argument("--ipctk-timeout", type=float, default=60.0)
 a = ap.parse_args()
 
 here = os.path.dirname(os.path.abspath(__file__))
@@ -48,6 +52,29 @@ def least(f, repeat):
         out = f()
         best = min(best, time.perf_counter() - s)
     return best, out
+
+
+def ipctk_least(x0, x1, faces, edges, repeat, timeout):
+    """Least of `repeat` compute_collision_free_stepsize calls in a child process, or None
+    when it did not finish within `timeout` seconds."""
+
+    def child(conn):
+        mesh = ipctk.CollisionMesh(
+            np.asfortranarray(x0),
+            np.asfortranarray(edges.astype(np.int32)),
+            np.asfortranarray(faces.astype(np.int32)),
+        )
+        t, _ = least(lambda: ipctk.compute_collision_free_stepsize(mesh, x0, x1), repeat)
+        conn.send(t)
+
+    parent, child_end = multiprocessing.Pipe()
+    p = multiprocessing.get_context("fork").Process(target=child, args=(child_end,))
+    p.start()
+    got = parent.poll(timeout)
+    t = parent.recv() if got else None
+    p.terminate()
+    p.join()
+    return t
 
 
 def motion(kind, n):
@@ -82,12 +109,11 @@ for n in a.n:
         pairs = len(hits.vertex_face) + len(hits.face_vertex) + len(hits.edge_edge)
         cand = hits.counters["prim_tests"]
         if ipctk is not None:
-            E = h.edges().astype(np.int32)
-            mesh = ipctk.CollisionMesh(
-                np.asfortranarray(x0), np.asfortranarray(E), np.asfortranarray(faces.astype(np.int32))
-            )
-            t_ipc, _ = least(lambda: ipctk.compute_collision_free_stepsize(mesh, x0, x1), a.repeat)
-            ipc = f"{ms(t_ipc)} | {t_ipc / t_first:.2f}x"
+            t_ipc = ipctk_least(x0, x1, faces, h.edges(), a.repeat, a.ipctk_timeout)
+            if t_ipc is None:
+                ipc = f"> {a.ipctk_timeout:.0f} s | > {a.ipctk_timeout / t_first:.0f}x"
+            else:
+                ipc = f"{ms(t_ipc)} | {t_ipc / t_first:.2f}x"
         else:
             ipc = "| "
         print(

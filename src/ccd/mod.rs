@@ -419,6 +419,23 @@ fn to_unit_scale(
     if k == 0 {
         return None;
     }
+    // The common case, `2^k` a normal float: a product by it is exact unless it overflows
+    // (delta far above the coordinates) or falls below the normal range (scaling down).
+    if (-1022..=1023).contains(&k) {
+        let s = f64::from_bits(((1023 + k) as u64) << 52);
+        let least = x0
+            .iter()
+            .chain(x1)
+            .flatten()
+            .chain(std::iter::once(&delta))
+            .filter(|x| **x != 0.0)
+            .fold(f64::INFINITY, |m, x| m.min(x.abs()));
+        let exact = (delta * s).is_finite() && (k > 0 || least * s >= f64::MIN_POSITIVE);
+        if exact {
+            let scale = |x: &[[f64; 3]; 4]| x.map(|p| p.map(|c| c * s));
+            return Some((scale(x0), scale(x1), delta * s));
+        }
+    }
     let mut y0 = [[0.0; 3]; 4];
     let mut y1 = [[0.0; 3]; 4];
     for i in 0..4 {

@@ -178,11 +178,12 @@ impl At {
     }
 }
 
-/// All certainly of one strict sign near `m` (evaluated lazily).
+/// The `n` quadratics `q(0..n)` all certainly of one strict sign near `m` (each built and
+/// evaluated only as long as the answer is open).
 #[inline(always)]
-fn one_sign(qs: &[Quad], m: f64, h: f64) -> bool {
-    let s = qs[0].sign_near(m, h);
-    s != 0 && qs[1..].iter().all(|q| q.sign_near(m, h) == s)
+fn one_sign(n: usize, q: impl Fn(usize) -> Quad, m: f64, h: f64) -> bool {
+    let s = q(0).sign_near(m, h);
+    s != 0 && (1..n).all(|i| q(i).sign_near(m, h) == s)
 }
 
 /// Certainly of strictly opposite signs.
@@ -191,98 +192,74 @@ fn opposite(a: At, b: At) -> bool {
     a.sign * b.sign < 0
 }
 
-/// The separating-axis quantities of a query in the plane of the two kept axes.
-enum Shape {
-    /// With `r_q = corner q - vertex` and the edges `e_0 = b - a`, `e_1 = c - b`,
-    /// `e_2 = a - c`: `coord[k][q] = r_q[k]`, `cross[i][q] = e_i x r_q`,
-    /// `dot[i][q] = e_i . r_q`, `turn[i] = r_i x r_(i+1)` (the vertex's side of edge i).
-    VertexFace {
-        r: [[Lin; 2]; 3],
-        coord: [[Quad; 3]; 2],
-        cross: [[Quad; 3]; 3],
-        dot: [[Quad; 3]; 3],
-        turn: [Quad; 3],
-    },
-    /// With `r = [b0 - a0, b1 - a0, b0 - a1, b1 - a1]`, `u = a1 - a0`, `v = b1 - b0`:
-    /// `coord[k][n] = r_n[k]`, `u_cross[n] = u x r_n`, `u_dot[n] = u . r_n`, likewise `v`.
-    EdgeEdge {
-        r: [[Lin; 2]; 4],
-        coord: [[Quad; 4]; 2],
-        u_cross: [Quad; 4],
-        u_dot: [Quad; 4],
-        v_cross: [Quad; 4],
-        v_dot: [Quad; 4],
-    },
-}
+type L2 = [Lin; 2];
 
 #[inline(always)]
-fn cross(a: &[Lin; 2], b: &[Lin; 2]) -> Quad {
+fn cross(a: &L2, b: &L2) -> Quad {
     Quad::two_products(a[0], b[1], a[1], b[0], -1.0)
 }
 
 #[inline(always)]
-fn dot(a: &[Lin; 2], b: &[Lin; 2]) -> Quad {
+fn dot(a: &L2, b: &L2) -> Quad {
     Quad::two_products(a[0], b[0], a[1], b[1], 1.0)
+}
+
+/// A query's relative vectors in the plane of the two kept axes, linear in t. The
+/// separating-axis quantities are built from them as the tests need them (most pairs are
+/// decided by the first few).
+enum Shape {
+    /// `r[q] = corner q - vertex`, and the edges `e[0] = b - a`, `e[1] = c - b`,
+    /// `e[2] = a - c` (`e[i]` runs from corner i to corner i + 1).
+    VertexFace { r: [L2; 3], e: [L2; 3] },
+    /// `r = [b0 - a0, b1 - a0, b0 - a1, b1 - a1]`, `u = a1 - a0`, `v = b1 - b0`.
+    EdgeEdge { r: [L2; 4], u: L2, v: L2 },
 }
 
 impl Shape {
     /// `None` when a coordinate difference is beyond the filter's range.
+    #[inline(always)]
     fn new(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], axes: [usize; 2]) -> Option<Shape> {
-        let d = |i: usize, j: usize| -> [Lin; 2] {
+        let d = |i: usize, j: usize| -> L2 {
             axes.map(|k| Lin::new(x0[i][k], x0[j][k], x1[i][k], x1[j][k]))
         };
-        let in_range = |ls: &[[Lin; 2]]| ls.iter().flatten().all(|l| l.mag <= MAX_MAGNITUDE);
-        if vf {
-            let r = [d(1, 0), d(2, 0), d(3, 0)];
-            let e = [d(2, 1), d(3, 2), d(1, 3)];
-            if !(in_range(&r) && in_range(&e)) {
-                return None;
+        let in_range = |ls: &[L2]| ls.iter().flatten().all(|l| l.mag <= MAX_MAGNITUDE);
+        let shape = if vf {
+            Shape::VertexFace {
+                r: [d(1, 0), d(2, 0), d(3, 0)],
+                e: [d(2, 1), d(3, 2), d(1, 3)],
             }
-            Some(Shape::VertexFace {
-                r,
-                coord: [0, 1].map(|k| r.map(|q| Quad::linear(q[k]))),
-                cross: e.map(|e| r.map(|q| cross(&e, &q))),
-                dot: e.map(|e| r.map(|q| dot(&e, &q))),
-                turn: [0, 1, 2].map(|i| cross(&r[i], &r[(i + 1) % 3])),
-            })
         } else {
-            let r = [d(2, 0), d(3, 0), d(2, 1), d(3, 1)];
-            let (u, v) = (d(1, 0), d(3, 2));
-            if !(in_range(&r) && in_range(&[u, v])) {
-                return None;
+            Shape::EdgeEdge {
+                r: [d(2, 0), d(3, 0), d(2, 1), d(3, 1)],
+                u: d(1, 0),
+                v: d(3, 2),
             }
-            Some(Shape::EdgeEdge {
-                r,
-                coord: [0, 1].map(|k| r.map(|q| Quad::linear(q[k]))),
-                u_cross: r.map(|q| cross(&u, &q)),
-                u_dot: r.map(|q| dot(&u, &q)),
-                v_cross: r.map(|q| cross(&v, &q)),
-                v_dot: r.map(|q| dot(&v, &q)),
-            })
-        }
+        };
+        let ok = match &shape {
+            Shape::VertexFace { r, e } => in_range(r) && in_range(e),
+            Shape::EdgeEdge { r, u, v } => in_range(r) && in_range(&[*u, *v]),
+        };
+        ok.then_some(shape)
     }
 
-    /// The projections are certainly disjoint at every time within `h` of `m`.
+    /// The projections are certainly disjoint at every time within `h` of `m`: on a
+    /// coordinate axis, or on the normal or the direction of an edge, the other feature's
+    /// points relative to the first (`r`) all strictly on one side.
     fn apart(&self, m: f64, h: f64) -> bool {
         match self {
-            Shape::VertexFace {
-                coord, cross, dot, ..
-            } => {
-                coord.iter().any(|q| one_sign(q, m, h))
-                    || (0..3).any(|i| one_sign(&cross[i], m, h) || one_sign(&dot[i], m, h))
+            Shape::VertexFace { r, e } => {
+                (0..2).any(|k| one_sign(3, |q| Quad::linear(r[q][k]), m, h))
+                    || e.iter().any(|e| {
+                        one_sign(3, |q| cross(e, &r[q]), m, h)
+                            || one_sign(3, |q| dot(e, &r[q]), m, h)
+                    })
             }
-            Shape::EdgeEdge {
-                coord,
-                u_cross,
-                u_dot,
-                v_cross,
-                v_dot,
-                ..
-            } => {
-                coord.iter().any(|q| one_sign(q, m, h))
-                    || [u_cross, u_dot, v_cross, v_dot]
-                        .iter()
-                        .any(|q| one_sign(&q[..], m, h))
+            Shape::EdgeEdge { r, u, v } => {
+                (0..2).any(|k| one_sign(4, |n| Quad::linear(r[n][k]), m, h))
+                    || [u, v].iter().any(|d| {
+                        one_sign(4, |n| cross(d, &r[n]), m, h)
+                            || one_sign(4, |n| dot(d, &r[n]), m, h)
+                    })
             }
         }
     }
@@ -290,27 +267,23 @@ impl Shape {
     /// The features certainly touch at the time `s`, given exact coplanarity.
     fn contact(&self, s: f64) -> bool {
         let at = |q: &Quad| At::of(q, s);
-        // The point with relative corners `r_i`, `r_j` (corner - point) on the closed
-        // segment between them: `r_i x r_j = 0` and `r_i . r_j <= 0` (which holds for a
+        // The point with relative corners `ri`, `rj` (corner - point) on the closed
+        // segment between them: `ri x rj = 0` and `ri . rj <= 0` (which holds for a
         // zero-length segment only at the point itself).
-        let on_segment =
-            |ri: &[Lin; 2], rj: &[Lin; 2]| at(&cross(ri, rj)).zero && at(&dot(ri, rj)).le0();
+        let on_segment = |ri: &L2, rj: &L2| at(&cross(ri, rj)).zero && at(&dot(ri, rj)).le0();
         match self {
-            Shape::VertexFace { r, turn, .. } => {
-                // Strictly inside: the vertex strictly on one side of all three edges.
-                let t = turn.map(|q| at(&q).sign);
-                (t[0] != 0 && t[1] == t[0] && t[2] == t[0])
+            Shape::VertexFace { r, .. } => {
+                // Strictly inside: the vertex strictly on one side of all three edges
+                // (`r_i x r_(i+1)`, its side of edge i).
+                let side = |i: usize| at(&cross(&r[i], &r[(i + 1) % 3])).sign;
+                let s0 = side(0);
+                (s0 != 0 && side(1) == s0 && side(2) == s0)
                     || (0..3).any(|i| on_segment(&r[i], &r[(i + 1) % 3]))
             }
-            Shape::EdgeEdge {
-                r,
-                u_cross,
-                v_cross,
-                ..
-            } => {
+            Shape::EdgeEdge { r, u, v } => {
                 // A proper crossing: b0, b1 strictly on both sides of line a, a0, a1 of line b.
-                (opposite(at(&u_cross[0]), at(&u_cross[1]))
-                    && opposite(at(&v_cross[0]), at(&v_cross[2])))
+                (opposite(at(&cross(u, &r[0])), at(&cross(u, &r[1])))
+                    && opposite(at(&cross(v, &r[0])), at(&cross(v, &r[2]))))
                     // b_j on segment a (`a0 - b_j = -r_j`, `a1 - b_j = -r_(2+j)`), a_i on
                     // segment b (`b0 - a_i = r_(2i)`, `b1 - a_i = r_(2i+1)`).
                     || (0..2).any(|j| on_segment(&r[j], &r[2 + j]))
@@ -338,6 +311,13 @@ fn flattest_axis(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> (usize, bool) {
     (k, plane)
 }
 
+/// The middle `m` of `[s0, s1]` and a half width `h`: every t in it is within `h` of `m`
+/// (`m` rounded, `h` rounded up).
+#[inline(always)]
+fn middle(s0: f64, s1: f64) -> (f64, f64) {
+    (0.5 * (s0 + s1), 0.5 * (s1 - s0) * (1.0 + U50) + s1 * U50)
+}
+
 /// Decides a query (with `min_distance = 0`, `t_max` in `[0, 1]`) that the main filter
 /// left `Unknown`, or says `Unknown` again.
 pub(crate) fn decide(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
@@ -350,6 +330,11 @@ pub(crate) fn decide(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f6
     let Some(shape) = Shape::new(vf, x0, x1, axes) else {
         return Verdict::Unknown;
     };
+    // The whole interval first: most pairs end here.
+    let (m, h) = middle(0.0, t_max);
+    if shape.apart(m, h) {
+        return Verdict::Miss;
+    }
     if plane && shape.contact(0.0) {
         return Verdict::Hit(0.0);
     }
@@ -365,9 +350,7 @@ pub(crate) fn decide(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f6
         if visits > MAX_VISITS {
             return Verdict::Unknown;
         }
-        // Every t in [s0, s1] is within h of m (m rounded, h rounded up).
-        let m = 0.5 * (s0 + s1);
-        let h = 0.5 * (s1 - s0) * (1.0 + U50) + s1 * U50;
+        let (m, h) = middle(s0, s1);
         if shape.apart(m, h) {
             continue;
         }
