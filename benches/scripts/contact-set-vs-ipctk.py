@@ -17,11 +17,11 @@ can be checked to be a tie at dhat or a type decided across a region boundary by
 import argparse
 import glob
 import os
-import time
 
 import numpy as np
 
 import dhcd
+from timing import least
 import ipctk
 
 ap = argparse.ArgumentParser()
@@ -35,15 +35,6 @@ frames = a.frames or sorted(
 ipctk.set_num_threads(1)
 ipctk.set_logger_level(ipctk.LoggerLevel.off)
 NAMES = ["PP", "PE", "PT", "EE"]
-
-
-def least(f, repeat):
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        s = time.perf_counter()
-        out = f()
-        best = min(best, time.perf_counter() - s)
-    return best, out
 
 
 def ours_as_dict(cs):

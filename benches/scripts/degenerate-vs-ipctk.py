@@ -16,11 +16,11 @@ import argparse
 import importlib.util
 import multiprocessing
 import os
-import time
 
 import numpy as np
 
 import dhcd
+from timing import least
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--n", type=int, nargs="+", default=[16, 32, 64])
@@ -43,15 +43,6 @@ if not a.no_ipctk:
 
     ipctk.set_num_threads(1)
     ipctk.set_logger_level(ipctk.LoggerLevel.off)
-
-
-def least(f, repeat):
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        s = time.perf_counter()
-        out = f()
-        best = min(best, time.perf_counter() - s)
-    return best, out
 
 
 def ipctk_least(x0, x1, faces, edges, repeat, timeout):

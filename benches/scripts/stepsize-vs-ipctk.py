@@ -10,11 +10,11 @@ both are printed, with dhcd's earliest impact (ccd earliest=True), which neither
 """
 import argparse
 import os
-import time
 
 import numpy as np
 
 import dhcd
+from timing import least
 import ipctk
 
 ap = argparse.ArgumentParser()
@@ -30,15 +30,6 @@ steps = [
     ("cloth-ball", 92),
     ("n-body-simulation", 18),
 ]
-
-
-def least(f, repeat):
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        s = time.perf_counter()
-        out = f()
-        best = min(best, time.perf_counter() - s)
-    return best, out
 
 
 print(

@@ -130,6 +130,7 @@ mod exact;
 mod filter;
 mod interval;
 mod near;
+mod pieces;
 mod planar;
 mod ring;
 
@@ -322,8 +323,9 @@ fn query(
     // A time limit below 1 (the earliest-time mode's pruning): the boxes over [0, t_max],
     // far smaller than over the whole step when t_max is small. Their rounding bound holds
     // for coordinates below 2^1000 (no overflow), at any scale.
+    let magnitude = max_magnitude(x0, x1);
     if options.t_max < 1.0
-        && max_magnitude(x0, x1) <= BOXES_UNTIL_MAX
+        && magnitude <= BOXES_UNTIL_MAX
         && filter::boxes_apart_until(kind, x0, x1, options.t_max, delta)
     {
         return Ok(None);
@@ -331,7 +333,7 @@ fn query(
     // One power-of-two scaling (when it is exact) brings the largest coordinate near 1:
     // contacts and times do not change, and the float filters never overflow or drown in
     // their underflow terms.
-    let unit = to_unit_scale(x0, x1, delta);
+    let unit = to_unit_scale(x0, x1, delta, magnitude);
     let (x0, x1, delta) = match &unit {
         Some((y0, y1, d)) => (y0, y1, *d),
         None => (x0, x1, delta),
@@ -396,7 +398,7 @@ fn scaled_exactly(x: f64, k: i32) -> Option<f64> {
     (y.is_finite() && step(step(y, -k1), -k2) == x).then_some(y)
 }
 
-/// The query scaled by one power of two so that its largest coordinate magnitude is in
+/// The query scaled by one power of two so that its largest coordinate magnitude `m` is in
 /// `[1, 2)`, when every coordinate and `delta` scale exactly (none loses bits below the
 /// smallest subnormal); `None` when already there, all zero, or not exact.
 #[allow(clippy::type_complexity)]
@@ -404,8 +406,8 @@ fn to_unit_scale(
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],
     delta: f64,
+    m: f64,
 ) -> Option<([[f64; 3]; 4], [[f64; 3]; 4], f64)> {
-    let m = max_magnitude(x0, x1);
     if m == 0.0 {
         return None;
     }

@@ -45,6 +45,7 @@
 
 use super::filter::{moving, Verdict};
 use super::interval::Iv;
+use super::pieces::{earliest_first, Piece};
 use super::ring::{self, Ring, V3};
 
 /// Bound on the pieces visited per query: where the distance stays near `delta` for a long
@@ -57,10 +58,6 @@ const LEAF_WIDTH: f64 = 1.0 / (1u64 << 46) as f64;
 /// Spacing and number of the probes after the first leaf not apart: up to `2^-40`.
 const PROBE_STEP: f64 = 1.0 / (1u64 << 44) as f64;
 const PROBES: u32 = 16;
-
-/// Depth bound of the bisection (a piece of `[0, 1]` narrower than `2^-46` needs 47 halvings;
-/// the midpoints of float endpoints are exact or rounded between them).
-const MAX_DEPTH: usize = 64;
 
 /// An upper bound on the speed at which the features' distance can change (see the module
 /// docs): the largest `|a_i' - b_j'|` over the corners of the two features.
@@ -94,46 +91,36 @@ pub(crate) fn decide(
         return Verdict::Hit(0.0);
     }
     let speed = max_relative_speed(vf, x0, x1);
-    let mut stack = [(0.0f64, 0.0f64); MAX_DEPTH + 1];
-    stack[0] = (0.0, t_max);
-    let (mut n, mut pieces) = (1usize, 0u32);
-    while n > 0 {
-        n -= 1;
-        let (lo, hi) = stack[n];
-        pieces += 1;
-        if pieces > MAX_PIECES {
-            return Verdict::Unknown;
-        }
+    earliest_first(t_max, MAX_PIECES, |lo, hi, last| {
         let mid = 0.5 * (lo + hi);
         // The largest distance from mid to an end, rounded up, times the speed.
         let reach = (mid - lo).max(hi - mid).next_up();
         let margin = (speed * reach).next_up();
         if apart(vf, &at(mid), (delta + margin).next_up()) {
-            continue;
+            return Piece::Apart;
         }
         // The features enclosed over the whole piece: sharper where they slide past each
         // other fast at a nearly constant distance (then L is large and the margin wide).
         if apart(vf, &moving(x0, x1, Iv { lo, hi }), delta) {
-            continue;
+            return Piece::Apart;
         }
-        if hi - lo <= LEAF_WIDTH || n + 2 > MAX_DEPTH || !(lo < mid && mid < hi) {
-            // Everything before lo is apart: within at a probe puts the contact in
-            // [lo, lo + 2^-40].
-            let within = (1..=PROBES).any(|k| {
-                let t = (lo + k as f64 * PROBE_STEP).min(t_max);
-                within(vf, &at(t), delta)
-            });
-            return if within || touches_by(vf, x0, x1, t_max, lo + TOUCH_SLACK) {
+        if hi - lo > LEAF_WIDTH && !last {
+            return Piece::Split;
+        }
+        // Everything before lo is apart: within at a probe puts the contact in
+        // [lo, lo + 2^-40].
+        let within = (1..=PROBES).any(|k| {
+            let t = (lo + k as f64 * PROBE_STEP).min(t_max);
+            within(vf, &at(t), delta)
+        });
+        Piece::Decided(
+            if within || touches_by(vf, x0, x1, t_max, lo + TOUCH_SLACK) {
                 Verdict::Hit(lo)
             } else {
                 Verdict::Unknown
-            };
-        }
-        stack[n] = (mid, hi);
-        stack[n + 1] = (lo, mid);
-        n += 2;
-    }
-    Verdict::Miss
+            },
+        )
+    })
 }
 
 /// How far after the first piece not apart (`lo`) the delta-0 filter's contact time may lie

@@ -36,6 +36,7 @@
 //! the filter is then a cheap miss certificate for nearly coplanar motion.
 
 use super::filter::{Verdict, ROOT_WIDTH};
+use super::pieces::{earliest_first, Piece};
 
 /// Most pieces visited for one query before it goes to the exact path.
 const MAX_VISITS: u32 = 256;
@@ -339,41 +340,29 @@ pub(crate) fn decide(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f6
         return Verdict::Hit(0.0);
     }
     let narrowest = if plane { ROOT_WIDTH } else { MISS_WIDTH };
-    let mut stack = [(0.0f64, 0.0f64); 64];
-    stack[0] = (0.0, t_max);
-    let mut len = 1;
-    let mut visits = 0;
-    while len > 0 {
-        len -= 1;
-        let (s0, s1) = stack[len];
-        visits += 1;
-        if visits > MAX_VISITS {
-            return Verdict::Unknown;
-        }
+    earliest_first(t_max, MAX_VISITS, |s0, s1, _| {
         let (m, h) = middle(s0, s1);
         if shape.apart(m, h) {
-            continue;
+            return Piece::Apart;
         }
         let width = s1 - s0;
         if width <= CONTACT_WIDTH {
             // Every earlier time is certified apart: a contact at s1 puts t* in [s0, s1].
             let inside = s0 > 0.0 && s1 < t_max;
             let touching = plane && inside && shape.contact(s1);
-            if touching && width <= narrowest {
-                return Verdict::Hit(s0);
-            }
             if !touching {
-                return Verdict::Unknown;
+                return Piece::Decided(Verdict::Unknown);
+            }
+            if width <= narrowest {
+                return Piece::Decided(Verdict::Hit(s0));
             }
         }
-        if width <= narrowest || !(s0 < m && m < s1) || len + 2 > stack.len() {
-            return Verdict::Unknown;
+        if width <= narrowest {
+            Piece::Decided(Verdict::Unknown)
+        } else {
+            Piece::Split
         }
-        stack[len] = (m, s1);
-        stack[len + 1] = (s0, m);
-        len += 2;
-    }
-    Verdict::Miss
+    })
 }
 
 #[cfg(test)]
