@@ -74,7 +74,13 @@
 //! of each member changes no sign variation) and all evaluation points are dyadic, so no
 //! rational arithmetic (and no gcd per operation) is needed.
 //!
-//! **Float filter first** (`filter.rs`): (0) swept boxes; (1) the Bernstein coefficients
+//! **Separation first** (`axis.rs`): the features' gap along a fixed axis is concave in t
+//! (its ends move linearly), so a gap above `delta` at t = 0 and at t = 1 holds all step.
+//! Tested in floats with a proven error bound along the centroids' line, the face normal or
+//! the edges' cross product, and the coordinate axes, it ends most pairs of neighbouring
+//! features of a mesh for a few dot products.
+//!
+//! **Float filter next** (`filter.rs`): (0) swept boxes; (1) the Bernstein coefficients
 //! of `f` on `[0, 1]` from eight 3x3 determinants with a proven forward error bound
 //! (`2^-45 m^3` plus an underflow term, m the largest coordinate difference): all of one
 //! sign means no contact; (2) the roots of f isolated by interval Bernstein subdivision,
@@ -126,6 +132,7 @@
 //! sample queries of Wang et al. 2021 about 14% of the queries reach it (they are built to
 //! be degenerate), on the labelled pairs of real simulation steps about 2%.
 
+mod axis;
 mod exact;
 mod filter;
 mod interval;
@@ -133,6 +140,8 @@ mod near;
 mod pieces;
 mod planar;
 mod ring;
+#[cfg(test)]
+mod testing;
 
 use crate::error::{Error, Result};
 
@@ -328,6 +337,11 @@ fn query(
         && magnitude <= BOXES_UNTIL_MAX
         && filter::boxes_apart_until(kind, x0, x1, options.t_max, delta)
     {
+        return Ok(None);
+    }
+    // Separation along a few fixed axes at both ends of the step: ends most pairs of
+    // neighbouring features, which the boxes do not, for a few dot products.
+    if axis::apart(vf, x0, x1, delta, magnitude) {
         return Ok(None);
     }
     // One power-of-two scaling (when it is exact) brings the largest coordinate near 1:

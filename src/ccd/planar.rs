@@ -372,24 +372,8 @@ mod tests {
     //! coincident and zero-length features, sheets of a grid sliding along its lines; and
     //! nearly coplanar motions, where only misses may be certified.
     use super::super::exact::{solve, Kind};
+    use super::super::testing::Rng;
     use super::*;
-
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-        fn below(&mut self, n: u64) -> u64 {
-            self.next() % n
-        }
-        /// A multiple of 1/4 in [-1, 1]: exact arithmetic, frequent degeneracies.
-        fn small(&mut self) -> f64 {
-            self.below(9) as f64 / 4.0 - 1.0
-        }
-    }
 
     /// A coplanar case in the plane `x_k = c(t)`, with planted degeneracies.
     fn coplanar_case(rng: &mut Rng) -> ([[f64; 3]; 4], [[f64; 3]; 4], f64, usize) {
