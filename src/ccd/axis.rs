@@ -19,14 +19,16 @@
 //! ends, sharper than the boxes over the whole step of stage 0). On armadillo-rollers
 //! 326 -> 327 the first axis ends 84% of the 7.0 M candidate pairs, all five 96%.
 //!
-//! **Rounding.** The axis is whatever float vector was computed: any direction is a valid
-//! axis, so only the projections and the gaps need a bound. A projection is a 3-term dot
-//! product, within `gamma_3 sum_k |x_k c_k| < 2^-51 M C` of the exact one (`M` the largest
-//! coordinate magnitude, `C = sum_k |c_k|`), plus `3 * 2^-1075` for underflow; the gap's
-//! subtraction adds at most `2^-53 (2 M C + 2^-50 M C)`. So `3 * 2^-51 M C + 2^-1070`,
-//! below `E = 2^-48 M C + 2^-1000` with room for the rounding of `C` itself, bounds the
-//! error of a computed gap, and a gap is certain when it exceeds
-//! `delta |c| + E` rounded up. `|c|` is bounded above from its rounded square (within
+//! **Rounding** (`u = 2^-53`, `M` the largest coordinate magnitude, `C = sum_k |c_k|`). The
+//! axis is whatever float vector was computed: any direction is a valid axis, so only the
+//! projections and the gaps need a bound. The poses are the given ones (error 0) or
+//! interpolated in floats at a time of `[0, 1]` ([`positions_at`]: each coordinate within
+//! `5.01 u M`, so its projection within `5.01 u M C`). A projection is a 3-term dot product,
+//! within `gamma_3 sum_k |x_k c_k| <= 3.01 u M C` of the exact one, plus `3 * 2^-1075` for
+//! underflow; a gap is the difference of two projections, rounded once more (`u` of at most
+//! `2.01 M C`). So a computed gap is within `18.1 u M C + 2^-1070` of the exact one, below
+//! `E = 2^-48 M C + 2^-1000 = 32 u M C + 2^-1000` with room for the rounding of `C`
+//! itself, and a gap is certain when it exceeds `delta |c| + E` rounded up. `|c|` is bounded above from its rounded square (within
 //! `2^-51` of `|c|^2`, then a square root and a product each within `2^-53`). Axes with
 //! `C` outside `[2^-400, 2^400]`, and queries with `M` outside it, are not tested: there
 //! the bound's terms could under- or overflow.
@@ -81,11 +83,18 @@ fn gaps(split: usize, x: &Points, c: &[f64; 3]) -> (f64, f64) {
     (b_lo - a_hi, a_lo - b_hi)
 }
 
-/// The two features certainly farther than `delta` apart along `c` at every time of
-/// `[0, 1]` (see the module docs); `m` is the query's largest coordinate magnitude, in
+/// The two features certainly farther than `delta` apart along `c` at every time between
+/// two poses `x0` and `x1` of the points, given or interpolated by [`positions_at`] (see
+/// the module docs); `m` is the query's largest coordinate magnitude, in
 /// `[2^-400, 2^400]`.
 #[inline(always)]
-fn apart_along(split: usize, x0: &Points, x1: &Points, c: &[f64; 3], delta: f64, m: f64) -> bool {
+fn apart_along(
+    split: usize,
+    (x0, x1): (&Points, &Points),
+    c: &[f64; 3],
+    delta: f64,
+    m: f64,
+) -> bool {
     let norm1 = c[0].abs() + c[1].abs() + c[2].abs();
     if !(TINY..=HUGE).contains(&norm1) {
         return false;
@@ -141,7 +150,7 @@ pub(crate) fn apart(vf: bool, x0: &Points, x1: &Points, delta: f64, m: f64) -> b
         return false;
     }
     let split = if vf { 1 } else { 2 };
-    let along = |c: &[f64; 3]| apart_along(split, x0, x1, c, delta, m);
+    let along = |c: &[f64; 3]| apart_along(split, (x0, x1), c, delta, m);
     along(&centroid_axis(split, x0))
         || along(&normal_axis(vf, x0))
         || along(&centroid_axis(split, x1))
@@ -151,10 +160,33 @@ pub(crate) fn apart(vf: bool, x0: &Points, x1: &Points, delta: f64, m: f64) -> b
         || along(&[0.0, 0.0, 1.0])
 }
 
+/// The points at time `t` in `[0, 1]`, `x0 + t (x1 - x0)` in floats: each coordinate within
+/// `5.01 u m` of the exact one (`u = 2^-53`; three roundings, `|x1 - x0| <= 2 m`), which the
+/// gap's bound allows for (module docs).
+#[inline(always)]
+pub(crate) fn positions_at(x0: &Points, x1: &Points, t: f64) -> Points {
+    std::array::from_fn(|i| std::array::from_fn(|k| x0[i][k] + t * (x1[i][k] - x0[i][k])))
+}
+
+/// The features certainly farther than `delta` apart along `c` at every time of `[lo, hi]`,
+/// from their poses at `lo` and `hi` interpolated by [`positions_at`] (the gap is concave on
+/// any time interval). `m`: the query's largest coordinate magnitude; nothing is certified
+/// outside `[2^-400, 2^400]`.
+#[inline(always)]
+pub(crate) fn apart_between(
+    vf: bool,
+    poses: (&Points, &Points),
+    c: &[f64; 3],
+    delta: f64,
+    m: f64,
+) -> bool {
+    (TINY..=HUGE).contains(&m) && apart_along(if vf { 1 } else { 2 }, poses, c, delta, m)
+}
+
 #[cfg(test)]
 mod tests {
-    //! Every pair the cull calls apart is apart for the exact path, on motions built to
-    //! touch (coordinates on a coarse grid, so contacts at exactly t = 0, t = 1 and in
+    //! Every pair the cull calls apart is apart for the exact path, over the whole step and
+    //! from a pose interpolated in floats, on motions built to touch (coordinates on a coarse grid, so contacts at exactly t = 0, t = 1 and in
     //! between are frequent), at scales from 2^-390 to 2^390 and with minimum distances;
     //! and the cull ends a fair share of them, so the check is not vacuous.
     use super::super::exact::{solve, Kind};
@@ -168,7 +200,7 @@ mod tests {
     #[test]
     fn every_pair_called_apart_is_apart_exactly() {
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-        let (mut apart_count, mut total) = (0u32, 0u32);
+        let (mut apart_count, mut between_count, mut total) = (0u32, 0u32, 0u32);
         for case in 0..4000 {
             let vf = case % 2 == 0;
             let x0: Points = std::array::from_fn(|_| std::array::from_fn(|_| rng.small()));
@@ -189,16 +221,30 @@ mod tests {
                 .flatten()
                 .fold(0.0f64, |m, x| m.max(x.abs()));
             total += 1;
+            let kind = if vf { Kind::VertexFace } else { Kind::EdgeEdge };
             if apart(vf, &y0, &y1, d, m) {
                 apart_count += 1;
-                let kind = if vf { Kind::VertexFace } else { Kind::EdgeEdge };
                 let exact = solve(kind, &x0, &x1, t_max, delta, &|| false).unwrap();
                 assert_eq!(
                     exact, None,
                     "vf {vf} {x0:?} -> {x1:?} delta {delta} scale {s}"
                 );
             }
+            // Over [0, hi] from the pose interpolated (rounded) at a time that is not dyadic,
+            // along the centroid axis there.
+            let hi = [0.1, 1.0 / 3.0, 0.7][rng.below(3) as usize];
+            let end = positions_at(&y0, &y1, hi);
+            let c = centroid_axis(if vf { 1 } else { 2 }, &end);
+            if apart_between(vf, (&y0, &end), &c, d, m) {
+                between_count += 1;
+                let exact = solve(kind, &x0, &x1, hi, delta, &|| false).unwrap();
+                assert_eq!(
+                    exact, None,
+                    "vf {vf} {x0:?} -> {x1:?} delta {delta} until {hi}"
+                );
+            }
         }
+        assert!(between_count > total / 4, "{between_count} of {total}");
         // Random pairs in one cube are often far apart: most must be culled.
         assert!(apart_count > total / 4, "{apart_count} of {total}");
     }

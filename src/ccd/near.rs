@@ -15,12 +15,18 @@
 //!
 //! **Search.** First the start: within at t = 0 means a contact at 0. Then pieces of
 //! `[0, t_max]` are visited earliest first (depth-first bisection), skipped when apart and
-//! split otherwise, down to width `2^-46`. At the first leaf `[lo, hi]` that is not apart,
-//! every time before `lo` is apart; if the distance is within `delta` at one of the points
-//! `lo + k 2^-44`, `k = 1..16`, the earliest contact lies in `[lo, lo + 2^-40]` and `lo` is
-//! returned (at most `2^-40` early, the exact path's tolerance). Otherwise (the distance
-//! touches `delta` without crossing it, or crosses it too slowly against `L` for floats to
-//! place within `2^-40`), the query is left to the exact path.
+//! split otherwise, down to width `2^-46`. Each piece is first tested the cheap way: the
+//! features' closest direction at the piece's end, in plain floats, is used as a fixed
+//! separating axis over the piece (`axis.rs`: the gap along a fixed axis is concave in t,
+//! so its values at the two ends bound it, with no margin for the motion); and a piece
+//! whose end is nearer than `delta` by that float estimate holds the contact, so it is split
+//! without trying the certificates that could not succeed. The Lipschitz tests above come
+//! next. At the first leaf `[lo, hi]` that is not apart, every time before `lo` is apart; if
+//! the distance is within `delta` at one of the points `lo + k 2^-44`, `k = 1..16`, the
+//! earliest contact lies in `[lo, lo + 2^-40]` and `lo` is returned (at most `2^-40` early,
+//! the exact path's tolerance). Otherwise (the distance touches `delta` without crossing it,
+//! or crosses it too slowly for floats to place within `2^-40`), the query is left to the
+//! exact path.
 //!
 //! Every test compares squared distances times a positive squared length with `delta^2`, so no
 //! division or square root is needed, and uses only these facts:
@@ -43,6 +49,7 @@
 //! A foot or a line is only used where its squared length factor is certainly `> 0`
 //! (degenerate triangles and zero-length edges fall back to their corners).
 
+use super::axis;
 use super::filter::{moving, Verdict};
 use super::interval::Iv;
 use super::pieces::{earliest_first, Piece};
@@ -91,7 +98,28 @@ pub(crate) fn decide(
         return Verdict::Hit(0.0);
     }
     let speed = max_relative_speed(vf, x0, x1);
+    let magnitude = x0
+        .iter()
+        .chain(x1)
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
     earliest_first(t_max, MAX_PIECES, |lo, hi, last| {
+        // The features' closest direction at the piece's end, in plain floats: the
+        // separating axis of a piece before the contact; and, with the features nearer
+        // than delta there, the sign that this piece holds the contact, so the certificates
+        // below, which could not succeed, are skipped.
+        let (start, end) = (
+            axis::positions_at(x0, x1, lo),
+            axis::positions_at(x0, x1, hi),
+        );
+        let c = closest_direction(vf, &end);
+        let splittable = hi - lo > LEAF_WIDTH && !last;
+        if splittable && ring_len2(&c) < delta * delta {
+            return Piece::Split;
+        }
+        if axis::apart_between(vf, (&start, &end), &c, delta, magnitude) {
+            return Piece::Apart;
+        }
         let mid = 0.5 * (lo + hi);
         // The largest distance from mid to an end, rounded up, times the speed.
         let reach = (mid - lo).max(hi - mid).next_up();
@@ -104,7 +132,7 @@ pub(crate) fn decide(
         if apart(vf, &moving(x0, x1, Iv { lo, hi }), delta) {
             return Piece::Apart;
         }
-        if hi - lo > LEAF_WIDTH && !last {
+        if splittable {
             return Piece::Split;
         }
         // Everything before lo is apart: within at a probe puts the contact in
@@ -121,6 +149,104 @@ pub(crate) fn decide(
             },
         )
     })
+}
+
+type P3 = [f64; 3];
+
+fn sub(a: &P3, b: &P3) -> P3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: &P3, b: &P3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn ring_len2(a: &P3) -> f64 {
+    dot(a, a)
+}
+
+fn cross(a: &P3, b: &P3) -> P3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// `a + s (b - a)`.
+fn lerp(a: &P3, b: &P3, s: f64) -> P3 {
+    [
+        a[0] + s * (b[0] - a[0]),
+        a[1] + s * (b[1] - a[1]),
+        a[2] + s * (b[2] - a[2]),
+    ]
+}
+
+/// The point of segment `[a, b]` nearest `p`, approximately (plain floats).
+fn nearest_on_segment(p: &P3, a: &P3, b: &P3) -> P3 {
+    let e = sub(b, a);
+    let len2 = dot(&e, &e);
+    let s = if len2 > 0.0 {
+        (dot(&sub(p, a), &e) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    lerp(a, b, s)
+}
+
+/// From the first feature's nearest point to the second's, approximately (plain floats, no
+/// guarantee: any direction is a valid separating axis, and the distance it gives only
+/// steers the search). `x`: the vertex and the triangle's corners, or two edges' ends.
+fn closest_direction(vf: bool, x: &[P3; 4]) -> P3 {
+    let nearest = |candidates: &[(P3, P3)]| -> P3 {
+        candidates
+            .iter()
+            .map(|(a, b)| sub(b, a))
+            .min_by(|u, v| dot(u, u).total_cmp(&dot(v, v)))
+            .unwrap_or([0.0; 3])
+    };
+    if vf {
+        let [p, a, b, c] = x;
+        let n = cross(&sub(b, a), &sub(c, a));
+        let n2 = dot(&n, &n);
+        if n2 > 0.0 {
+            let foot = lerp(
+                p,
+                &[p[0] + n[0], p[1] + n[1], p[2] + n[2]],
+                dot(&sub(a, p), &n) / n2,
+            );
+            let inside = [(a, b), (b, c), (c, a)]
+                .iter()
+                .all(|(u, v)| dot(&cross(&sub(v, u), &sub(&foot, u)), &n) >= 0.0);
+            if inside {
+                return sub(&foot, p);
+            }
+        }
+        nearest(&[
+            (*p, nearest_on_segment(p, a, b)),
+            (*p, nearest_on_segment(p, b, c)),
+            (*p, nearest_on_segment(p, c, a)),
+        ])
+    } else {
+        let [a0, a1, b0, b1] = x;
+        let (u, v, r) = (sub(a1, a0), sub(b1, b0), sub(b0, a0));
+        let w = cross(&u, &v);
+        let w2 = dot(&w, &w);
+        if w2 > 0.0 {
+            // The lines' closest points, when both lie on the segments.
+            let s = dot(&cross(&r, &v), &w) / w2;
+            let t = dot(&cross(&r, &u), &w) / w2;
+            if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t) {
+                return sub(&lerp(b0, b1, t), &lerp(a0, a1, s));
+            }
+        }
+        nearest(&[
+            (*a0, nearest_on_segment(a0, b0, b1)),
+            (*a1, nearest_on_segment(a1, b0, b1)),
+            (nearest_on_segment(b0, a0, a1), *b0),
+            (nearest_on_segment(b1, a0, a1), *b1),
+        ])
+    }
 }
 
 /// How far after the first piece not apart (`lo`) the delta-0 filter's contact time may lie
