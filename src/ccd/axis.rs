@@ -10,7 +10,8 @@
 //! `delta |c|` (or both below `-delta |c|`, the other side) prove the features farther than
 //! `delta` apart at every time of the step: their distance is at least `|g(t)| / |c|`. No
 //! margin for the motion is needed; the test is exact for straight-line motion, up to the
-//! rounding bounded below. It holds for any `t_max <= 1`.
+//! rounding bounded below. The same holds between any two times of the step, from the poses
+//! at those times.
 //!
 //! **Axes**, in the order they pay on real meshes (a vertex against the triangles around its
 //! own, two edges of one neighbourhood): the line between the features' centroids at
@@ -141,8 +142,9 @@ fn normal_axis(vf: bool, x: &Points) -> [f64; 3] {
 }
 
 /// The pair (`vf`: a vertex and a triangle, else two edges, as the CCD queries lay out
-/// their points) certainly farther than `delta` apart at every time of `[0, 1]`, by
-/// separation along the axes of the module docs. `m` is the largest coordinate magnitude of
+/// their points) certainly farther than `delta` apart at every time between the poses `x0`
+/// and `x1` (given, or interpolated by [`positions_at`]), by separation along the axes of
+/// the module docs. `m` is the largest coordinate magnitude of
 /// the query; outside `[2^-400, 2^400]` nothing is certified.
 #[inline(always)]
 pub(crate) fn apart(vf: bool, x0: &Points, x1: &Points, delta: f64, m: f64) -> bool {

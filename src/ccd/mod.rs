@@ -339,9 +339,15 @@ fn query(
     {
         return Ok(None);
     }
-    // Separation along a few fixed axes at both ends of the step: ends most pairs of
+    // Separation along a few fixed axes at both ends of [0, t_max]: ends most pairs of
     // neighbouring features, which the boxes do not, for a few dot products.
-    if axis::apart(vf, x0, x1, delta, magnitude) {
+    let apart = if options.t_max < 1.0 {
+        let end = axis::positions_at(x0, x1, options.t_max);
+        axis::apart(vf, x0, &end, delta, magnitude)
+    } else {
+        axis::apart(vf, x0, x1, delta, magnitude)
+    };
+    if apart {
         return Ok(None);
     }
     // One power-of-two scaling (when it is exact) brings the largest coordinate near 1:
