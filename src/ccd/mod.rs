@@ -74,11 +74,12 @@
 //! of each member changes no sign variation) and all evaluation points are dyadic, so no
 //! rational arithmetic (and no gcd per operation) is needed.
 //!
-//! **Separation first** (`axis.rs`): the features' gap along a fixed axis is concave in t
-//! (its ends move linearly), so a gap above `delta` at t = 0 and at t = 1 holds all step.
-//! Tested in floats with a proven error bound along the centroids' line, the face normal or
-//! the edges' cross product, and the coordinate axes, it ends most pairs of neighbouring
-//! features of a mesh for a few dot products.
+//! **Separation first** (`axis.rs`), after the swept boxes of stage 0 below: the features'
+//! gap along a fixed axis is concave in t (their points move linearly), so a gap above
+//! `delta` at t = 0 and at t = `t_max` holds in between. Tested in floats with a proven
+//! error bound along the centroids' line, the face normal or the edges' cross product, and
+//! the coordinate axes, it ends most pairs of neighbouring features of a mesh for a few dot
+//! products.
 //!
 //! **Float filter next** (`filter.rs`): (0) swept boxes; (1) the Bernstein coefficients
 //! of `f` on `[0, 1]` from eight 3x3 determinants with a proven forward error bound
