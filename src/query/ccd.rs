@@ -34,7 +34,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{points_box_f64, Candidates, LeafEdges, LeafTriangles};
+use super::features::{points_box_f64, Candidates, FeatureBox, LeafEdges, LeafTriangles};
 use crate::bv::swept::{f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
@@ -261,6 +261,27 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
     bounds: K::Swept,
     tri_rows: [Vec<f32>; 6],
     edge_rows: [Vec<f32>; 6],
+    /// Per node (filled for leaves): the box of its triangles' corners and its own vertices,
+    /// at t0 and at t1.
+    leaf_ends: Vec<[FeatureBox; 2]>,
+}
+
+/// Two leaves' points certainly farther than `margin` apart all step: on some axis, one
+/// leaf's box lies beyond the other's by more than `margin` at t0 and at t1, on the same
+/// side. The gap along a fixed axis between two sets of linearly moving points is concave
+/// in t (a minimum of linear functions minus a maximum of them), so its ends bound it; the
+/// boxes are rounded outward and the margin's sum rounded up, so the test is certain. This
+/// ends the leaf pairs whose boxes over the step overlap only because both leaves move the
+/// same way (a sheet sliding in its plane, a body translating), before their feature pairs
+/// are enumerated.
+#[inline(always)]
+fn leaves_apart(a: &[FeatureBox; 2], b: &[FeatureBox; 2], margin: f32) -> bool {
+    let beyond =
+        |lo: &FeatureBox, hi: &FeatureBox, k: usize| (lo.1[k] + margin).next_up() < hi.0[k];
+    (0..3).any(|k| {
+        (beyond(&a[0], &b[0], k) && beyond(&a[1], &b[1], k))
+            || (beyond(&b[0], &a[0], k) && beyond(&b[1], &a[1], k))
+    })
 }
 
 /// `motion`'s positions (checked: the mesh's vertex count, finite, in range) in `tree`'s
@@ -318,12 +339,30 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
                 .map(|e| e.map(|v| v as usize)),
             &step,
         );
+        let triangles = tree.triangles();
+        let mut ends = Vec::with_capacity(tree.node_count());
+        for n in 0..tree.node_count() {
+            let mut end = [([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]); 2];
+            if tree.is_leaf(n) {
+                // Its triangles' corners and its own vertices (free points included).
+                let corners = triangles[tree.tri_range(n)].iter().flatten();
+                for v in corners.map(|&v| v as usize).chain(tree.vert_run(n)) {
+                    for (e, x) in end.iter_mut().zip([&step.x0[v], &step.x1[v]]) {
+                        let b = points_box_f64([*x]);
+                        e.0 = std::array::from_fn(|k| e.0[k].min(b.0[k]));
+                        e.1 = std::array::from_fn(|k| e.1[k].max(b.1[k]));
+                    }
+                }
+            }
+            ends.push(end);
+        }
         Self {
             h,
             bounds: K::swept(tree),
             step,
             tri_rows,
             edge_rows,
+            leaf_ends: ends,
         }
     }
 
@@ -768,6 +807,9 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
         out: &mut ImpactOut,
     ) {
         let (a, b, self_query) = (self.a, self.b, self.self_query);
+        if !(self_query && x == y) && leaves_apart(&a.leaf_ends[x], &b.leaf_ends[y], self.margin) {
+            return;
+        }
         let tv = |s: &Swept<'_, K>, v: usize| s.tree().vert_order()[v];
         let tt = |s: &Swept<'_, K>, t: usize| s.tree().tri_order()[t];
         let before = out.len();
@@ -911,5 +953,44 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                 );
             }
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn boxed(lo: [f32; 3], hi: [f32; 3]) -> FeatureBox {
+        (lo, hi)
+    }
+
+    /// Leaves apart on one axis at both ends, on the same side, are apart; leaves that swap
+    /// sides during the step (they pass each other), or whose gap is within the margin at
+    /// either end, are not.
+    #[test]
+    fn leaves_are_apart_only_on_one_side_at_both_ends() {
+        let unit = |x: f32| boxed([x, 0.0, 0.0], [x + 1.0, 1.0, 1.0]);
+        // Both translate by 10 along x, 2 apart: apart all step.
+        let a = [unit(0.0), unit(10.0)];
+        let b = [unit(3.0), unit(13.0)];
+        assert!(leaves_apart(&a, &b, 0.0));
+        assert!(leaves_apart(&b, &a, 0.0));
+        assert!(leaves_apart(&a, &b, 1.5));
+        // The gap (2) is not more than the margin.
+        assert!(!leaves_apart(&a, &b, 2.0));
+        // b passes a: right of it at t0, left of it at t1.
+        let passing = [unit(3.0), unit(5.0)];
+        assert!(!leaves_apart(&a, &passing, 0.0));
+        // Touching at t1 (closed boxes).
+        let touching = [unit(3.0), unit(11.0)];
+        assert!(!leaves_apart(&a, &touching, 0.0));
+        // Apart on y at both ends, overlapping on x.
+        let above = [
+            boxed([0.5, 2.0, 0.0], [1.0, 3.0, 1.0]),
+            boxed([10.5, 2.0, 0.0], [11.0, 3.0, 1.0]),
+        ];
+        assert!(leaves_apart(&a, &above, 0.5));
+        // An infinite margin culls nothing.
+        assert!(!leaves_apart(&a, &b, f32::INFINITY));
     }
 }
