@@ -7,9 +7,12 @@
 //! spheres), tested with SIMD kernels; two regions whose features touch during the step
 //! have bounds that meet during the step, so every colliding pair lies in a leaf pair the
 //! walk reaches. As for proximity, each vertex and each edge belongs to one leaf (so each
-//! feature pair is met in one leaf pair, however many triangles share it), and each leaf
-//! pair first culls its feature pairs by their own boxes over the step (in `f32`, rounded
-//! outward, grown by the minimum distance) before the exact test of [`crate::ccd`]:
+//! feature pair is met in one leaf pair, however many triangles share it). A leaf pair is
+//! skipped when on one axis a leaf lies beyond the other by more than the minimum distance
+//! at t0 and at t1 (the gap along a fixed axis is concave in t under linear motion: two
+//! leaves moving the same way, whose boxes over the step overlap, are apart all step). Each
+//! leaf pair then culls its feature pairs by their own boxes over the step (in `f32`,
+//! rounded outward, grown by the minimum distance) before the exact test of [`crate::ccd`]:
 //! whether the pair touches in `[0, t_max]` is exact for the `f64` input, and the time of
 //! impact is never later than the true one and at most [`crate::ccd::TOI_TOLERANCE`]
 //! earlier.
