@@ -1,4 +1,4 @@
-//! Separation along a fixed axis over the whole step, in floats with a proven error bound:
+//! Separation along a fixed axis over a time interval, in floats with a proven error bound:
 //! the cull that ends most pairs of neighbouring features before the filters that look for
 //! a contact time.
 //!
@@ -18,7 +18,7 @@
 //! `t = 0`, the face normal (vertex-face) or the cross product of the edges (edge-edge) at
 //! `t = 0`, the same two at `t = 1`, then the coordinate axes (the features' boxes at both
 //! ends, sharper than the boxes over the whole step of stage 0). On armadillo-rollers
-//! 326 -> 327 the first axis ends 84% of the 7.0 M candidate pairs, all five 96%.
+//! 326 -> 327 the first axis ends 84% of the 7.0 M candidate pairs, all seven 96%.
 //!
 //! **Rounding** (`u = 2^-53`, `M` the largest coordinate magnitude, `C = sum_k |c_k|`). The
 //! axis is whatever float vector was computed: any direction is a valid axis, so only the
@@ -29,10 +29,10 @@
 //! underflow; a gap is the difference of two projections, rounded once more (`u` of at most
 //! `2.01 M C`). So a computed gap is within `18.1 u M C + 2^-1070` of the exact one, below
 //! `E = 2^-48 M C + 2^-1000 = 32 u M C + 2^-1000` with room for the rounding of `C`
-//! itself, and a gap is certain when it exceeds `delta |c| + E` rounded up. `|c|` is bounded above from its rounded square (within
-//! `2^-51` of `|c|^2`, then a square root and a product each within `2^-53`). Axes with
-//! `C` outside `[2^-400, 2^400]`, and queries with `M` outside it, are not tested: there
-//! the bound's terms could under- or overflow.
+//! itself, and a gap is certain when it exceeds `delta |c| + E` rounded up. `|c|` is
+//! bounded above from its rounded square (within `2^-51` of `|c|^2`, then a square root and
+//! a product each within `2^-53`). Axes with `C` outside `[2^-400, 2^400]`, and queries
+//! with `M` outside it, are not tested: there the bound's terms could under- or overflow.
 
 /// `2^-48`: the relative part of a gap's error bound.
 const REL: f64 = 3.552_713_678_800_501e-15;
@@ -188,9 +188,10 @@ pub(crate) fn apart_between(
 #[cfg(test)]
 mod tests {
     //! Every pair the cull calls apart is apart for the exact path, over the whole step and
-    //! from a pose interpolated in floats, on motions built to touch (coordinates on a coarse grid, so contacts at exactly t = 0, t = 1 and in
-    //! between are frequent), at scales from 2^-390 to 2^390 and with minimum distances;
-    //! and the cull ends a fair share of them, so the check is not vacuous.
+    //! from a pose interpolated in floats, on motions built to touch (coordinates on a
+    //! coarse grid, so contacts at exactly t = 0, t = 1 and in between are frequent), at
+    //! scales from 2^-390 to 2^390 and with minimum distances; and the cull ends a fair
+    //! share of them, so the check is not vacuous.
     use super::super::exact::{solve, Kind};
     use super::super::testing::Rng;
     use super::*;

@@ -113,17 +113,19 @@
 //! segment, or the closest points of the two non-parallel lines inside both segments and
 //! within delta (polynomials of degree <= 6). This is **exact** too (delta is an f64, so
 //! `delta^2` is rational and scales with the coordinates). Its float filter (`near.rs`)
-//! comes first: swept boxes inflated by delta, then time pieces of `[0, t_max]` visited
-//! earliest first, each certified apart at its midpoint with a margin (the features' largest
-//! relative speed times the half width: the distance is Lipschitz in t), by the boxes, the
-//! plane or lines, or the feature's parts farther than delta, or within (a corner, a foot on an edge, the foot in the
-//! triangle, or the lines' closest points on both segments within delta) in interval
-//! arithmetic, and split where neither; the contact time is the start of the first piece
-//! not certified apart, within `2^-40`. Only pairs whose distance touches delta without
-//! crossing it, or crosses it too slowly for floats to place within `2^-40`, go to the
-//! exact path. On a folding 8 x 8 sheet with `delta = 0.004` (1,065 colliding pairs of
-//! 3,581 tested) none reaches it; on armadillo-rollers 326 -> 327 with `delta = 0.001`
-//! (68,387 colliding pairs of 7.5 M tested), 196 do.
+//! comes first: swept boxes inflated by delta and the fixed-axis separation, then time
+//! pieces of `[0, t_max]` visited earliest first. Each piece is tested along the features'
+//! closest direction at its end as a fixed axis (`axis.rs`), then certified apart at its
+//! midpoint with a margin (the features' largest relative speed times the half width: the
+//! distance is Lipschitz in t) by the boxes, the plane or lines, or the feature's parts
+//! farther than delta, or within (a corner, a foot on an edge, the foot in the triangle, or
+//! the lines' closest points on both segments within delta) in interval arithmetic, and
+//! split where neither; the contact time is the start of the first piece not certified
+//! apart, within `2^-40`. Only pairs whose distance touches delta without crossing it, or
+//! crosses it too slowly for floats to place within `2^-40`, go to the exact path. On a
+//! folding 8 x 8 sheet with `delta = 0.004` (1,065 colliding pairs of 3,581 tested) none
+//! reaches it; on armadillo-rollers 326 -> 327 with `delta = 0.001` (68,387 colliding
+//! pairs), 196 do.
 
 //! # Limits
 //!
