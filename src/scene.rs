@@ -1079,7 +1079,9 @@ fn step_size_of<K: BoundingVolume>(
     let first_work: Counters = impacts.iter().map(|i| i.counters).sum();
     let best = step::bound_at(keep_earliest(&mut impacts));
     let moving: Vec<Motion<'_>> = motions.iter().flatten().copied().collect();
-    let (query, gap) = step::query_for(options, &moving, step::by(&best));
+    // A still object's vertices have displacement zero: it counts in the relative motion.
+    let still = motions.iter().any(Option::is_none);
+    let (query, gap) = step::query_for(options, &moving, still, step::by(&best));
     let (jobs, broad_phase_tests) = jobs_of(objects, boxes(), f32_up(query.options.min_distance));
     sweep_jobs(objects, &steps, &jobs, &mut sweeps, parallel);
     let mut limiting = swept_walks(&sweeps, &jobs, parallel, |ws, a, b, self_job, par| {

@@ -199,6 +199,58 @@ fn a_folding_sheet_equals_the_brute_force() {
     }
 }
 
+/// The falling vertex stopping short of the triangle (z from 1 to 0.1: it never touches, but
+/// passes its gap 0.2 at t = 8/9) while the whole mesh drifts far: the drift dwarfs the
+/// pair's approach, so only the relative motion bounds which pairs the gap walk must test.
+/// Alone the mesh drifts as one; in a scene beside a still copy of the triangle, the still
+/// object's zero displacement makes the drift itself relative motion.
+#[test]
+fn a_drifting_mesh_stops_at_its_gap_alone_and_beside_a_still_object() {
+    let (m, x0, mut x1) = falling_vertex();
+    x1[3][2] = 0.1;
+    let want = 0.8 / 0.9;
+    let drift = [40.0, -25.0, 10.0];
+    let drifted: Vec<[f64; 3]> = x1
+        .iter()
+        .map(|p| [p[0] + drift[0], p[1] + drift[1], p[2] + drift[2]])
+        .collect();
+    let close = |step: f64, want: f64| step <= want && want - step <= 2.0 * TOI_TOLERANCE;
+    for_each_method!(K => {
+        let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
+        let s = collision_free_stepsize(&h, Motion::new(&x0, &drifted), &StepOptions::default())
+            .unwrap();
+        assert!(close(s.step, want), "{:?}: {}", K::METHOD, s.step);
+        assert_eq!(s.limiting.vertex_face.len(), 1);
+    });
+    // A still triangle under the drifting vertex's path: the vertex (alone in its object,
+    // with a far triangle) drifts across it from above, while staying above it.
+    let wall = Mesh::new_f64(
+        vec![
+            [-100.0, -100.0, 0.0],
+            [100.0, -100.0, 0.0],
+            [0.0, 100.0, 0.0],
+        ],
+        vec![[0, 1, 2]],
+    )
+    .unwrap();
+    let p0 = vec![[0.0, 0.0, 1.0], [5.0, 5.0, 5.0], [6.0, 5.0, 5.0]];
+    let p1: Vec<[f64; 3]> = p0
+        .iter()
+        .map(|p| [p[0] + 3.0, p[1] + 2.0, p[2] - 0.9])
+        .collect();
+    let falling = Mesh::new_f64(p0.clone(), vec![[0, 1, 2]]).unwrap();
+    for method in dhcd::Method::ALL {
+        let mut scene = Scene::new(method, Options::default());
+        let _still = scene.add(&wall).unwrap();
+        let moving = scene.add(&falling).unwrap();
+        let motions = [(moving, Motion::new(&p0, &p1))];
+        let s = scene
+            .collision_free_stepsize(&motions, &StepOptions::default(), Par::Seq)
+            .unwrap();
+        assert!(close(s.step, want), "{method:?}: {}", s.step);
+    }
+}
+
 #[test]
 fn bad_options_are_typed_errors() {
     let (m, x0, x1) = falling_vertex();

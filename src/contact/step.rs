@@ -22,9 +22,14 @@
 //! by it (the distance at t0 against the most the features can approach by then, decided
 //! exactly). Any pair that reaches its `g` closes by `rescaling (d0 -
 //! min_distance)` within the step, which it cannot do unless `d0 - min_distance <= M /
-//! rescaling`, `M` twice the largest vertex displacement by the first impact `T` (`T` times
-//! that of the step); so every such pair comes within `min_distance + (1 - rescaling) M /
-//! rescaling` of the other, and the walk culls at that distance.
+//! rescaling`, `M` the most two vertices can approach each other by the first impact `T`;
+//! so every such pair comes within `min_distance + (1 - rescaling) M / rescaling` of the
+//! other, and the walk culls at that distance. `M` is `T` times the diameter of the set of
+//! vertex displacements (with the zero displacement of still objects): two points of two
+//! features move relative to each other by a difference of two convex combinations of
+//! displacements, at most that diameter. A mesh translating as a whole has `M = 0` and
+//! culls at `min_distance`. The diameter is bounded by the smaller of twice the largest
+//! displacement and the diagonal of the displacements' bounding box.
 
 use std::sync::atomic::AtomicU64;
 
@@ -87,19 +92,13 @@ pub struct StepSize {
     pub limiting: Impacts,
 }
 
-/// The rule's culling distance for the motions `steps` (see the [module](self)).
-fn cull_distance(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> f64 {
-    let mut largest = 0.0f64;
-    for m in steps {
-        for (p, q) in m.x0.iter().zip(m.x1) {
-            let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
-            largest = largest.max(d);
-        }
-    }
+/// The rule's culling distance for the motions `steps` (see the [module](self)); `still`:
+/// some object that can pair with them does not move (its displacement, zero, counts).
+fn cull_distance(options: &StepOptions, steps: &[Motion<'_>], still: bool, by: f64) -> f64 {
     let s = options.rescaling;
     // Rounded up: a few ulps of slack on every operation above.
     // Pairs need only reach their gap by time `by`: vertices move `by` of their step.
-    let d = options.min_distance + (1.0 - s) / s * 2.0 * largest * by;
+    let d = options.min_distance + (1.0 - s) / s * approach_bound(steps, still) * by;
     let d = d * (1.0 + 16.0 * f64::EPSILON);
     if d.is_finite() {
         d
@@ -108,13 +107,50 @@ fn cull_distance(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> f64 {
     }
 }
 
+/// An upper bound on `|u_i - u_j|` over every two vertices of `steps` (and the zero
+/// displacement when `still`), `u = x1 - x0` exactly: the smaller of twice the largest `|u|`
+/// and the diagonal of the box of the `u`, each rounded up.
+fn approach_bound(steps: &[Motion<'_>], still: bool) -> f64 {
+    let (mut lo, mut hi) = if still {
+        ([0.0f64; 3], [0.0f64; 3])
+    } else {
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3])
+    };
+    let mut largest = 0.0f64;
+    for m in steps {
+        for (p, q) in m.x0.iter().zip(m.x1) {
+            let u = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+            largest = largest.max((u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt());
+            for k in 0..3 {
+                lo[k] = lo[k].min(u[k]);
+                hi[k] = hi[k].max(u[k]);
+            }
+        }
+    }
+    if largest == 0.0 {
+        // No vertex moves (or none at all): nothing approaches.
+        return 0.0;
+    }
+    // Each computed `u` is within half an ulp of the exact one per coordinate (at most
+    // `EPSILON * largest`); the box's extents grow by twice that, the norm by its rounding.
+    let slack = 4.0 * f64::EPSILON * largest;
+    let extent = |k: usize| (hi[k] - lo[k]).max(0.0) + slack;
+    let diagonal = (extent(0).powi(2) + extent(1).powi(2) + extent(2).powi(2)).sqrt();
+    (2.0 * largest).min(diagonal) * (1.0 + 16.0 * f64::EPSILON)
+}
+
 /// The gap walk's query (earliest mode, culling at [`cull_distance`] for pairs that must
-/// reach their gap by `by`) and the rule.
-pub(crate) fn query_for(options: &StepOptions, steps: &[Motion<'_>], by: f64) -> (CcdQuery, Gap) {
+/// reach their gap by `by`) and the rule; `still` as for [`cull_distance`].
+pub(crate) fn query_for(
+    options: &StepOptions,
+    steps: &[Motion<'_>],
+    still: bool,
+    by: f64,
+) -> (CcdQuery, Gap) {
     let query = CcdQuery {
         options: CcdOptions {
             t_max: 1.0,
-            min_distance: cull_distance(options, steps, by),
+            min_distance: cull_distance(options, steps, still, by),
         },
         mode: CcdMode::Earliest,
     };
@@ -140,7 +176,7 @@ fn step_between<K: BoundingVolume>(
     let control = ws.control.clone();
     let budget = Budget::new(&control);
     let (best, first_work) = first_impact(a, b, self_query, options, &budget, ws, par)?;
-    let (query, gap) = query_for(options, motions, by(&best));
+    let (query, gap) = query_for(options, motions, false, by(&best));
     let (mut limiting, _) = run(
         a,
         b,
@@ -254,4 +290,75 @@ pub fn collision_free_stepsize_pair<K: BoundingVolume>(
     let sa = Swept::new(a, a_motion)?;
     let sb = Swept::new(b, b_motion)?;
     step_between(&sa, &sb, false, &[a_motion, b_motion], options, ws, par)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The largest `|u_i - u_j|` over every two displacements (and zero when `still`).
+    fn brute_force(steps: &[Motion<'_>], still: bool) -> f64 {
+        let mut u: Vec<[f64; 3]> = steps
+            .iter()
+            .flat_map(|m| m.x0.iter().zip(m.x1))
+            .map(|(p, q)| [q[0] - p[0], q[1] - p[1], q[2] - p[2]])
+            .collect();
+        if still {
+            u.push([0.0; 3]);
+        }
+        let mut most = 0.0f64;
+        for a in &u {
+            for b in &u {
+                let d = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
+                most = most.max(d);
+            }
+        }
+        most
+    }
+
+    #[test]
+    fn a_translation_approaches_nothing_unless_something_stays_still() {
+        let x0: Vec<[f64; 3]> = (0..50)
+            .map(|i| [0.1 * i as f64, (0.37 * i as f64).sin(), 1e3])
+            .collect();
+        let x1: Vec<[f64; 3]> = x0.iter().map(|p| [p[0] + 0.5, p[1] - 0.25, p[2]]).collect();
+        let m = [Motion::new(&x0, &x1)];
+        let alone = approach_bound(&m, false);
+        assert!((0.0..1e-12).contains(&alone), "{alone}");
+        let beside_a_wall = approach_bound(&m, true);
+        assert!(
+            beside_a_wall >= (0.5f64 * 0.5 + 0.25 * 0.25).sqrt(),
+            "{beside_a_wall}"
+        );
+        assert_eq!(approach_bound(&[Motion::new(&x0, &x0)], true), 0.0);
+    }
+
+    #[test]
+    fn the_bound_is_never_below_the_largest_relative_displacement() {
+        let mut state = 7u64;
+        let mut draw = || crate::shapes::splitmix64(&mut state) as f64 / u64::MAX as f64 - 0.5;
+        for case in 0..200 {
+            let n = 1 + case % 9;
+            let scale = [1e-9, 1.0, 1e6][case % 3];
+            let x0: Vec<[f64; 3]> = (0..n).map(|_| [draw(), draw(), draw()]).collect();
+            let x1: Vec<[f64; 3]> = x0
+                .iter()
+                .map(|p| [p[0] + scale * draw(), p[1] + scale * draw(), p[2]])
+                .collect();
+            let y0: Vec<[f64; 3]> = (0..n).map(|_| [draw(), draw(), draw()]).collect();
+            let y1: Vec<[f64; 3]> = y0.iter().map(|p| [p[0] + 3.0, p[1], p[2]]).collect();
+            let steps = [Motion::new(&x0, &x1), Motion::new(&y0, &y1)];
+            for still in [false, true] {
+                for k in [1, 2] {
+                    let exact = brute_force(&steps[..k], still);
+                    let bound = approach_bound(&steps[..k], still);
+                    assert!(bound >= exact, "case {case}: {bound} < {exact}");
+                    assert!(
+                        bound <= 2.0 * exact + 1e-9 * scale,
+                        "case {case}: {bound} loose"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -1,0 +1,300 @@
+"""The cases of the issue "At the floor" in one run, dhcd beside the IPC Toolkit 1.6.1, one
+thread each, f64, least of --repeat calls, dhat = --relative x the bounding-box diagonal:
+
+- the real frame steps of ../shared/data/real-frames (frame N -> N+1), when it is there;
+- three 40 x 40 sheets (3,200 triangles, the cases of benches/contact.rs): a wavy sheet
+  moving a small step, the same sheet folded over itself with its layers closing in, and a
+  flat sheet sliding in its own plane;
+- the degenerate motions of ../shared/data/degenerate/sheets.py at --n (slide, fold,
+  collapse, line, slide2), each beside the "wavy slide": the slide with every vertex lifted
+  off the plane by a fixed wave, a non-degenerate step of the same mesh.
+
+Columns, dhcd against ipctk:
+- proximity: `self_proximity(h, dhat)` and `self_contact_set(h, dhat)` against
+  `NormalCollisions.build(mesh, x0, dhat)` (LBVH);
+- CCD: `ccd(h, x0, x1, earliest=True)` (the earliest impact), `collision_free_stepsize(h, x0,
+  x1)` and `ccd(h, x0, x1)` (every colliding pair with its time) against
+  `compute_collision_free_stepsize(mesh, x0, x1)` (LBVH + Tight Inclusion).
+Each call runs in a child process stopped after --timeout seconds (ipctk's narrow phase
+takes minutes on some degenerate motions); such a cell reads "> T s".
+
+usage: python benches/scripts/floor-vs-ipctk.py [--repeat 3] [--n 64] [--timeout 120]
+           [--relative 1e-3] [--no-real] [--write docs/PERFORMANCE.md]
+--write replaces the text between the markers `<!-- floor-vs-ipctk: begin -->` and
+`<!-- floor-vs-ipctk: end -->` of that file with the tables (and the date, commit, load and
+command); without it the tables are printed. Needs a venv with dhcd, numpy and ipctk==1.6.1
+(bash ../shared/peers/ipctk/setup.sh target/ipctk-venv, then pip install the dhcd wheel
+into it).
+"""
+import argparse
+import datetime
+import glob
+import importlib.util
+import multiprocessing
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+
+import dhcd
+import ipctk
+from timing import least
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--repeat", type=int, default=3)
+ap.add_argument("--n", type=int, default=64)
+ap.add_argument("--timeout", type=float, default=120.0)
+ap.add_argument("--relative", type=float, default=1e-3)
+ap.add_argument("--no-real", action="store_true")
+ap.add_argument("--write")
+a = ap.parse_args()
+if a.repeat < 1 or a.n < 2 or a.timeout <= 0:
+    sys.exit("--repeat >= 1, --n >= 2 and --timeout > 0")
+
+here = os.path.dirname(os.path.abspath(__file__))
+shared = os.path.join(here, "../../../shared")
+ipctk.set_num_threads(1)
+ipctk.set_logger_level(ipctk.LoggerLevel.off)
+MASK = (1 << 64) - 1
+
+
+# --- the 40 x 40 sheets of benches/contact.rs (dhcd::shapes in float32) --------------------
+
+
+def grid(nx, ny, cell):
+    j, i = np.meshgrid(np.arange(ny + 1), np.arange(nx + 1), indexing="ij")
+    x = np.stack([i.ravel() * cell, j.ravel() * cell, np.zeros(i.size)], 1).astype(np.float32)
+    at = lambda i, j: j * (nx + 1) + i
+    f = []
+    for jj in range(ny):
+        for ii in range(nx):
+            f.append([at(ii, jj), at(ii + 1, jj), at(ii + 1, jj + 1)])
+            f.append([at(ii, jj), at(ii + 1, jj + 1), at(ii, jj + 1)])
+    return x, np.array(f, dtype=np.uint32)
+
+
+def wave(rest, t, amplitude):
+    p = rest.astype(np.float32)
+    t, amplitude = np.float32(t), np.float32(amplitude)
+    s = np.sin(p[:, 0] * np.float32(3.1) + t) * np.cos(p[:, 1] * np.float32(2.3) - np.float32(0.7) * t)
+    r = np.sin(p[:, 2] * np.float32(2.7) + np.float32(1.3) * t)
+    return np.stack(
+        [p[:, 0] + amplitude * s, p[:, 1] + amplitude * r * np.float32(0.5), p[:, 2] + amplitude * s * r], 1
+    )
+
+
+def splitmix64(state):
+    state = (state + 0x9E3779B97F4A7C15) & MASK
+    z = state
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & MASK
+    return state, z ^ (z >> 31)
+
+
+def jitter(p, amplitude, seed):
+    out = p.astype(np.float32).copy()
+    for i in range(len(p)):
+        state = seed ^ ((i * 0xD1B54A32D192ED03) & MASK)
+        for k in range(3):
+            state, z = splitmix64(state)
+            u = np.float32(z >> 40) / np.float32(1 << 23) - np.float32(1.0)
+            out[i, k] = out[i, k] + np.float32(amplitude) * u
+    return out
+
+
+def sheets():
+    rest, faces = grid(40, 40, np.float32(1.0 / 40.0))
+
+    def folded(h):
+        p = rest.copy()
+        beyond = rest[:, 0] > np.float32(0.5)
+        p[beyond, 0] = np.float32(1.0) - rest[beyond, 0]
+        p[beyond, 2] += np.float32(h)
+        return jitter(p, 0.0005, 3)
+
+    slid = rest.astype(np.float64) + [0.01, 0.005, 0.0]
+    return [
+        ("wavy 40 x 40 sheet, small step", wave(rest, 0.0, 0.02), wave(rest, 0.05, 0.02), faces),
+        ("the same sheet folded, layers closing in", folded(0.03), folded(0.0), faces),
+        ("flat 40 x 40 sheet sliding in its plane", rest, slid, faces),
+    ]
+
+
+# --- the degenerate motions ------------------------------------------------------------------
+
+
+def degenerate(n):
+    spec = importlib.util.spec_from_file_location(
+        "sheets", os.path.join(shared, "data/degenerate/sheets.py")
+    )
+    if spec is None or not os.path.exists(spec.origin):
+        print(f"degenerate motions SKIPPED: no {spec.origin}", file=sys.stderr)
+        return []
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = []
+    for kind in ["wavy slide", "slide", "fold", "collapse", "line", "slide2"]:
+        x0, x1, faces = mod.make("slide" if kind == "wavy slide" else kind, n)
+        if kind == "wavy slide":
+            lift = 0.02 * np.sin(7.1 * x0[:, 0] + 3.3) * np.cos(5.3 * x0[:, 1] + 1.1)
+            x0, x1 = x0.copy(), x1.copy()
+            x0[:, 2] += lift
+            x1[:, 2] += lift
+        out.append((f"{kind}, N = {n}", x0, x1, faces))
+    return out
+
+
+def real_frames():
+    root = os.path.join(shared, "data/real-frames")
+    if not os.path.isdir(root):
+        print(f"real frames SKIPPED: no folder {root}", file=sys.stderr)
+        return []
+    out = []
+    for path in sorted(glob.glob(os.path.join(root, "*.ply"))):
+        name, frame = re.match(r"(.*)-(\d+)\.ply$", os.path.basename(path)).groups()
+        nxt = os.path.join(root, f"{name}-{int(frame) + 1}.ply")
+        if os.path.exists(nxt):
+            x0, faces = dhcd.load_mesh(path, precision="f64")
+            x1, _ = dhcd.load_mesh(nxt, precision="f64")
+            out.append((f"{name} {frame} -> {int(frame) + 1}", x0, x1, faces))
+    return out
+
+
+# --- timing ----------------------------------------------------------------------------------
+
+
+def in_child(f, timeout):
+    """(least time of --repeat calls of f, f's last result) from a forked child, or None when
+    it did not finish within `timeout` seconds."""
+
+    def child(conn):
+        conn.send(least(f, a.repeat))
+
+    parent, child_end = multiprocessing.Pipe()
+    p = multiprocessing.get_context("fork").Process(target=child, args=(child_end,))
+    p.start()
+    out = parent.recv() if parent.poll(timeout) else None
+    p.terminate()
+    p.join()
+    return out
+
+
+def ms(t):
+    return f"{t * 1e3:.3g} ms" if t < 1 else f"{t:.3g} s"
+
+
+def cell(ours, theirs):
+    """"dhcd / ipctk | ratio" with ratio = ipctk time / dhcd time (> 1: dhcd faster)."""
+    o = ms(ours[0]) if ours else f"> {a.timeout:.0f} s"
+    t = ms(theirs[0]) if theirs else f"> {a.timeout:.0f} s"
+    if ours and theirs:
+        r = f"{theirs[0] / ours[0]:.2f}x"
+    elif ours:
+        r = f"> {a.timeout / ours[0]:.0f}x"
+    elif theirs:
+        r = f"< {theirs[0] / a.timeout:.2g}x"
+    else:
+        r = "?"
+    return f"{o} | {t} | {r}"
+
+
+def measure(name, x0, x1, faces):
+    x0 = np.ascontiguousarray(x0, dtype=np.float64)
+    x1 = np.ascontiguousarray(x1, dtype=np.float64)
+    faces = np.ascontiguousarray(faces, dtype=np.uint32)
+    h = dhcd.Hierarchy(x0, faces)
+    dhat = a.relative * float(np.linalg.norm(x0.max(0) - x0.min(0)))
+    mesh = ipctk.CollisionMesh(
+        np.asfortranarray(x0),
+        np.asfortranarray(h.edges().astype(np.int32)),
+        np.asfortranarray(faces.astype(np.int32)),
+    )
+
+    def build():
+        c = ipctk.NormalCollisions()
+        c.build(mesh, x0, dhat, broad_phase=ipctk.LBVH())
+        return len(c)
+
+    t = a.timeout
+    r = {
+        "prox": in_child(lambda: len(dhcd.self_proximity(h, dhat)), t),
+        "set": in_child(lambda: len(dhcd.self_contact_set(h, dhat)), t),
+        "build": in_child(build, t),
+        "earliest": in_child(lambda: dhcd.ccd(h, x0, x1, earliest=True).toi, t),
+        "step": in_child(lambda: dhcd.collision_free_stepsize(h, x0, x1), t),
+        "all": in_child(lambda: len(dhcd.ccd(h, x0, x1)), t),
+        "ipc": in_child(lambda: ipctk.compute_collision_free_stepsize(mesh, x0, x1), t),
+    }
+    print(f"{name}: " + ", ".join(f"{k} {v[0]:.4g} s" if v else f"{k} timeout" for k, v in r.items()),
+          file=sys.stderr, flush=True)
+    return name, len(faces), dhat, r
+
+
+def tables(rows):
+    out = [
+        "| case | triangles | dhat | contacts (ipctk) | dhcd proximity | ipctk build | ratio | "
+        "dhcd contact set | ipctk build | ratio |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for name, tris, dhat, r in rows:
+        contacts = f"{r['build'][1]:,}" if r["build"] else "?"
+        out.append(
+            f"| {name} | {tris:,} | {dhat:.3g} | {contacts} | {cell(r['prox'], r['build'])} | "
+            f"{cell(r['set'], r['build'])} |"
+        )
+    out += [
+        "",
+        "| case | colliding pairs | earliest impact | dhcd earliest | ipctk step size | ratio | "
+        "dhcd step size | ipctk | ratio | dhcd all pairs | ipctk earliest | ratio |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for name, tris, dhat, r in rows:
+        colliding = f"{r['all'][1]:,}" if r["all"] else "?"
+        toi = r["earliest"][1] if r["earliest"] else None
+        toi = "?" if toi is None else ("none" if np.isinf(toi) else f"{toi:.6g}")
+        out.append(
+            f"| {name} | {colliding} | {toi} | {cell(r['earliest'], r['ipc'])} | "
+            f"{cell(r['step'], r['ipc'])} | {cell(r['all'], r['ipc'])} |"
+        )
+    wavy = next((r for name, _, _, r in rows if name.startswith("wavy slide")), None)
+    if wavy:
+        out += [
+            "",
+            "Degenerate motions against the wavy slide of the same mesh (dhcd time / wavy "
+            "slide's; the target is at most 3x where the output is small):",
+            "",
+            "| motion | proximity | earliest impact | step size | all pairs |",
+            "|---|---:|---:|---:|---:|",
+        ]
+        for name, _, _, r in rows:
+            if not re.match(r"(slide|fold|collapse|line|slide2), N", name):
+                continue
+            f = lambda k: f"{r[k][0] / wavy[k][0]:.2f}x" if r[k] and wavy[k] else "?"
+            out.append(f"| {name} | {f('prox')} | {f('earliest')} | {f('step')} | {f('all')} |")
+    return out
+
+
+rows = [measure(*c) for c in (([] if a.no_real else real_frames()) + sheets() + degenerate(a.n))]
+commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                        cwd=here).stdout.strip()
+load = open("/proc/loadavg").read().split()[:3]
+header = (
+    f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, commit {commit}, load "
+    f"{' '.join(load)}, `python benches/scripts/floor-vs-ipctk.py --repeat {a.repeat} --n {a.n} "
+    f"--timeout {a.timeout:g}`; one thread, f64, least of {a.repeat}, dhat = {a.relative:g} x "
+    "diagonal; ratio = ipctk time / dhcd time:"
+)
+text = [header, ""] + tables(rows)
+if a.write:
+    begin, end = "<!-- floor-vs-ipctk: begin -->", "<!-- floor-vs-ipctk: end -->"
+    doc = open(a.write).read()
+    if begin not in doc or end not in doc:
+        sys.exit(f"{a.write} has no markers {begin} ... {end}")
+    head, rest = doc.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    open(a.write, "w").write(head + begin + "\n" + "\n".join(text) + "\n" + end + tail)
+    print(f"wrote {a.write}")
+else:
+    print("\n".join(text))
