@@ -433,11 +433,12 @@ impl Gap {
     /// exact closest features' `f64` distance, rounded up a few ulps so that the kept gap is
     /// never below the rule's).
     ///
-    /// `None` when the pair cannot reach its gap before `o.t_max`: its distance at t0 exceeds
-    /// the gap plus the most its features can approach each other by then (`t_max` times the
-    /// largest displacement of a vertex of each feature, summed: a point of a feature is a
-    /// fixed convex combination of its vertices, so it moves no farther than they do),
-    /// decided exactly.
+    /// `None` when the pair cannot reach its gap before `o.t_max`. By then its features
+    /// approach each other by at most `A = t_max` times the largest relative displacement of
+    /// a vertex of one and a vertex of the other (a point of a feature is a fixed convex
+    /// combination of its vertices), so reaching the gap `g = dmin + (1 - s)(d0 - dmin)`
+    /// needs `d0 <= g + A`, that is `d0 <= dmin + A / s`: decided exactly on the positions
+    /// at t0 before any distance is computed (most pairs are culled by their boxes there).
     #[inline]
     pub(crate) fn options(
         &self,
@@ -448,30 +449,24 @@ impl Gap {
     ) -> Option<CcdOptions> {
         use crate::distance::{edge_edge_distance_sq, edge_edge_within};
         use crate::distance::{point_triangle_distance_sq, point_triangle_within};
-        let d0_sq = if vertex_face {
-            point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
-        } else {
-            edge_edge_distance_sq(x0[0], x0[1], x0[2], x0[3]).0
-        };
-        let d0 = d0_sq.sqrt();
-        let g = self.min_distance + (1.0 - self.rescaling) * (d0 - self.min_distance);
-        let g = (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0);
-        let g = if g.is_finite() { g } else { f64::MAX };
-        let moved = |k: usize| {
-            let d = [0, 1, 2].map(|c| x1[k][c] - x0[k][c]);
-            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
-        };
-        let (first, second) = if vertex_face {
-            (0..1, 1..4)
-        } else {
-            (0..2, 2..4)
-        };
+        let u: [[f64; 3]; 4] = std::array::from_fn(|k| [0, 1, 2].map(|c| x1[k][c] - x0[k][c]));
+        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let split = if vertex_face { 1 } else { 2 };
+        // The largest |u_i - u_j| over a vertex i of the first feature and j of the second,
+        // plus the rounding of the computed displacements and differences (a few ulps of
+        // |u_i| + |u_j|).
+        let mut relative = 0.0f64;
+        for i in 0..split {
+            for j in split..4 {
+                let d = [0, 1, 2].map(|c| u[i][c] - u[j][c]);
+                let slack = 4.0 * f64::EPSILON * (norm(u[i]) + norm(u[j]));
+                relative = relative.max(norm(d) + slack);
+            }
+        }
         // Within [0, t_max] (in earliest mode the best time so far) a vertex moves `t_max`
-        // of its displacement.
-        let moves = first.map(moved).fold(0.0, f64::max) + second.map(moved).fold(0.0, f64::max);
-        let approach = moves * o.t_max;
-        // Rounded up (each operation above is within a few ulps).
-        let reach = (g + approach) * (1.0 + 16.0 * f64::EPSILON);
+        // of its displacement. Rounded up (each operation above is within a few ulps).
+        let reach =
+            (self.min_distance + relative * o.t_max / self.rescaling) * (1.0 + 16.0 * f64::EPSILON);
         if reach.is_finite() {
             let near = if vertex_face {
                 point_triangle_within(x0[0], [x0[1], x0[2], x0[3]], reach).is_some()
@@ -482,6 +477,15 @@ impl Gap {
                 return None;
             }
         }
+        let d0_sq = if vertex_face {
+            point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
+        } else {
+            edge_edge_distance_sq(x0[0], x0[1], x0[2], x0[3]).0
+        };
+        let d0 = d0_sq.sqrt();
+        let g = self.min_distance + (1.0 - self.rescaling) * (d0 - self.min_distance);
+        let g = (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0);
+        let g = if g.is_finite() { g } else { f64::MAX };
         Some(CcdOptions {
             min_distance: g,
             ..o
