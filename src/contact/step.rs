@@ -30,6 +30,13 @@
 //! displacements, at most that diameter. A mesh translating as a whole has `M = 0` and
 //! culls at `min_distance`. The diameter is bounded by the smaller of twice the largest
 //! displacement and the diagonal of the displacements' bounding box.
+//!
+//! The gap walk's bounds and boxes are fitted over `[0, T]` only (plus the walk's pruning
+//! slack), not the whole step ([`Swept::until`]): with `T` small, as when a contact is
+//! already close, far fewer leaf and feature pairs meet. Each pair found is then tested on
+//! its exact motion, as every other. Per pair, [`Gap`] culls before computing any distance:
+//! a pair reaches its gap only if `d0 <= min_distance + A / rescaling`, `A` the largest
+//! relative displacement of a vertex of one feature and one of the other by `T`.
 
 use std::sync::atomic::AtomicU64;
 
@@ -40,7 +47,7 @@ use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
-use crate::query::ccd::{earliest_bound, run, Gap, Swept};
+use crate::query::ccd::{earliest_bound, horizon_error, run, Gap, Swept};
 use crate::query::{CcdMode, CcdQuery, Impacts, Motion};
 use crate::walk::Workspace;
 
@@ -176,9 +183,17 @@ fn step_between<K: BoundingVolume>(
     let control = ws.control.clone();
     let budget = Budget::new(&control);
     let (best, first_work) = first_impact(a, b, self_query, options, &budget, ws, par)?;
-    let (query, gap) = query_for(options, motions, false, by(&best));
+    let by = by(&best);
+    let (mut query, gap) = query_for(options, motions, false, by);
+    // The gap walk's bounds over `[0, by]` only, its margin grown by their rounding.
+    let until_a = a.until(by);
+    let until_b = if self_query { None } else { Some(b.until(by)) };
+    let b = until_b.as_ref().unwrap_or(&until_a);
+    let error = horizon_error([a.step(), b.step()]);
+    let culled = (query.options.min_distance + 2.0 * error).next_up();
+    query.options.min_distance = if culled.is_finite() { culled } else { f64::MAX };
     let (mut limiting, _) = run(
-        a,
+        &until_a,
         b,
         self_query,
         &query,

@@ -260,13 +260,31 @@ pub fn self_ccd_with<K: BoundingVolume>(
 /// (internal order) and own edges (leaf-edge order), as six rows each.
 pub(crate) struct Swept<'h, K: BoundingVolume> {
     h: &'h Hierarchy<K>,
+    /// The exact tests' positions.
     step: Cow<'h, Step>,
+    /// The positions the bounds and boxes are fitted to, when not `step`'s: t0 and a time
+    /// `by < 1` of the step ([`Swept::until`]).
+    culling: Option<Step>,
     bounds: K::Swept,
     tri_rows: [Vec<f32>; 6],
     edge_rows: [Vec<f32>; 6],
     /// Per node (filled for leaves): the box of its triangles' corners and its own vertices,
     /// at t0 and at t1.
     leaf_ends: Vec<[FeatureBox; 2]>,
+}
+
+/// A bound on how far a position at a time `by` of `steps`, computed in `f64` as `x0 + by
+/// (x1 - x0)` ([`Swept::until`]), lies from the exact point: three roundings of values at
+/// most twice the largest coordinate `M` in size, at most `4 EPSILON M` per coordinate, so
+/// `8 EPSILON M` in norm (rounded up).
+pub(crate) fn horizon_error<'a>(steps: impl IntoIterator<Item = &'a Step>) -> f64 {
+    let mut largest = 0.0f64;
+    for s in steps {
+        for p in s.x0.iter().chain(&s.x1) {
+            largest = largest.max(p[0].abs()).max(p[1].abs()).max(p[2].abs());
+        }
+    }
+    (8.0 * f64::EPSILON * largest).next_up()
 }
 
 /// Two leaves' points certainly farther than `margin` apart all step: on some axis, one
@@ -330,17 +348,41 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
 
     /// `h` over `step` (its positions in `h`'s internal order, checked).
     pub(crate) fn of_step(h: &'h Hierarchy<K>, step: Cow<'h, Step>) -> Self {
+        Self::fitted(h, step, None)
+    }
+
+    /// The same hierarchy and step, its bounds and boxes fitted over `[0, by]` only, for a
+    /// walk whose pairs are tested up to `by` (the step size's gap walk, after the first
+    /// impact): far fewer pairs meet when `by` is small. The positions at `by` are computed
+    /// in `f64`, each coordinate within [`horizon_error`] of the exact point of its line,
+    /// and the ends of a linear motion bound it in between (boxes, leaf ends) or make it a
+    /// moving ball: so the bounds hold every pair that comes within a margin by `by` once
+    /// the walk's margin is grown by twice that error.
+    pub(crate) fn until<'s>(&'s self, by: f64) -> Swept<'s, K> {
+        let step = Cow::Borrowed(self.step.as_ref());
+        if by >= 1.0 {
+            return Swept::fitted(self.h, step, None);
+        }
+        let at = |(p, q): (&[f64; 3], &[f64; 3])| -> [f64; 3] {
+            std::array::from_fn(|k| p[k] + by * (q[k] - p[k]))
+        };
+        let culling = Step {
+            x0: self.step.x0.clone(),
+            x1: self.step.x0.iter().zip(&self.step.x1).map(at).collect(),
+        };
+        Swept::fitted(self.h, step, Some(culling))
+    }
+
+    fn fitted(h: &'h Hierarchy<K>, step: Cow<'h, Step>, culling: Option<Step>) -> Self {
         let tree = h.tree();
-        let tri_rows = box_rows(
-            tree.triangles().iter().map(|t| t.map(|v| v as usize)),
-            &step,
-        );
+        let fit = culling.as_ref().unwrap_or(&step);
+        let tri_rows = box_rows(tree.triangles().iter().map(|t| t.map(|v| v as usize)), fit);
         let edge_rows = box_rows(
             tree.leaf_edges()
                 .all()
                 .iter()
                 .map(|e| e.map(|v| v as usize)),
-            &step,
+            fit,
         );
         let triangles = tree.triangles();
         let mut ends = Vec::with_capacity(tree.node_count());
@@ -350,7 +392,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
                 // Its triangles' corners and its own vertices (free points included).
                 let corners = triangles[tree.tri_range(n)].iter().flatten();
                 for v in corners.map(|&v| v as usize).chain(tree.vert_run(n)) {
-                    for (e, x) in end.iter_mut().zip([&step.x0[v], &step.x1[v]]) {
+                    for (e, x) in end.iter_mut().zip([&fit.x0[v], &fit.x1[v]]) {
                         let b = points_box_f64([*x]);
                         e.0 = std::array::from_fn(|k| e.0[k].min(b.0[k]));
                         e.1 = std::array::from_fn(|k| e.1[k].max(b.1[k]));
@@ -363,6 +405,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             h,
             bounds: K::swept(tree),
             step,
+            culling,
             tri_rows,
             edge_rows,
             leaf_ends: ends,
@@ -371,6 +414,16 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
 
     fn tree(&self) -> &'h RegionTree {
         self.h.tree()
+    }
+
+    /// The exact tests' positions.
+    pub(crate) fn step(&self) -> &Step {
+        &self.step
+    }
+
+    /// The positions the bounds and boxes are fitted to (see [`Swept::until`]).
+    fn culling(&self) -> &Step {
+        self.culling.as_ref().unwrap_or(&self.step)
     }
 
     /// The boxes over the step of leaf `leaf`'s triangles.
@@ -791,7 +844,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
             Side::A => self.a,
             Side::B => self.b,
         };
-        K::swept_group(&s.bounds, s.h.nodes(), s.h.tree(), &s.step, g)
+        K::swept_group(&s.bounds, s.h.nodes(), s.h.tree(), s.culling(), g)
     }
 
     #[inline(always)]
@@ -908,7 +961,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             first: st.tree().tri_range(y).start,
             corners: st.tree().triangles(),
         };
-        let vertex_box = |v: usize| points_box_f64([sv.step.x0[v], sv.step.x1[v]]);
+        let fit = sv.culling();
+        let vertex_box = |v: usize| points_box_f64([fit.x0[v], fit.x1[v]]);
         candidates.vertices_vs_triangles(
             simd,
             sv.tree().vert_run(x),
