@@ -414,6 +414,44 @@ pub(crate) fn hmax(a: &V<f64>) -> f64 {
     m(m(a[0], a[1]), a[2])
 }
 
+/// Whether two point sets are certainly farther than `d` apart along `w` (any nonzero float
+/// vector): projection onto `w / |w|` shortens no distance, so a gap between the sets'
+/// projections above `d |w|` separates them by more than `d`. The points are given relative
+/// to a common origin as computed differences (each coordinate within half an ulp of the
+/// exact difference and at most `m` in size; the origin itself is `[0; 3]`); every rounding
+/// of the projections is bounded by `16 EPSILON m |w|_1`, and the test is certain.
+#[inline(always)]
+pub(crate) fn apart_along(w: &V<f64>, first: &[V<f64>], second: &[V<f64>], d: f64, m: f64) -> bool {
+    let w1 = w[0].abs() + w[1].abs() + w[2].abs();
+    if w1.is_nan() || w1 <= 0.0 {
+        return false;
+    }
+    let err = 16.0 * f64::EPSILON * m * w1;
+    let span = |pts: &[V<f64>]| {
+        pts.iter()
+            .map(|p| dot(p, w))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+                (lo.min(s), hi.max(s))
+            })
+    };
+    let ((lo_a, hi_a), (lo_b, hi_b)) = (span(first), span(second));
+    let gap = (lo_b - hi_a).max(lo_a - hi_b) - 3.0 * err;
+    let norm = dot(w, w).sqrt() * (1.0 + 8.0 * f64::EPSILON);
+    gap > 0.0 && gap > d * norm * (1.0 + 8.0 * f64::EPSILON)
+}
+
+/// `c` without its part along `dir` (`None` when `dir` is zero): the direction across a
+/// segment or edge `dir` towards `c`.
+#[inline(always)]
+pub(crate) fn across(dir: &V<f64>, c: &V<f64>) -> Option<V<f64>> {
+    let dd = dot(dir, dir);
+    if dd.is_nan() || dd <= 0.0 {
+        return None;
+    }
+    let f = dot(c, dir) / dd;
+    Some(std::array::from_fn(|k| c[k] - f * dir[k]))
+}
+
 /// Whether some component of `a - b` exceeds `d` (exact: rounding is monotone and `d` is a
 /// float, so `fl(a - b) > d` iff `a - b > d`).
 #[inline(always)]

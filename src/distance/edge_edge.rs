@@ -28,10 +28,10 @@
 use num_bigint::BigInt;
 
 use super::arith::{
-    certified, cross, dot, exact_ratio, float_value, gap_exceeds, hmax, lagrange, ldexp,
-    line_parts, max3, min3, plane_parts, plane_q, point_parts, ratio_to_f64, scale_of, sign_of,
-    sub3, to_grid, Bound, Parts, Powers, Ring, DOT, DOT2, DOT3, LAGRANGE, LAGRANGE2, LINE, PLANE,
-    POINT, V,
+    across, apart_along, certified, cross, dot, exact_ratio, float_value, gap_exceeds, hmax,
+    lagrange, ldexp, line_parts, max3, min3, plane_parts, plane_q, point_parts, ratio_to_f64,
+    scale_of, sign_of, sub3, to_grid, Bound, Parts, Powers, Ring, DOT, DOT2, DOT3, LAGRANGE,
+    LAGRANGE2, LINE, PLANE, POINT, V,
 };
 use super::EdgeEdge as Ee;
 
@@ -408,6 +408,9 @@ fn fast(e: [[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, 
     }
     let ty = match classify_certified(&l, &dots, &pw) {
         Some(ty) => ty,
+        // Parallel or touching lines leave the type uncertain; a pair certainly farther
+        // than `d` apart is decided without it.
+        None if decide && apart_across(&l, ds, ms) => return None,
         None => classify_uncertain(&l, &dots, pw, e),
     };
     let parts = parts(&l, ty);
@@ -419,6 +422,7 @@ fn fast(e: [[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, 
         };
         let s = match certified(v, pw.of(bound(q))) {
             Some(s) => s,
+            None if apart_across(&l, ds, ms) => 1,
             None => exact_sign(e, d, q),
         };
         if s > 0 {
@@ -431,6 +435,25 @@ fn fast(e: [[f64; 3]; 4], d: f64, m: f64, k: i32, decide: bool) -> Option<(f64, 
         None => exact_distance(e, ty),
     };
     Some((v, ty))
+}
+
+/// Whether the segments are certainly farther than `d` apart, seen along a direction across
+/// one of them: the part of the vector from its start to the other's midpoint perpendicular
+/// to it ([`apart_along`]); each side's direction is tried. This decides the pairs whose type
+/// or distance the float filter leaves uncertain (parallel segments, as a flat grid's
+/// parallel diagonals) when they are far, without the exact path.
+#[cold]
+#[inline(never)]
+fn apart_across(l: &Leaves<f64>, d: f64, m: f64) -> bool {
+    let neg = |p: &V<f64>| p.map(|x| -x);
+    let mid = |p: &V<f64>, q: &V<f64>| std::array::from_fn(|k| 0.5 * (p[k] + q[k]));
+    // Relative to a0: a's ends 0 and u, b's -r and -r01. Relative to b0: b's ends 0 and v,
+    // a's r and r10.
+    let (b0, b1) = (neg(&l.r), neg(&l.r01));
+    let o = [0.0; 3];
+    across(&l.u, &mid(&b0, &b1)).is_some_and(|w| apart_along(&w, &[o, l.u], &[b0, b1], d, m))
+        || across(&l.v, &mid(&l.r, &l.r10))
+            .is_some_and(|w| apart_along(&w, &[o, l.v], &[l.r, l.r10], d, m))
 }
 
 /// [`classify`] with the float signs, exact where uncertain (cold: a near-tie).
@@ -627,6 +650,48 @@ mod tests {
             prop_assert_eq!(classify_uncertain(&l, &dots, pw, e), exact);
             let within = ex.sign(Q::Dist(exact)) <= 0;
             prop_assert_eq!(super::within(e, d).map(|r| r.1), within.then_some(exact));
+            // The separation across a segment is certain whenever it is claimed.
+            if apart_across(&l, d, m) {
+                prop_assert!(!within, "claimed apart, within {}", d);
+            }
+        }
+
+        /// Parallel and nearly parallel segments (the case the separation across a segment
+        /// decides): claimed apart only when the exact distance exceeds `d`.
+        #[test]
+        fn the_separation_across_a_segment_is_certain(
+            (a0, along, off, shift) in (
+                prop::array::uniform3(-8i32..=8),
+                prop::array::uniform3(-3i32..=3),
+                prop::array::uniform3(-3i32..=3),
+                -4i32..=4,
+            ),
+            nudge in prop::array::uniform3(-1i32..=1),
+            e in -30i32..30,
+            d in 0.0f64..4.0,
+        ) {
+            let unit = 2f64.powi(e);
+            let p = |v: [i32; 3]| v.map(|x| f64::from(x) * unit);
+            let a0 = p(a0);
+            let a1: V<f64> = std::array::from_fn(|k| a0[k] + f64::from(along[k]) * unit);
+            // b: a's direction, shifted across by `off` and along by `shift`, one end nudged.
+            let b0: V<f64> = std::array::from_fn(|k| {
+                a0[k] + f64::from(off[k] + shift * along[k]) * unit
+            });
+            let mut b1: V<f64> = std::array::from_fn(|k| b0[k] + f64::from(along[k]) * unit);
+            for k in 0..3 {
+                b1[k] = match nudge[k] { 1 => b1[k].next_up(), -1 => b1[k].next_down(), _ => b1[k] };
+            }
+            let d = d * unit;
+            let e = [a0, a1, b0, b1];
+            let (m, _) = extent(e, d);
+            prop_assume!(m > 0.0 && scale_of(m) == Some(0));
+            let l = Leaves::new(&a0, &a1, &b0, &b1);
+            if apart_across(&l, d, m) {
+                let mut ex = Exact::new(&a0, &a1, &b0, &b1, d);
+                let ty = classify(&mut ex);
+                prop_assert!(ex.sign(Q::Dist(ty)) > 0, "{:?} claimed apart at {}", e, d);
+            }
         }
     }
 }

@@ -27,9 +27,10 @@
 use num_bigint::BigInt;
 
 use super::arith::{
-    certified, cross, dot, exact_ratio, float_value, gap_exceeds, hmax, lagrange, ldexp,
-    line_parts, max3, min3, plane_parts, plane_q, point_parts, ratio_to_f64, scale_of, sign_of,
-    sub3, to_grid, Bound, Parts, Powers, Ring, DOT, DOT2, LAGRANGE, LINE, PLANE, POINT, V,
+    across, apart_along, certified, cross, dot, exact_ratio, float_value, gap_exceeds, hmax,
+    lagrange, ldexp, line_parts, max3, min3, plane_parts, plane_q, point_parts, ratio_to_f64,
+    scale_of, sign_of, sub3, to_grid, Bound, Parts, Powers, Ring, DOT, DOT2, LAGRANGE, LINE, PLANE,
+    POINT, V,
 };
 use super::PointTriangle as Pt;
 
@@ -387,6 +388,9 @@ fn fast(p: [f64; 3], t: [[f64; 3]; 3], d: f64, m: f64, k: i32, decide: bool) -> 
     }
     let ty = match classify_certified(&l, &dots, &pw) {
         Some(ty) => ty,
+        // A point in or near the triangle's plane leaves the type uncertain; a pair
+        // certainly farther than `d` apart is decided without it.
+        None if decide && apart_beside(&l, ds, ms) => return None,
         None => classify_uncertain(&l, &dots, pw, p, t),
     };
     let parts = parts(&l, ty);
@@ -398,6 +402,7 @@ fn fast(p: [f64; 3], t: [[f64; 3]; 3], d: f64, m: f64, k: i32, decide: bool) -> 
         };
         let s = match certified(v, pw.of(bound(q))) {
             Some(s) => s,
+            None if apart_beside(&l, ds, ms) => 1,
             None => exact_sign(p, t, d, q),
         };
         if s > 0 {
@@ -410,6 +415,28 @@ fn fast(p: [f64; 3], t: [[f64; 3]; 3], d: f64, m: f64, k: i32, decide: bool) -> 
         None => exact_distance(p, t, ty),
     };
     Some((v, ty))
+}
+
+/// Whether the point is certainly farther than `d` from the triangle, seen across one of
+/// its edges: the part of the vector from the edge's start to the point perpendicular to
+/// the edge ([`apart_along`]; a point outside the triangle in its plane lies beyond some
+/// edge's line). Decides the pairs whose type or distance the float filter leaves
+/// uncertain (a point in the triangle's plane, as on a flat sheet) when they are far,
+/// without the exact path.
+#[cold]
+#[inline(never)]
+fn apart_beside(l: &Leaves<f64>, d: f64, m: f64) -> bool {
+    let neg = |p: &V<f64>| p.map(|x| -x);
+    let o = [0.0; 3];
+    // Each edge from its start: the edge, the third corner and the point, relative to it.
+    let edges = [
+        (l.ab, l.ac, l.ap),
+        (l.bc, neg(&l.ab), l.bp),
+        (neg(&l.ac), neg(&l.bc), l.cp),
+    ];
+    edges
+        .iter()
+        .any(|(e, z, q)| across(e, q).is_some_and(|w| apart_along(&w, &[o, *e, *z], &[*q], d, m)))
 }
 
 /// [`classify`] with the float signs, exact where uncertain (cold: a near-tie).
@@ -585,6 +612,10 @@ mod tests {
             prop_assert_eq!(classify_uncertain(&l, &dots, pw, p, t), exact);
             let within = ex.sign(Q::Dist(exact)) <= 0;
             prop_assert_eq!(super::within(p, t, d).map(|r| r.1), within.then_some(exact));
+            // The separation across an edge is certain whenever it is claimed.
+            if apart_beside(&l, d, m) {
+                prop_assert!(!within, "claimed apart, within {}", d);
+            }
         }
     }
 }
