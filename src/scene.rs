@@ -1081,10 +1081,29 @@ fn step_size_of<K: BoundingVolume>(
     let moving: Vec<Motion<'_>> = motions.iter().flatten().copied().collect();
     // A still object's vertices have displacement zero: it counts in the relative motion.
     let still = motions.iter().any(Option::is_none);
-    let (query, gap) = step::query_for(options, &moving, still, step::by(&best));
+    let by = step::by(&best);
+    let (mut query, gap) = step::query_for(options, &moving, still, by);
     let (jobs, broad_phase_tests) = jobs_of(objects, boxes(), f32_up(query.options.min_distance));
     sweep_jobs(objects, &steps, &jobs, &mut sweeps, parallel);
-    let mut limiting = swept_walks(&sweeps, &jobs, parallel, |ws, a, b, self_job, par| {
+    // The gap walk's bounds over `[0, by]` only (see `contact::step`), for the objects in
+    // its jobs; its margin grown by their positions' rounding there.
+    let mut in_jobs = vec![false; objects.len()];
+    for &(a, b) in &jobs {
+        in_jobs[a] = true;
+        in_jobs[b] = true;
+    }
+    let horizon: Vec<Option<Swept<'_, K>>> = if by < 1.0 {
+        let fitted = sweeps.iter().zip(&in_jobs);
+        let until = fitted.map(|(s, &used)| s.as_ref().filter(|_| used).map(|s| s.until(by)));
+        let used = sweeps.iter().zip(&in_jobs).filter(|(_, &u)| u);
+        let moved = used.filter_map(|(s, _)| s.as_ref()).map(|s| s.step());
+        query.options.min_distance = step::grown(query.options.min_distance, moved);
+        until.collect()
+    } else {
+        Vec::new()
+    };
+    let walked = if by < 1.0 { &horizon } else { &sweeps };
+    let mut limiting = swept_walks(walked, &jobs, parallel, |ws, a, b, self_job, par| {
         ccd::run(
             a,
             b,

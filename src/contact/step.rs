@@ -40,6 +40,7 @@
 
 use std::sync::atomic::AtomicU64;
 
+use crate::bv::swept::Step;
 use crate::bv::BoundingVolume;
 use crate::ccd::CcdOptions;
 use crate::control::Budget;
@@ -186,14 +187,17 @@ fn step_between<K: BoundingVolume>(
     let by = by(&best);
     let (mut query, gap) = query_for(options, motions, false, by);
     // The gap walk's bounds over `[0, by]` only, its margin grown by their rounding.
-    let until_a = a.until(by);
-    let until_b = if self_query { None } else { Some(b.until(by)) };
-    let b = until_b.as_ref().unwrap_or(&until_a);
-    let error = horizon_error([a.step(), b.step()]);
-    let culled = (query.options.min_distance + 2.0 * error).next_up();
-    query.options.min_distance = if culled.is_finite() { culled } else { f64::MAX };
+    let (until_a, until_b);
+    let (a, b) = if by < 1.0 {
+        until_a = a.until(by);
+        until_b = (!self_query).then(|| b.until(by));
+        query.options.min_distance = grown(query.options.min_distance, [a.step(), b.step()]);
+        (&until_a, until_b.as_ref().unwrap_or(&until_a))
+    } else {
+        (a, b)
+    };
     let (mut limiting, _) = run(
-        &until_a,
+        a,
         b,
         self_query,
         &query,
@@ -208,6 +212,17 @@ fn step_between<K: BoundingVolume>(
         step: step_at(limiting.toi),
         limiting,
     })
+}
+
+/// The gap walk's culling distance `d` when its bounds are fitted up to a time of the
+/// steps `steps` ([`Swept::until`]): grown by twice the rounding of the positions there.
+pub(crate) fn grown<'a>(d: f64, steps: impl IntoIterator<Item = &'a Step>) -> f64 {
+    let d = (d + 2.0 * horizon_error(steps)).next_up();
+    if d.is_finite() {
+        d
+    } else {
+        f64::MAX
+    }
 }
 
 /// The earliest impact at the minimum distance (plain CCD, cheap: culled at that
