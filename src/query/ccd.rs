@@ -504,6 +504,7 @@ impl Gap {
         use crate::distance::{point_triangle_distance_sq, point_triangle_within};
         let u: [[f64; 3]; 4] = std::array::from_fn(|k| [0, 1, 2].map(|c| x1[k][c] - x0[k][c]));
         let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let length = u.map(norm);
         let split = if vertex_face { 1 } else { 2 };
         // The largest |u_i - u_j| over a vertex i of the first feature and j of the second,
         // plus the rounding of the computed displacements and differences (a few ulps of
@@ -512,7 +513,7 @@ impl Gap {
         for i in 0..split {
             for j in split..4 {
                 let d = [0, 1, 2].map(|c| u[i][c] - u[j][c]);
-                let slack = 4.0 * f64::EPSILON * (norm(u[i]) + norm(u[j]));
+                let slack = 4.0 * f64::EPSILON * (length[i] + length[j]);
                 relative = relative.max(norm(d) + slack);
             }
         }
