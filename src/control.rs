@@ -156,6 +156,12 @@ impl<'c> Budget<'c> {
         }
     }
 
+    /// Takes back `n` result pairs counted by [`Budget::add`] and dropped since (a walk
+    /// started again finds them anew).
+    pub(crate) fn release(&self, n: usize) {
+        self.pairs.fetch_sub(n as u64, Ordering::Relaxed);
+    }
+
     /// Appends `x` to `v`, or stops the query if `v` cannot grow.
     #[inline(always)]
     pub(crate) fn push<T>(&self, v: &mut Vec<T>, x: T) {

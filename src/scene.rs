@@ -1082,7 +1082,7 @@ fn step_size_of<K: BoundingVolume>(
     // A still object's vertices have displacement zero: it counts in the relative motion.
     let still = motions.iter().any(Option::is_none);
     let by = step::by(&best);
-    let (mut query, gap) = step::query_for(options, &moving, still, by);
+    let (query, gap) = step::query_for(options, &moving, still, by);
     let (jobs, broad_phase_tests) = jobs_of(objects, boxes(), f32_up(query.options.min_distance));
     sweep_jobs(objects, &steps, &jobs, &mut sweeps, parallel);
     // The gap walk's bounds over `[0, by]` only (see `contact::step`), for the objects in
@@ -1095,9 +1095,6 @@ fn step_size_of<K: BoundingVolume>(
     let horizon: Vec<Option<Swept<'_, K>>> = if by < 1.0 {
         let fitted = sweeps.iter().zip(&in_jobs);
         let until = fitted.map(|(s, &used)| s.as_ref().filter(|_| used).map(|s| s.until(by)));
-        let used = sweeps.iter().zip(&in_jobs).filter(|(_, &u)| u);
-        let moved = used.filter_map(|(s, _)| s.as_ref()).map(|s| s.step());
-        query.options.min_distance = step::grown(query.options.min_distance, moved);
         until.collect()
     } else {
         Vec::new()

@@ -328,8 +328,11 @@ fn frame_truth_through_the_pipeline() {
 /// coplanar faces (exact path) and plain crossings (float filter). Earliest mode returns
 /// exactly the pairs of all mode whose time is `<= 1/2` (the next contacts are `1/32` later),
 /// for every method and thread count, self and pair queries.
-#[test]
-fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
+///
+/// `speed` multiplies every displacement (a power of two: the positions stay exact), so the
+/// ties are at `1 / (2 speed)`. At 32 they are at `1/64`: the walk finds one and starts
+/// again on bounds fitted up to that time, which must still reach every other tie.
+fn check_planted_ties(speed: f64) {
     let sheet = grid(8, 16, 1.0 / 16.0, [0.0; 3]);
     let flap = grid(8, 16, 1.0 / 16.0, [0.0; 3]);
     let layer = grid(6, 16, 1.0 / 16.0, [0.0; 3]);
@@ -351,22 +354,24 @@ fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
         .iter()
         .enumerate()
         .map(|(i, q)| {
-            if flap_range.contains(&i) {
+            let end = if flap_range.contains(&i) {
                 [0.0, q[1], q[2]]
             } else if i >= layer_start {
                 [q[0], q[1], -0.125]
             } else {
                 *q
-            }
+            };
+            std::array::from_fn(|k| q[k] + speed * (end[k] - q[k]))
         })
         .collect();
     let m = Mesh::new_f64(p0.clone(), tris).unwrap();
     let all = brute_force_self_ccd(&m, Motion::new(&p0, &p1), &CcdOptions::default());
     let want = earliest_of(&all, all.toi);
     let tied = want.counters.contacts;
-    assert!(tied > 500, "{tied} pairs tie at 1/2");
+    let tie = 0.5 / speed;
+    assert!(tied > 500, "{tied} pairs tie at {tie}");
     assert_eq!(
-        all.toi.map(|t| 0.5 - t <= dhcd::ccd::TOI_TOLERANCE),
+        all.toi.map(|t| tie - t <= dhcd::ccd::TOI_TOLERANCE),
         Some(true)
     );
     let later = all
@@ -375,8 +380,8 @@ fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
         .map(|x| x.toi)
         .chain(all.edge_edge.iter().map(|x| x.toi));
     assert!(later
-        .filter(|&t| t > 0.5)
-        .all(|t| t >= 0.5 + 1.0 / 32.0 - 1e-12));
+        .filter(|&t| t > tie)
+        .all(|t| t >= tie + 1.0 / 32.0 / speed - 1e-12));
     for_each_method!(K => {
         let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
         for par in [Par::Seq, Par::Rayon(2)] {
@@ -388,7 +393,7 @@ fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
                 par,
             )
             .unwrap();
-            assert_same(&got, &want, &format!("{:?} {par:?}", K::METHOD));
+            assert_same(&got, &want, &format!("speed {speed} {:?} {par:?}", K::METHOD));
         }
     });
     // The pair form: the sheet still, the flap and the layer as the second mesh.
@@ -405,4 +410,15 @@ fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
     );
     check_pair::<dhcd::bv::Dh>(&a, am, &b, bm, &[0.0], "tied sheet and flap");
     check_pair::<dhcd::bv::Aabb>(&a, am, &b, bm, &[0.0], "tied sheet and flap");
+}
+
+#[test]
+fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
+    check_planted_ties(1.0);
+}
+
+/// The ties early in the step: the walk restarts on bounds fitted up to them.
+#[test]
+fn earliest_ties_near_the_start_survive_the_walks_restart() {
+    check_planted_ties(32.0);
 }

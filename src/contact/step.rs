@@ -40,7 +40,6 @@
 
 use std::sync::atomic::AtomicU64;
 
-use crate::bv::swept::Step;
 use crate::bv::BoundingVolume;
 use crate::ccd::CcdOptions;
 use crate::control::Budget;
@@ -48,7 +47,7 @@ use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
-use crate::query::ccd::{earliest_bound, horizon_error, run, Gap, Swept};
+use crate::query::ccd::{earliest_bound, horizon_for, run, Gap, Swept};
 use crate::query::{CcdMode, CcdQuery, Impacts, Motion};
 use crate::walk::Workspace;
 
@@ -184,18 +183,8 @@ fn step_between<K: BoundingVolume>(
     let control = ws.control.clone();
     let budget = Budget::new(&control);
     let (best, first_work) = first_impact(a, b, self_query, options, &budget, ws, par)?;
-    let by = by(&best);
-    let (mut query, gap) = query_for(options, motions, false, by);
-    // The gap walk's bounds over `[0, by]` only, its margin grown by their rounding.
-    let (until_a, until_b);
-    let (a, b) = if by < 1.0 {
-        until_a = a.until(by);
-        until_b = (!self_query).then(|| b.until(by));
-        query.options.min_distance = grown(query.options.min_distance, [a.step(), b.step()]);
-        (&until_a, until_b.as_ref().unwrap_or(&until_a))
-    } else {
-        (a, b)
-    };
+    // The walk fits its bounds over `[0, by]` only, knowing the first impact.
+    let (query, gap) = query_for(options, motions, false, by(&best));
     let (mut limiting, _) = run(
         a,
         b,
@@ -212,17 +201,6 @@ fn step_between<K: BoundingVolume>(
         step: step_at(limiting.toi),
         limiting,
     })
-}
-
-/// The gap walk's culling distance `d` when its bounds are fitted up to a time of the
-/// steps `steps` ([`Swept::until`]): grown by twice the rounding of the positions there.
-pub(crate) fn grown<'a>(d: f64, steps: impl IntoIterator<Item = &'a Step>) -> f64 {
-    let d = (d + 2.0 * horizon_error(steps)).next_up();
-    if d.is_finite() {
-        d
-    } else {
-        f64::MAX
-    }
 }
 
 /// The earliest impact at the minimum distance (plain CCD, cheap: culled at that
@@ -264,8 +242,9 @@ pub(crate) fn bound_at(toi: Option<f64>) -> AtomicU64 {
 /// The latest time a pair that limits the step can reach its gap: the first impact plus
 /// the walk's pruning slack (rounded up), at most 1.
 pub(crate) fn by(best: &AtomicU64) -> f64 {
-    let t = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
-    (t + 8.0 * crate::ccd::TOI_TOLERANCE).next_up().min(1.0)
+    horizon_for(f64::from_bits(
+        best.load(std::sync::atomic::Ordering::Relaxed),
+    ))
 }
 
 /// The gap walk's counters plus the first walk's work: the step size's counters hold both

@@ -26,14 +26,18 @@
 //! it plus a slack, so most pairs stop early; the pairs found near the best are then tested
 //! again over the whole interval, so the answer does not depend on the order, the threads,
 //! the method or which path (float filter or exact) decided a pair. (Its work counters do
-//! depend on the order.)
+//! depend on the order.) Once the best time is below an eighth of the time the bounds
+//! reach, the walk starts again on bounds fitted only up to that time plus the slack
+//! ([`Swept::until`]): where some contact is close at t0, as in most simulation steps,
+//! bounds over the first instants of the step meet far fewer pairs than bounds over all of
+//! it. A time limit below 1 fits the bounds up to it the same way, in both modes.
 //!
 //! Results are in the caller's original indices, sorted, the same for every method and thread
 //! count. `prim_tests` counts the feature pairs given to the exact test, `contacts` the
 //! pairs reported, `bv_updates` the bounds fitted over the step.
 
 use std::borrow::Cow;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use pulp::Simd;
 
@@ -265,6 +269,11 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
     /// The positions the bounds and boxes are fitted to, when not `step`'s: t0 and a time
     /// `by < 1` of the step ([`Swept::until`]).
     culling: Option<Step>,
+    /// The time `culling` reaches (1: the whole step).
+    horizon: f64,
+    /// A bound on how far `culling`'s positions at `horizon` lie from the exact points of
+    /// the motion ([`horizon_error`]; 0 for the whole step).
+    horizon_error: f64,
     bounds: K::Swept,
     tri_rows: [Vec<f32>; 6],
     edge_rows: [Vec<f32>; 6],
@@ -277,12 +286,10 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
 /// (x1 - x0)` ([`Swept::until`]), lies from the exact point: three roundings of values at
 /// most twice the largest coordinate `M` in size, at most `4 EPSILON M` per coordinate, so
 /// `8 EPSILON M` in norm (rounded up).
-pub(crate) fn horizon_error<'a>(steps: impl IntoIterator<Item = &'a Step>) -> f64 {
+fn horizon_error(step: &Step) -> f64 {
     let mut largest = 0.0f64;
-    for s in steps {
-        for p in s.x0.iter().chain(&s.x1) {
-            largest = largest.max(p[0].abs()).max(p[1].abs()).max(p[2].abs());
-        }
+    for p in step.x0.iter().chain(&step.x1) {
+        largest = largest.max(p[0].abs()).max(p[1].abs()).max(p[2].abs());
     }
     (8.0 * f64::EPSILON * largest).next_up()
 }
@@ -352,12 +359,13 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
     }
 
     /// The same hierarchy and step, its bounds and boxes fitted over `[0, by]` only, for a
-    /// walk whose pairs are tested up to `by` (the step size's gap walk, after the first
-    /// impact): far fewer pairs meet when `by` is small. The positions at `by` are computed
-    /// in `f64`, each coordinate within [`horizon_error`] of the exact point of its line,
-    /// and the ends of a linear motion bound it in between (boxes, leaf ends) or make it a
-    /// moving ball: so the bounds hold every pair that comes within a margin by `by` once
-    /// the walk's margin is grown by twice that error.
+    /// walk whose pairs are tested up to `by` (earliest mode once a time of impact is
+    /// known, the step size's gap walk, a time limit below 1): far fewer pairs meet when
+    /// `by` is small. The positions at `by` are computed in `f64`, each within
+    /// [`horizon_error`] of the exact point of its line, and the ends of a linear motion
+    /// bound it in between (boxes, leaf ends) or make it a moving ball: so the bounds hold
+    /// every pair that comes within a margin by `by` once the walk's margin is grown by
+    /// that error on each side ([`SweptQuery::new`]).
     pub(crate) fn until<'s>(&'s self, by: f64) -> Swept<'s, K> {
         let step = Cow::Borrowed(self.step.as_ref());
         if by >= 1.0 {
@@ -370,7 +378,15 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             x0: self.step.x0.clone(),
             x1: self.step.x0.iter().zip(&self.step.x1).map(at).collect(),
         };
-        Swept::fitted(self.h, step, Some(culling))
+        let mut s = Swept::fitted(self.h, step, Some(culling));
+        s.horizon = by;
+        s.horizon_error = horizon_error(&s.step);
+        s
+    }
+
+    /// The time the bounds and boxes reach (1: the whole step).
+    pub(crate) fn horizon(&self) -> f64 {
+        self.horizon
     }
 
     fn fitted(h: &'h Hierarchy<K>, step: Cow<'h, Step>, culling: Option<Step>) -> Self {
@@ -406,6 +422,8 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             bounds: K::swept(tree),
             step,
             culling,
+            horizon: 1.0,
+            horizon_error: 0.0,
             tri_rows,
             edge_rows,
             leaf_ends: ends,
@@ -414,11 +432,6 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
 
     fn tree(&self) -> &'h RegionTree {
         self.h.tree()
-    }
-
-    /// The exact tests' positions.
-    pub(crate) fn step(&self) -> &Step {
-        &self.step
     }
 
     /// The positions the bounds and boxes are fitted to (see [`Swept::until`]).
@@ -460,8 +473,17 @@ struct SweptQuery<'s, 'h, K: BoundingVolume> {
     b: &'s Swept<'h, K>,
     self_query: bool,
     options: CcdOptions,
-    /// The minimum distance as an `f32` not below it: the feature boxes' growth.
+    /// The culling distance of the node tests: the minimum distance (the step size's
+    /// culling distance when `gap` is set), grown by the rounding of the positions the
+    /// bounds are fitted to ([`Swept::until`]).
+    cull: f64,
+    /// `cull` as an `f32` not below it: the leaf and feature boxes' growth.
     margin: f32,
+    /// Earliest mode: the walk stops, to start again on bounds fitted up to the best time,
+    /// once [`horizon_for`] the best time is at most this ([`RESTART_FACTOR`]).
+    restart_below: Option<f64>,
+    /// The walk stopped for that.
+    abandoned: AtomicBool,
     /// Earliest mode: the least time of impact found so far, by this walk or any other
     /// sharing the bound ([`earliest_bound`]).
     best: Option<&'s AtomicU64>,
@@ -579,9 +601,40 @@ pub(crate) fn earliest_bound(query: &CcdQuery) -> Option<AtomicU64> {
     (query.mode == CcdMode::Earliest).then(|| AtomicU64::new(f64::INFINITY.to_bits()))
 }
 
+/// In earliest mode, a walk whose best time of impact falls to `1 / RESTART_FACTOR` of its
+/// bounds' horizon (or below) stops and starts again on bounds fitted up to that time
+/// ([`Swept::until`]): where a contact is close, far fewer pairs meet over the start of the
+/// step than over all of it (a twentieth of the feature pairs on real frame steps whose
+/// first impact is near t0). The work before the restart is lost, so the horizon must have
+/// shrunk enough to pay for it.
+const RESTART_FACTOR: f64 = 8.0;
+
+/// The most restarts of one walk (each shrinks the horizon by [`RESTART_FACTOR`] at least).
+const MAX_RESTARTS: u32 = 3;
+
+/// The latest time a pair that ties with the best time of impact `best` so far can first
+/// touch, rounded up, at most 1: every pair the earliest answer can hold touches by then
+/// (see [`PRUNE_SLACK`]), so a walk's bounds need not reach past it.
+pub(crate) fn horizon_for(best: f64) -> f64 {
+    (best + 8.0 * TOI_TOLERANCE).next_up().min(1.0)
+}
+
+/// The time a walk's bounds must reach: the time limit, and in earliest mode
+/// [`horizon_for`] the best time so far.
+fn wanted_horizon(options: &CcdOptions, best: Option<&AtomicU64>) -> f64 {
+    let best = best.map_or(f64::INFINITY, |b| f64::from_bits(b.load(Ordering::Relaxed)));
+    options.t_max.min(horizon_for(best))
+}
+
 /// The CCD walk of `a` against `b` (options checked), pruned by `best` in earliest mode and
 /// counted against `budget`; also the bounds fitted on each side. An error when the budget
 /// stopped the walk (this walk or another sharing the budget).
+///
+/// The walk's bounds are fitted up to the time limit, or in earliest mode the best time
+/// so far when one is known ([`Swept::until`], when that is before `a`'s and `b`'s own
+/// horizons); in earliest mode the walk starts again on tighter bounds when its best time
+/// falls far enough ([`RESTART_FACTOR`]). Pairs are tested on their exact motions either
+/// way, so the answer is the same; the work of every walk is counted.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn run<K: BoundingVolume>(
     a: &Swept<'_, K>,
@@ -594,40 +647,93 @@ pub(crate) fn run<K: BoundingVolume>(
     ws: &mut Workspace,
     par: Par,
 ) -> Result<(Impacts, [u64; 2])> {
-    let q = SweptQuery {
-        a,
-        b,
-        self_query,
-        options: query.options,
-        margin: f32_up(query.options.min_distance),
-        best,
-        budget,
-        gap,
-    };
-    let w = walk::walk(&q, ws, par);
-    budget.finish()?;
-    let mut out = w.out;
-    if query.mode == CcdMode::Earliest {
-        q.settle_earliest(&mut out);
+    let mut counters = Counters::default();
+    let mut fitted = [0u64; 2];
+    let mut restarts = 0;
+    let fit = |by: f64| (a.until(by), (!self_query).then(|| b.until(by)));
+    let wanted = wanted_horizon(&query.options, best);
+    let mut horizon = (wanted < a.horizon().min(b.horizon())).then(|| fit(wanted));
+    loop {
+        let (sa, sb) = match &horizon {
+            Some((ua, ub)) => (ua, ub.as_ref().unwrap_or(ua)),
+            None => (a, b),
+        };
+        let restart_below = (best.is_some() && restarts < MAX_RESTARTS)
+            .then(|| sa.horizon().min(sb.horizon()) / RESTART_FACTOR);
+        let q = SweptQuery::new(sa, sb, self_query, query.options, best, budget, gap);
+        let q = SweptQuery { restart_below, ..q };
+        let w = walk::walk(&q, ws, par);
         budget.finish()?;
+        counters += w.counters;
+        fitted = [0, 1].map(|k| fitted[k] + w.fitted[k]);
+        if q.abandoned.load(Ordering::Relaxed) {
+            // Its pairs are found again by the next walk.
+            budget.release(w.out.len());
+            restarts += 1;
+            horizon = Some(fit(wanted_horizon(&query.options, best)));
+            continue;
+        }
+        let mut out = w.out;
+        if query.mode == CcdMode::Earliest {
+            q.settle_earliest(&mut out);
+            budget.finish()?;
+        }
+        return Ok((q.impacts(out, counters), fitted));
     }
-    out.vertex_face
-        .sort_unstable_by_key(|x| (u64::from(x.vertex) << 32) | u64::from(x.triangle));
-    out.face_vertex
-        .sort_unstable_by_key(|x| (u64::from(x.triangle) << 32) | u64::from(x.vertex));
-    out.edge_edge.sort_unstable_by_key(|x| (x.a, x.b));
-    let toi = out.least_toi();
-    let mut counters = w.counters;
-    counters.contacts =
-        (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
-    let impacts = Impacts {
-        vertex_face: out.vertex_face,
-        face_vertex: out.face_vertex,
-        edge_edge: out.edge_edge,
-        toi,
-        counters,
-    };
-    Ok((impacts, w.fitted))
+}
+
+impl<'s, 'h, K: BoundingVolume> SweptQuery<'s, 'h, K> {
+    /// The walk of `a` against `b`, its culling distance grown by the rounding of the
+    /// positions their bounds are fitted to (each within its `horizon_error`).
+    fn new(
+        a: &'s Swept<'h, K>,
+        b: &'s Swept<'h, K>,
+        self_query: bool,
+        options: CcdOptions,
+        best: Option<&'s AtomicU64>,
+        budget: &'s Budget<'s>,
+        gap: Option<Gap>,
+    ) -> Self {
+        let mut cull = options.min_distance;
+        if a.horizon_error > 0.0 || b.horizon_error > 0.0 {
+            cull = (cull + a.horizon_error + b.horizon_error).next_up();
+            if !cull.is_finite() {
+                cull = f64::MAX;
+            }
+        }
+        Self {
+            a,
+            b,
+            self_query,
+            options,
+            cull,
+            margin: f32_up(cull),
+            restart_below: None,
+            abandoned: AtomicBool::new(false),
+            best,
+            budget,
+            gap,
+        }
+    }
+
+    /// The answer of a finished walk: its pairs sorted, with the work counted.
+    fn impacts(&self, mut out: ImpactOut, mut counters: Counters) -> Impacts {
+        out.vertex_face
+            .sort_unstable_by_key(|x| (u64::from(x.vertex) << 32) | u64::from(x.triangle));
+        out.face_vertex
+            .sort_unstable_by_key(|x| (u64::from(x.triangle) << 32) | u64::from(x.vertex));
+        out.edge_edge.sort_unstable_by_key(|x| (x.a, x.b));
+        let toi = out.least_toi();
+        counters.contacts =
+            (out.vertex_face.len() + out.face_vertex.len() + out.edge_edge.len()) as u64;
+        Impacts {
+            vertex_face: out.vertex_face,
+            face_vertex: out.face_vertex,
+            edge_edge: out.edge_edge,
+            toi,
+            counters,
+        }
+    }
 }
 
 /// Earliest mode over several walks that shared one bound: `least`, the least of their
@@ -850,7 +956,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
 
     #[inline(always)]
     fn test<S: Simd>(&self, simd: S, a: Self::Block, i: usize, b: Self::Block, n: usize) -> u32 {
-        K::swept_test(simd, a, i, b, n, self.options.min_distance)
+        K::swept_test(simd, a, i, b, n, self.cull)
     }
 
     #[inline(always)]
@@ -931,11 +1037,18 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
 
     #[inline(always)]
     fn stopped(&self, poll: bool) -> bool {
-        if poll {
+        let stopped = if poll {
             self.budget.poll()
         } else {
             self.budget.stopped()
+        };
+        if let (Some(below), Some(best)) = (self.restart_below, self.best) {
+            if horizon_for(f64::from_bits(best.load(Ordering::Relaxed))) <= below {
+                self.abandoned.store(true, Ordering::Relaxed);
+                return true;
+            }
         }
+        stopped
     }
 }
 
