@@ -217,10 +217,14 @@ fn a_drifting_mesh_stops_at_its_gap_alone_and_beside_a_still_object() {
     let close = |step: f64, want: f64| step <= want && want - step <= 2.0 * TOI_TOLERANCE;
     for_each_method!(K => {
         let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
-        let s = collision_free_stepsize(&h, Motion::new(&x0, &drifted), &StepOptions::default())
-            .unwrap();
-        assert!(close(s.step, want), "{:?}: {}", K::METHOD, s.step);
-        assert_eq!(s.limiting.vertex_face.len(), 1);
+        for par in [Par::Seq, Par::Rayon(2)] {
+            let motion = Motion::new(&x0, &drifted);
+            let mut ws = Workspace::default();
+            let s = collision_free_stepsize_with(&h, motion, &StepOptions::default(), &mut ws, par)
+                .unwrap();
+            assert!(close(s.step, want), "{:?} {par:?}: {}", K::METHOD, s.step);
+            assert_eq!(s.limiting.vertex_face.len(), 1);
+        }
     });
     // A still triangle under the drifting vertex's path: the vertex (alone in its object,
     // with a far triangle) drifts across it from above, while staying above it.
@@ -244,10 +248,12 @@ fn a_drifting_mesh_stops_at_its_gap_alone_and_beside_a_still_object() {
         let _still = scene.add(&wall).unwrap();
         let moving = scene.add(&falling).unwrap();
         let motions = [(moving, Motion::new(&p0, &p1))];
-        let s = scene
-            .collision_free_stepsize(&motions, &StepOptions::default(), Par::Seq)
-            .unwrap();
-        assert!(close(s.step, want), "{method:?}: {}", s.step);
+        for par in [Par::Seq, Par::Rayon(2)] {
+            let s = scene
+                .collision_free_stepsize(&motions, &StepOptions::default(), par)
+                .unwrap();
+            assert!(close(s.step, want), "{method:?} {par:?}: {}", s.step);
+        }
     }
 }
 
