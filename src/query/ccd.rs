@@ -41,8 +41,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{points_box_f64, Candidates, FeatureBox, LeafEdges, LeafTriangles};
-use crate::bv::swept::{f32_up, Step};
+use super::features::{points_box_f64, widen, Candidates, FeatureBox, LeafEdges, LeafTriangles};
+use crate::bv::swept::{f32_down, f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
 use crate::control::Budget;
@@ -403,19 +403,19 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         let triangles = tree.triangles();
         let mut ends = Vec::with_capacity(tree.node_count());
         for n in 0..tree.node_count() {
-            let mut end = [([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]); 2];
+            // In `f64`, rounded outward once (an empty box stays empty: infinities convert
+            // to themselves).
+            let mut lo = [[f64::INFINITY; 3]; 2];
+            let mut hi = [[f64::NEG_INFINITY; 3]; 2];
             if tree.is_leaf(n) {
                 // Its triangles' corners and its own vertices (free points included).
                 let corners = triangles[tree.tri_range(n)].iter().flatten();
                 for v in corners.map(|&v| v as usize).chain(tree.vert_run(n)) {
-                    for (e, x) in end.iter_mut().zip([&fit.x0[v], &fit.x1[v]]) {
-                        let b = points_box_f64([*x]);
-                        e.0 = std::array::from_fn(|k| e.0[k].min(b.0[k]));
-                        e.1 = std::array::from_fn(|k| e.1[k].max(b.1[k]));
-                    }
+                    widen(&mut lo[0], &mut hi[0], &fit.x0[v]);
+                    widen(&mut lo[1], &mut hi[1], &fit.x1[v]);
                 }
             }
-            ends.push(end);
+            ends.push([0, 1].map(|e| (lo[e].map(f32_down), hi[e].map(f32_up))));
         }
         Self {
             h,

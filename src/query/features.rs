@@ -74,18 +74,29 @@ pub(crate) fn points_box<const N: usize>(p: [[f32; 3]; N], rounded: bool) -> Fea
     }
 }
 
-/// The closed box of `f64` points, rounded outward to `f32`.
+/// The closed box of `f64` points (finite: checked on input), rounded outward to `f32`.
 #[inline(always)]
 pub(crate) fn points_box_f64<const N: usize>(p: [[f64; 3]; N]) -> FeatureBox {
     let mut lo = p[0];
     let mut hi = p[0];
     for q in &p[1..] {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
+        widen(&mut lo, &mut hi, q);
     }
     (lo.map(f32_down), hi.map(f32_up))
+}
+
+/// Grows the box `[lo, hi]` to hold `q`. Plain comparisons, not `f64::min`/`max`: the
+/// points are finite, and the NaN handling of those costs more than the comparison.
+#[inline(always)]
+pub(crate) fn widen(lo: &mut [f64; 3], hi: &mut [f64; 3], q: &[f64; 3]) {
+    for k in 0..3 {
+        if q[k] < lo[k] {
+            lo[k] = q[k];
+        }
+        if q[k] > hi[k] {
+            hi[k] = q[k];
+        }
+    }
 }
 
 /// An edge (internal vertex indices) as its original indices, smaller first, and its
