@@ -1,6 +1,7 @@
 //! CCD over whole meshes ([`dhcd::self_ccd`], [`dhcd::ccd_pair`]): every colliding
 //! vertex-triangle and edge-edge pair equal to the brute force over every pair (the exact
-//! tests of `dhcd::ccd`), for every method, 1 and 2 threads, both modes, minimum distances;
+//! tests of `dhcd::ccd`), for every method, 1 and 2 threads, both modes, minimum distances,
+//! time limits 1 and 3/8;
 //! and every labelled pair of the real simulation steps through the whole pipeline.
 
 use dhcd::bv::BoundingVolume;
@@ -37,8 +38,9 @@ fn check_self<K: BoundingVolume>(
 ) {
     let h = Hierarchy::<K>::new(m, Options::default()).unwrap();
     let motion = Motion::new(x0, x1);
-    for &d in deltas {
-        let options = CcdOptions::new(1.0, d).unwrap();
+    // A time limit below 1 fits the walk's bounds up to it.
+    for (&d, t_max) in deltas.iter().flat_map(|d| [(d, 1.0), (d, 0.375)]) {
+        let options = CcdOptions::new(t_max, d).unwrap();
         let want = brute_force_self_ccd(m, motion, &options);
         for mode in [CcdMode::All, CcdMode::Earliest] {
             let want = match mode {
@@ -48,7 +50,10 @@ fn check_self<K: BoundingVolume>(
             for par in [Par::Seq, Par::Rayon(2)] {
                 let q = CcdQuery { options, mode };
                 let got = self_ccd_with(&h, motion, &q, &mut Workspace::default(), par).unwrap();
-                let what = format!("{what} {:?} delta={d} {mode:?} {par:?}", K::METHOD);
+                let what = format!(
+                    "{what} {:?} delta={d} t_max={t_max} {mode:?} {par:?}",
+                    K::METHOD
+                );
                 assert_same(&got, &want, &what);
             }
         }
@@ -68,8 +73,9 @@ fn check_pair<K: BoundingVolume>(
         Hierarchy::<K>::new(a, Options::default()).unwrap(),
         Hierarchy::<K>::new(b, Options::default()).unwrap(),
     );
-    for &d in deltas {
-        let options = CcdOptions::new(1.0, d).unwrap();
+    // A time limit below 1 fits the walk's bounds up to it.
+    for (&d, t_max) in deltas.iter().flat_map(|d| [(d, 1.0), (d, 0.375)]) {
+        let options = CcdOptions::new(t_max, d).unwrap();
         let want = brute_force_ccd(a, am, b, bm, &options);
         for mode in [CcdMode::All, CcdMode::Earliest] {
             let want = match mode {
@@ -80,7 +86,10 @@ fn check_pair<K: BoundingVolume>(
                 let q = CcdQuery { options, mode };
                 let got =
                     ccd_pair_with(&ha, am, &hb, bm, &q, &mut Workspace::default(), par).unwrap();
-                let what = format!("{what} {:?} delta={d} {mode:?} {par:?}", K::METHOD);
+                let what = format!(
+                    "{what} {:?} delta={d} t_max={t_max} {mode:?} {par:?}",
+                    K::METHOD
+                );
                 assert_same(&got, &want, &what);
             }
         }
