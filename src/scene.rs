@@ -1085,8 +1085,9 @@ fn step_size_of<K: BoundingVolume>(
     let (query, gap) = step::query_for(options, &moving, still, by);
     let (jobs, broad_phase_tests) = jobs_of(objects, boxes(), f32_up(query.options.min_distance));
     sweep_jobs(objects, &steps, &jobs, &mut sweeps, parallel);
-    // The gap walk's bounds over `[0, by]` only (see `contact::step`), for the objects in
-    // its jobs; its margin grown by their positions' rounding there.
+    // The gap walk's bounds over `[0, by]` only (see `contact::step`), fitted here once per
+    // object in its jobs rather than by `ccd::run` once per job (which then finds them fitted
+    // up to `by` and grows the margin by their rounding).
     let mut in_jobs = vec![false; objects.len()];
     for &(a, b) in &jobs {
         in_jobs[a] = true;

@@ -81,18 +81,29 @@ pub(crate) fn f32_up(x: f64) -> f32 {
     }
 }
 
+/// Grows the box `[lo, hi]` to hold `q`. Plain comparisons, not `f64::min`/`max`: the
+/// points are finite (checked on input), and the NaN handling of those costs more than the
+/// comparison.
+#[inline(always)]
+pub(crate) fn widen(lo: &mut [f64; 3], hi: &mut [f64; 3], q: &[f64; 3]) {
+    for k in 0..3 {
+        if q[k] < lo[k] {
+            lo[k] = q[k];
+        }
+        if q[k] > hi[k] {
+            hi[k] = q[k];
+        }
+    }
+}
+
 /// Node `n`'s box over the step: `[lo xyz, hi xyz]` of every region vertex at t0 and t1,
 /// rounded outward to `f32`.
 pub(crate) fn box_over_step(tree: &RegionTree, step: &Step, n: usize) -> [f32; 6] {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for v in tree.region_vertices(n) {
-        for p in [step.x0[v as usize], step.x1[v as usize]] {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
+        widen(&mut lo, &mut hi, &step.x0[v as usize]);
+        widen(&mut lo, &mut hi, &step.x1[v as usize]);
     }
     [
         f32_down(lo[0]),

@@ -41,8 +41,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{points_box_f64, widen, Candidates, FeatureBox, LeafEdges, LeafTriangles};
-use crate::bv::swept::{f32_down, f32_up, Step};
+use super::features::{points_box_f64, Candidates, FeatureBox, LeafEdges, LeafTriangles};
+use crate::bv::swept::{f32_down, f32_up, widen, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
 use crate::control::Budget;
@@ -604,8 +604,7 @@ pub(crate) fn earliest_bound(query: &CcdQuery) -> Option<AtomicU64> {
 /// In earliest mode, a walk whose best time of impact falls to `1 / RESTART_FACTOR` of its
 /// bounds' horizon (or below) stops and starts again on bounds fitted up to that time
 /// ([`Swept::until`]): where a contact is close, far fewer pairs meet over the start of the
-/// step than over all of it (a twentieth of the feature pairs on real frame steps whose
-/// first impact is near t0). The work before the restart is lost, so the horizon must have
+/// step than over all of it. The work before the restart is lost, so the horizon must have
 /// shrunk enough to pay for it.
 const RESTART_FACTOR: f64 = 8.0;
 

@@ -18,7 +18,7 @@ use pulp::Simd;
 
 use crate::counters::Counters;
 
-use crate::bv::swept::{f32_down, f32_up};
+use crate::bv::swept::{f32_down, f32_up, widen};
 use dhcd_kernels::overlap::{boxes_meet_with, BoxRows, MAX_BOX_ROW};
 
 pub(crate) type FeatureBox = ([f32; 3], [f32; 3]);
@@ -83,20 +83,6 @@ pub(crate) fn points_box_f64<const N: usize>(p: [[f64; 3]; N]) -> FeatureBox {
         widen(&mut lo, &mut hi, q);
     }
     (lo.map(f32_down), hi.map(f32_up))
-}
-
-/// Grows the box `[lo, hi]` to hold `q`. Plain comparisons, not `f64::min`/`max`: the
-/// points are finite, and the NaN handling of those costs more than the comparison.
-#[inline(always)]
-pub(crate) fn widen(lo: &mut [f64; 3], hi: &mut [f64; 3], q: &[f64; 3]) {
-    for k in 0..3 {
-        if q[k] < lo[k] {
-            lo[k] = q[k];
-        }
-        if q[k] > hi[k] {
-            hi[k] = q[k];
-        }
-    }
 }
 
 /// An edge (internal vertex indices) as its original indices, smaller first, and its
