@@ -137,6 +137,7 @@
 
 mod axis;
 mod exact;
+mod expansion;
 mod filter;
 mod interval;
 mod near;
