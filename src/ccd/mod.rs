@@ -100,10 +100,14 @@
 //! interval by a separating-axis test in interval-bounded floats; and, when all eight
 //! points share one coordinate exactly (motion in one axis plane, where `f` is
 //! identically 0 and the 3D predicate is the 2D one), contact certified at a time after
-//! every earlier piece was certified apart, which gives the time within `2^-40`. A sheet
-//! lying on a floor and sliding, folding flat or sliding over another sheet is decided
-//! there, but for contacts at a single instant (touching without entering) and at 0 or
-//! `t_max`. Only what neither filter decides goes to the exact path.
+//! every earlier piece was certified apart, which gives the time within `2^-40`. Touching
+//! at a single instant (without entering) is certified too: two points meeting along a
+//! line they share, at a root estimated in floats and certified in a window of `2^-41`;
+//! or exact contact at a time with few bits (1/2, 1, `k/16`) where the positions are
+//! floats (error-free transformations, `expansion.rs`), with every separation before it
+//! certified from its exact value there. A sheet lying on a floor and sliding, folding
+//! flat, collapsing onto a line or sliding over another sheet is decided there. Only what
+//! neither filter decides goes to the exact path.
 //!
 //! **Minimum distance `delta > 0`**: the same exact engine on the formula "distance <=
 //! delta": the vertex within delta of the face's plane with its foot in the

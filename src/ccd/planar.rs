@@ -26,14 +26,36 @@
 //!   grid lines of an axis-aligned sheet; other boundary contacts go to the exact path.
 //!
 //! **Earliest contact.** Touching at t = 0 is checked first (the positions are exact
-//! there). Then pieces of `[0, t_max]` are visited earliest first: a piece certified apart
-//! is skipped, another is halved, and a piece of width `<= 2^-40` not certified apart
-//! whose end `s1` is certainly in contact gives `Hit(s0)`: every earlier time is certified
-//! apart, so `s0 <= t* <= s1`. A piece starting at 0 or ending at `t_max` never gives a
-//! hit (a contact there is decided exactly, so `toi = 0` and `toi = t_max` stay exact
-//! answers), nor does a piece where neither certificate holds: `Unknown`, the exact path.
-//! Without exact coplanarity no contact can be certified, so the pieces stop at `2^-4`:
-//! the filter is then a cheap miss certificate for nearly coplanar motion.
+//! there: the float test, then the exact one). Then pieces of `[0, t_max]` are visited
+//! earliest first: a piece certified apart is skipped, another is halved, and a piece of
+//! width `<= 2^-40` not certified apart whose end `s1` is certainly in contact gives
+//! `Hit(s0)`: every earlier time is certified apart, so `s0 <= t* <= s1`. A piece starting
+//! at 0 or ending at `t_max` never gives such a hit (a contact there is decided exactly,
+//! so `toi = 0` and `toi = t_max` stay exact answers). Without exact coplanarity no
+//! contact can be certified, so the pieces stop at `2^-4`: the filter is then a cheap miss
+//! certificate for nearly coplanar motion.
+//!
+//! **Touching at one instant** (exact coplanarity). A sheet folding flat (its half on a
+//! line at t = 1/2), collapsing onto a line, or a vertex passing a corner along a grid
+//! line touches for one instant only: no float enclosure certifies that. At the first
+//! piece not certified apart, two certificates are tried before it is halved:
+//! - *Meeting points*: a vertex and a corner (or two endpoints) whose relative vector is
+//!   zero all step in one coordinate and changes sign in the other (linear in t) meet at
+//!   its root. The root is estimated in floats and certified inside a window of `2^-41`
+//!   (signs at both ends), with everything before the window certified apart: the
+//!   window's start is the time, whatever float the root is not.
+//! - *An exact instant*: at a time `c` with few bits (the simplest in the piece, then its
+//!   end), the positions `x0 + c (x1 - x0)` computed by error-free transformations
+//!   (`expansion.rs`; the instant is used only if every one is a float), the contact
+//!   decided exactly there (signs of 2D cross and dot products of float differences, by
+//!   expansions), and apart on `[s0, c)` certified for each separating quantity `Q` from
+//!   its exact value at `c`: `Q(t) = Q(c) + (c - t) L(t)` with `L` linear, whose sign at
+//!   both ends floats certify. Then `t* = c` exactly: the time 1/2 or 1 itself.
+//! A narrow last piece is signed from the exact positions at `t_max` the same way (a
+//! vertex stopping a hair short of a corner at t = 1), and coordinates (linear in t) by
+//! their exact signs at 0 and 1. What none of this decides goes to the exact path; the
+//! degenerate sheets of `tests` (fold, collapse, line, slide, slide2 on grids of 4, 6 and
+//! 8) never reach it.
 
 use super::expansion::{
     difference, lowest_bit, sign_of_two_products, two_product, two_sum, Exactly,
