@@ -86,11 +86,12 @@ const TINY: f64 = 9.332_636_185_032_189e-302; // 2^-1000
 #[derive(Clone, Copy)]
 struct Lin {
     d0: f64,
-    d1: f64,
     s: f64,
     mag: f64,
     zero: bool,
     zero0: bool,
+    /// The exact sign at t = 1 (that of the float difference `d1`).
+    sign1: i8,
 }
 
 impl Lin {
@@ -99,11 +100,11 @@ impl Lin {
         let (d0, d1) = (a0 - b0, a1 - b1);
         Lin {
             d0,
-            d1,
             s: d1 - d0,
             mag: (d0.abs() + d1.abs()) * (1.0 + U50),
             zero: a0 == b0 && a1 == b1,
             zero0: a0 == b0,
+            sign1: (d1 > 0.0) as i8 - (d1 < 0.0) as i8,
         }
     }
 
@@ -111,11 +112,10 @@ impl Lin {
     /// difference of two floats has the sign of the exact one, zero included).
     #[inline(always)]
     fn sign_at(&self, t: f64) -> i8 {
-        let exact = |d: f64| (d > 0.0) as i8 - (d < 0.0) as i8;
         if t == 0.0 {
-            exact(self.d0)
+            (self.d0 > 0.0) as i8 - (self.d0 < 0.0) as i8
         } else if t == 1.0 {
-            exact(self.d1)
+            self.sign1
         } else {
             Quad::linear(*self).sign_near(t, 0.0)
         }
@@ -559,6 +559,9 @@ impl Shape {
         s0: f64,
         s1: f64,
     ) -> Option<f64> {
+        if s1 <= s0 {
+            return None;
+        }
         let simplest = simplest_time(s0, s1);
         let times = [simplest, s1];
         let count = if simplest == s1 { 1 } else { 2 };
@@ -687,13 +690,15 @@ pub(crate) fn decide(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f6
         return Verdict::Miss;
     }
     // Touching at t = 0: the positions are exact there, so the exact test decides what
-    // the float one leaves open.
-    let touching_at_start = || {
-        shape.contact_near(0.0)
-            || Instant::new(x0, x1, axes, 0.0).is_some_and(|at| shape.contact_at(&at))
-    };
-    if plane && touching_at_start() {
-        return Verdict::Hit(0.0);
+    // the float one leaves open (and all of a query with `t_max = 0`).
+    if plane {
+        let start = Instant::new(x0, x1, axes, 0.0);
+        if shape.contact_near(0.0) || start.as_ref().is_some_and(|at| shape.contact_at(at)) {
+            return Verdict::Hit(0.0);
+        }
+        if t_max == 0.0 && start.is_some() {
+            return Verdict::Miss;
+        }
     }
     earliest_first(t_max, MAX_VISITS, |s0, s1, _| {
         let width = s1 - s0;
