@@ -51,6 +51,7 @@
 //!   expansions), and apart on `[s0, c)` certified for each separating quantity `Q` from
 //!   its exact value at `c`: `Q(t) = Q(c) + (c - t) L(t)` with `L` linear, whose sign at
 //!   both ends floats certify. Then `t* = c` exactly: the time 1/2 or 1 itself.
+//!
 //! A narrow last piece is signed from the exact positions at `t_max` the same way (a
 //! vertex stopping a hair short of a corner at t = 1), and coordinates (linear in t) by
 //! their exact signs at 0 and 1. What none of this decides goes to the exact path; the
