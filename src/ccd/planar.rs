@@ -619,18 +619,48 @@ impl Shape {
                     return None;
                 }
                 let estimate = -l.d0 / l.s;
-                let a = (estimate - MEETING_HALF_WIDTH).max(s0);
-                let b = (estimate + MEETING_HALF_WIDTH).min(s1);
-                let certified = a > 0.0
-                    && a < b
-                    && b - a <= ROOT_WIDTH
-                    && l.sign_at(a) == before
-                    && l.sign_at(b) == after
-                    && (a == s0 || self.apart_on(s0, a, None));
-                certified.then_some(a)
+                let certified = |(a, b): (f64, f64)| {
+                    a > 0.0
+                        && a < b
+                        && b - a <= ROOT_WIDTH
+                        && l.sign_at(a) == before
+                        && l.sign_at(b) == after
+                        && (a == s0 || self.apart_on(s0, a, None))
+                };
+                // First the narrowest piece of the walk's own halving that holds the
+                // estimate: pairs meeting at one instant then answer one time, the lower
+                // end the other filters and the exact path give (a multiple of 2^-40 for
+                // t_max = 1). Then, for a meeting too near that piece's ends, a window
+                // around the estimate.
+                let window = (
+                    (estimate - MEETING_HALF_WIDTH).max(s0),
+                    (estimate + MEETING_HALF_WIDTH).min(s1),
+                );
+                [piece_holding(s0, s1, estimate), window]
+                    .into_iter()
+                    .find(|&w| certified(w))
+                    .map(|(a, _)| a)
             })
         })
     }
+}
+
+/// The piece of width `<= 2^-40` that halving `[s0, s1]` as [`earliest_first`] does (the
+/// rounded midpoint) reaches around `t`.
+fn piece_holding(s0: f64, s1: f64, t: f64) -> (f64, f64) {
+    let (mut lo, mut hi) = (s0, s1);
+    while hi - lo > ROOT_WIDTH {
+        let mid = 0.5 * (lo + hi);
+        if !(lo < mid && mid < hi) {
+            break;
+        }
+        if t < mid {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    (lo, hi)
 }
 
 /// The time in `(s0, s1]` (`0 <= s0 < s1 <= 1`) with the fewest bits: the least multiple
