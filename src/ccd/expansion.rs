@@ -9,6 +9,8 @@
 //! products) a multiple of `2^-960` below `2^802`, and every intermediate sum of them is
 //! exact in f64 or has an exact error term: nothing is lost.
 
+use crate::distance::decompose;
+
 /// `a + b = s + e` exactly (Knuth's two-sum), for any finite `a`, `b` whose sum does not
 /// overflow.
 #[inline(always)]
@@ -42,16 +44,11 @@ pub(crate) fn two_product(a: f64, b: f64) -> (f64, f64) {
 /// `2^lowest_bit(x)`); `i32::MAX` for zero.
 #[inline(always)]
 pub(crate) fn lowest_bit(x: f64) -> i32 {
-    let bits = x.to_bits() & !(1u64 << 63);
-    if bits == 0 {
-        return i32::MAX;
-    }
-    let exponent = (bits >> 52) as i32;
-    let mantissa = bits & ((1u64 << 52) - 1);
-    if exponent == 0 {
-        -1074 + mantissa.trailing_zeros() as i32
+    let (m, e) = decompose(x);
+    if m == 0 {
+        i32::MAX
     } else {
-        exponent - 1075 + (mantissa | (1u64 << 52)).trailing_zeros() as i32
+        e + m.trailing_zeros() as i32
     }
 }
 
@@ -155,23 +152,8 @@ mod tests {
 
     /// `x` as an integer multiple of `2^-1100` (exact for every f64 of the tested range).
     fn big(x: f64) -> BigInt {
-        if x == 0.0 {
-            return BigInt::zero();
-        }
-        let bits = x.to_bits();
-        let exponent = ((bits >> 52) & 0x7ff) as i64;
-        let mantissa = bits & ((1u64 << 52) - 1);
-        let (m, e) = if exponent == 0 {
-            (mantissa, -1074)
-        } else {
-            (mantissa | (1u64 << 52), exponent - 1075)
-        };
-        let v = BigInt::from(m) << ((e + 1100) as usize);
-        if x < 0.0 {
-            -v
-        } else {
-            v
-        }
+        let (m, e) = decompose(x);
+        BigInt::from(m) << ((e + 1100) as usize)
     }
 
     fn sign(x: &BigInt) -> i8 {

@@ -571,9 +571,17 @@ impl Shape {
                 .is_some_and(|at| self.contact_at(&at) && self.apart_before(s0, &at))
         })
     }
-}
 
-impl Shape {
+    /// The relative vectors of the points that can meet: each corner of the face and the
+    /// vertex, or each endpoint of one edge and each of the other.
+    #[inline(always)]
+    fn point_pairs(&self) -> &[Rel] {
+        match self {
+            Shape::VertexFace { r, .. } => r,
+            Shape::EdgeEdge { r, .. } => r,
+        }
+    }
+
     /// A point of one feature certainly meets a point of the other at some time strictly
     /// inside `(a, b)`, given exact coplanarity: a vertex and a corner of the face, or two
     /// endpoints, whose relative vector is zero all step in one coordinate (structurally:
@@ -583,20 +591,11 @@ impl Shape {
     /// passing a corner along their line touches it for one instant, at a time no float
     /// need represent.
     fn meet_between(&self, a: f64, b: f64) -> bool {
-        let points: &[Rel] = match self {
-            Shape::VertexFace { r, .. } => r,
-            Shape::EdgeEdge { r, .. } => r,
-        };
-        points
+        self.point_pairs()
             .iter()
             .any(|r| (0..2).any(|k| r.l[1 - k].zero && r.l[k].sign_at(a) * r.l[k].sign_at(b) < 0))
     }
-}
 
-/// Half the window [`Shape::first_meeting`] puts around its estimate of a meeting.
-const MEETING_HALF_WIDTH: f64 = 2.273_736_754_432_320_6e-13; // 2^-42
-
-impl Shape {
     /// The first contact in the piece `[s0, s1]`, every earlier time certified apart, when
     /// it is two points meeting along a line they share ([`Shape::meet_between`]) at a
     /// time `t`: estimated in floats, then certified inside a window `(a, b)` of width
@@ -604,11 +603,7 @@ impl Shape {
     /// first contact is then in `[a, t]`, so `a` is within `2^-40` below it. Saves the
     /// forty halvings that narrow down to an instant no float represents.
     fn first_meeting(&self, s0: f64, s1: f64) -> Option<f64> {
-        let points: &[Rel] = match self {
-            Shape::VertexFace { r, .. } => r,
-            Shape::EdgeEdge { r, .. } => r,
-        };
-        points.iter().find_map(|r| {
+        self.point_pairs().iter().find_map(|r| {
             (0..2).find_map(|k| {
                 if !r.l[1 - k].zero {
                     return None;
@@ -644,6 +639,9 @@ impl Shape {
         })
     }
 }
+
+/// Half the window [`Shape::first_meeting`] puts around its estimate of a meeting.
+const MEETING_HALF_WIDTH: f64 = 2.273_736_754_432_320_6e-13; // 2^-42
 
 /// The piece of width `<= 2^-40` that halving `[s0, s1]` as [`earliest_first`] does (the
 /// rounded midpoint) reaches around `t`.
@@ -723,12 +721,16 @@ pub(crate) fn decide(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f6
     // Touching at t = 0: the positions are exact there, so the exact test decides what
     // the float one leaves open (and all of a query with `t_max = 0`).
     if plane {
-        let start = Instant::new(x0, x1, axes, 0.0);
-        if shape.contact_near(0.0) || start.as_ref().is_some_and(|at| shape.contact_at(at)) {
+        if shape.contact_near(0.0) {
             return Verdict::Hit(0.0);
         }
-        if t_max == 0.0 && start.is_some() {
-            return Verdict::Miss;
+        if let Some(start) = Instant::new(x0, x1, axes, 0.0) {
+            if shape.contact_at(&start) {
+                return Verdict::Hit(0.0);
+            }
+            if t_max == 0.0 {
+                return Verdict::Miss;
+            }
         }
     }
     earliest_first(t_max, MAX_VISITS, |s0, s1, _| {

@@ -463,6 +463,7 @@ pub(crate) fn gap_exceeds(a: &V<f64>, b: &V<f64>, d: f64) -> bool {
 // The exact path.
 
 /// `x = m 2^e` exactly (`m` an integer, `|m| < 2^53`, `e >= -1074`) for a finite `x`.
+#[inline]
 pub(crate) fn decompose(x: f64) -> (i64, i32) {
     let bits = x.to_bits();
     let e = ((bits >> 52) & 0x7ff) as i32;

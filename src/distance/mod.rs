@@ -104,6 +104,9 @@ mod arith;
 mod edge_edge;
 mod point_triangle;
 
+/// `x = m 2^e` of a finite f64, shared with the CCD's error-free arithmetic.
+pub(crate) use arith::decompose;
+
 /// Which sub-features of a point-triangle pair are closest: IPC's `PointTriangleDistanceType`
 /// (same order and numeric values). Edge `i` joins corners `i` and `i + 1 (mod 3)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
