@@ -14,19 +14,30 @@
 //! sliding past each other fast at a nearly constant distance (large `L`).
 //!
 //! **Search.** First the start: within at t = 0 means a contact at 0. Then pieces of
-//! `[0, t_max]` are visited earliest first (depth-first bisection), skipped when apart and
-//! split otherwise, down to width `2^-46`. Each piece is first tested the cheap way: the
-//! features' closest direction at the piece's end, in plain floats, is used as a fixed
-//! separating axis over the piece (`axis.rs`: the gap along a fixed axis is concave in t,
-//! so its values at the two ends bound it, with no margin for the motion); and a piece
-//! whose end is nearer than `delta` by that float estimate holds the contact, so it is split
-//! without trying the certificates that could not succeed. The Lipschitz tests above come
-//! next. At the first leaf `[lo, hi]` that is not apart, every time before `lo` is apart; if
-//! the distance is within `delta` at one of the points `lo + k 2^-44`, `k = 1..16`, the
-//! earliest contact lies in `[lo, lo + 2^-40]` and `lo` is returned (at most `2^-40` early,
-//! the exact path's tolerance). Otherwise (the distance touches `delta` without crossing it,
-//! or crosses it too slowly for floats to place within `2^-40`), the query is left to the
-//! exact path.
+//! `[0, t_max]` are visited earliest first, skipped when apart and split otherwise, down to
+//! width `2^-46`. Each piece is first tested the cheap way: the features' closest direction
+//! at the piece's end, in plain floats, is used as a fixed separating axis over the piece
+//! (`axis.rs`: the gap along a fixed axis is concave in t, so its values at the two ends
+//! bound it, with no margin for the motion). A piece whose end is nearer than `delta` by
+//! that float estimate holds the contact: it is split without trying the certificates that
+//! could not succeed, the first time at the float estimate `t` of the contact time (regula
+//! falsi on the float distance), `2^-41` before it, so that the piece before is apart by
+//! what the features close in `2^-41` and one piece of each side replaces the ~46 halvings
+//! down to the contact; later ones are halved. The Lipschitz tests above come next.
+//!
+//! **Answer.** When every time before `lo` is apart (the piece after the estimate's split,
+//! or the first leaf `[lo, hi]` that is not apart) and the distance is within `delta` at
+//! one of the points `lo + k 2^-44`, `k = 1..16`, the earliest contact lies in
+//! `[lo, lo + 2^-40]` and `lo` is returned (at most `2^-40` early, the exact path's
+//! tolerance); after an estimate, `t - 2^-44` instead when the piece up to it is apart too.
+//! Otherwise (the distance touches `delta` without crossing it, or crosses it too slowly
+//! for floats to place within `2^-40`), the query is left to the exact path.
+//!
+//! **Relative corners.** The interval tests and the float estimates see the corners
+//! relative to the first one as it moves (`x_i(t) - x_0(t)`, the same distances): their
+//! rounding is a few ulps of the features' separation, not of the coordinates. A feature a
+//! hundredth of the mesh's size approaching at a few `delta` per step is then placed within
+//! `2^-40`; enclosed at the coordinates' magnitude it was not, and took the exact path.
 //!
 //! Every test compares squared distances times a positive squared length with `delta^2`, so no
 //! division or square root is needed, and uses only these facts:
@@ -50,7 +61,7 @@
 //! (degenerate triangles and zero-length edges fall back to their corners).
 
 use super::axis;
-use super::filter::{moving, Verdict};
+use super::filter::Verdict;
 use super::interval::Iv;
 use super::pieces::{earliest_first, Piece};
 use super::ring::{self, Ring, V3};
@@ -65,6 +76,66 @@ const LEAF_WIDTH: f64 = 1.0 / (1u64 << 46) as f64;
 /// Spacing and number of the probes after the first leaf not apart: up to `2^-40`.
 const PROBE_STEP: f64 = 1.0 / (1u64 << 44) as f64;
 const PROBES: u32 = 16;
+
+/// The corners relative to the first one as it moves, `y_i(t) = x_i(t) - x_0(t) = (x0_i -
+/// x0_0) + t u_i`: every distance is the same, and the enclosures are as wide as a few
+/// ulps of the features' separation instead of the coordinates' magnitude. Far from the
+/// origin (a mesh of unit size, a `delta` and features a hundredth of it) that is what lets
+/// a slow approach be placed within `2^-40`.
+struct Relative {
+    y0: [V3<Iv>; 4],
+    u: [V3<Iv>; 4],
+    /// The same in plain floats, for the estimates that steer the search.
+    y0_float: [P3; 4],
+    u_float: [P3; 4],
+}
+
+impl Relative {
+    fn new(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> Self {
+        let y0: [V3<Iv>; 4] = std::array::from_fn(|i| {
+            std::array::from_fn(|k| {
+                if i == 0 {
+                    Iv::point(0.0)
+                } else {
+                    Iv::diff(x0[i][k], x0[0][k])
+                }
+            })
+        });
+        let u = std::array::from_fn(|i| {
+            std::array::from_fn(|k| {
+                if i == 0 {
+                    Iv::point(0.0)
+                } else {
+                    Iv::diff(x1[i][k], x1[0][k]).sub(&y0[i][k])
+                }
+            })
+        });
+        let y0_float = std::array::from_fn(|i| std::array::from_fn(|k| x0[i][k] - x0[0][k]));
+        let u_float = std::array::from_fn(|i| {
+            std::array::from_fn(|k| (x1[i][k] - x1[0][k]) - (x0[i][k] - x0[0][k]))
+        });
+        Relative {
+            y0,
+            u,
+            y0_float,
+            u_float,
+        }
+    }
+
+    /// The corners at `t` in plain floats (no guarantee: for estimates).
+    #[inline(always)]
+    fn estimate_at(&self, t: f64) -> [P3; 4] {
+        std::array::from_fn(|i| {
+            std::array::from_fn(|k| self.y0_float[i][k] + t * self.u_float[i][k])
+        })
+    }
+
+    /// Encloses the corners at every time of `t`.
+    #[inline(always)]
+    fn at(&self, t: Iv) -> [V3<Iv>; 4] {
+        std::array::from_fn(|i| std::array::from_fn(|k| self.y0[i][k].add(&t.mul(&self.u[i][k]))))
+    }
+}
 
 /// An upper bound on the speed at which the features' distance can change (see the module
 /// docs): the largest `|a_i' - b_j'|` over the corners of the two features.
@@ -93,7 +164,8 @@ pub(crate) fn decide(
     t_max: f64,
     delta: f64,
 ) -> Verdict {
-    let at = |t: f64| moving(x0, x1, Iv::point(t));
+    let relative = Relative::new(x0, x1);
+    let at = |t: f64| relative.at(Iv::point(t));
     if within(vf, &at(0.0), delta) {
         return Verdict::Hit(0.0);
     }
@@ -103,33 +175,63 @@ pub(crate) fn decide(
         .chain(x1)
         .flatten()
         .fold(0.0f64, |m, x| m.max(x.abs()));
-    earliest_first(t_max, MAX_PIECES, |lo, hi, last| {
-        // The features' closest direction at the piece's end, in plain floats: the
-        // separating axis of a piece before the contact; and, with the features nearer
-        // than delta there, the sign that this piece holds the contact, so the certificates
-        // below, which could not succeed, are skipped.
-        let (start, end) = (
-            axis::positions_at(x0, x1, lo),
-            axis::positions_at(x0, x1, hi),
+    // `[lo, hi]` certainly apart, `c` the features' closest direction at `hi` (plain
+    // floats): along `c` as a fixed axis; by the Lipschitz bound from `mid`; or with the
+    // corners enclosed over the whole piece, sharper where they slide past each other fast
+    // at a nearly constant distance (then the speed is large and the margin wide).
+    let apart_over = |lo: f64, hi: f64, c: &P3| {
+        let poses = (
+            &axis::positions_at(x0, x1, lo),
+            &axis::positions_at(x0, x1, hi),
         );
-        let c = closest_direction(vf, &end);
-        let splittable = hi - lo > LEAF_WIDTH && !last;
-        if splittable && ring_len2(&c) < delta * delta {
-            return Piece::Split;
-        }
-        if axis::apart_between(vf, (&start, &end), &c, delta, magnitude) {
-            return Piece::Apart;
+        if axis::apart_between(vf, poses, c, delta, magnitude) {
+            return true;
         }
         let mid = 0.5 * (lo + hi);
         // The largest distance from mid to an end, rounded up, times the speed.
         let reach = (mid - lo).max(hi - mid).next_up();
         let margin = (speed * reach).next_up();
-        if apart(vf, &at(mid), (delta + margin).next_up()) {
-            return Piece::Apart;
+        apart(vf, &at(mid), (delta + margin).next_up())
+            || apart(vf, &relative.at(Iv { lo, hi }), delta)
+    };
+    // The float estimate of the contact time, and the end of the piece split off before it
+    // (one estimate per query).
+    let mut estimate: Option<(f64, f64)> = None;
+    earliest_first(t_max, MAX_PIECES, |lo, hi, last| {
+        if let Some((t, a)) = estimate {
+            // Every time before `a` is apart: within at a probe after it puts the contact
+            // in [a, a + 2^-40]; closer when the piece up to one probe step before the
+            // estimate is apart too (the probe that was within is less than 2^-40 after
+            // that). Otherwise the piece is searched as any other.
+            if a == lo && within_soon(vf, &at, lo, t_max, delta) {
+                let closer = t - PROBE_STEP;
+                let c = closest_direction(vf, &relative.estimate_at(closer));
+                let from = if closer > lo && apart_over(lo, closer, &c) {
+                    closer
+                } else {
+                    lo
+                };
+                return Piece::Decided(Verdict::Hit(from));
+            }
         }
-        // The features enclosed over the whole piece: sharper where they slide past each
-        // other fast at a nearly constant distance (then L is large and the margin wide).
-        if apart(vf, &moving(x0, x1, Iv { lo, hi }), delta) {
+        // The features' closest direction at the piece's end: the separating axis of a
+        // piece before the contact; and, with the features nearer than delta there, the
+        // sign that this piece holds the contact, so the certificates, which could not
+        // succeed, are skipped: the piece is split at the float estimate of the contact
+        // time (the first time), or halved.
+        let c = closest_direction(vf, &relative.estimate_at(hi));
+        let splittable = hi - lo > LEAF_WIDTH && !last;
+        if splittable && ring_len2(&c) < delta * delta {
+            if estimate.is_none() {
+                if let Some(t) = crossing_estimate(vf, &relative, (lo, hi), delta) {
+                    let a = t - ESTIMATE_LEAD;
+                    estimate = Some((t, a));
+                    return Piece::SplitAt(a);
+                }
+            }
+            return Piece::Split;
+        }
+        if apart_over(lo, hi, &c) {
             return Piece::Apart;
         }
         if splittable {
@@ -137,18 +239,90 @@ pub(crate) fn decide(
         }
         // Everything before lo is apart: within at a probe puts the contact in
         // [lo, lo + 2^-40].
-        let within = (1..=PROBES).any(|k| {
-            let t = (lo + k as f64 * PROBE_STEP).min(t_max);
-            within(vf, &at(t), delta)
-        });
         Piece::Decided(
-            if within || touches_by(vf, x0, x1, t_max, lo + TOUCH_SLACK) {
+            if within_soon(vf, &at, lo, t_max, delta)
+                || touches_by(vf, x0, x1, t_max, lo + TOUCH_SLACK)
+            {
                 Verdict::Hit(lo)
             } else {
                 Verdict::Unknown
             },
         )
     })
+}
+
+/// The features certainly within `delta` at one of the probes `lo + k 2^-44`, `k = 1..16`
+/// (clamped to `t_max`), the latest first: past a contact the distance falls below
+/// `delta` by more the later the probe, so the latest is the likeliest to certify. `at`:
+/// the enclosure of the corners at a time.
+fn within_soon(
+    vf: bool,
+    at: &impl Fn(f64) -> [V3<Iv>; 4],
+    lo: f64,
+    t_max: f64,
+    delta: f64,
+) -> bool {
+    (1..=PROBES).rev().any(|k| {
+        let t = (lo + k as f64 * PROBE_STEP).min(t_max);
+        within(vf, &at(t), delta)
+    })
+}
+
+/// How far before the estimated contact time the piece searched first ends: the probes
+/// after it reach `2^-41` past the estimate, and the piece before it is apart by the
+/// distance the features close in `2^-41`, well above the axis test's rounding bound for
+/// all but the slowest approaches.
+const ESTIMATE_LEAD: f64 = 1.0 / (1u64 << 41) as f64;
+
+/// Most evaluations of the distance by [`crossing_estimate`].
+const ESTIMATE_STEPS: u32 = 48;
+
+/// The last time of `[lo, hi]` at which the features' distance, computed in plain floats,
+/// is still above `delta`, when it is at `lo` and below at `hi` (no guarantee: the
+/// estimate only places the pieces the certificates then test). Regula falsi with the
+/// Illinois halving on `|c(t)|^2 - delta^2`, `c` the closest direction, down to a bracket
+/// of a few ulps of `hi`.
+fn crossing_estimate(
+    vf: bool,
+    relative: &Relative,
+    (mut lo, mut hi): (f64, f64),
+    delta: f64,
+) -> Option<f64> {
+    let dd = delta * delta;
+    let g = |t: f64| ring_len2(&closest_direction(vf, &relative.estimate_at(t))) - dd;
+    let (mut g_lo, mut g_hi) = (g(lo), g(hi));
+    if !(g_lo > 0.0 && g_hi <= 0.0) {
+        return None;
+    }
+    // The side kept twice in a row has its value halved (Illinois), so the bracket shrinks
+    // at both ends.
+    let mut kept = 0i8;
+    for _ in 0..ESTIMATE_STEPS {
+        if hi - lo <= 4.0 * f64::EPSILON * hi {
+            break;
+        }
+        let secant = hi - g_hi * (hi - lo) / (g_hi - g_lo);
+        let t = if secant > lo && secant < hi {
+            secant
+        } else {
+            0.5 * (lo + hi)
+        };
+        let value = g(t);
+        if value > 0.0 {
+            (lo, g_lo) = (t, value);
+            if kept == -1 {
+                g_hi *= 0.5;
+            }
+            kept = -1;
+        } else {
+            (hi, g_hi) = (t, value);
+            if kept == 1 {
+                g_lo *= 0.5;
+            }
+            kept = 1;
+        }
+    }
+    Some(lo)
 }
 
 type P3 = [f64; 3];
@@ -458,4 +632,149 @@ fn beside(p: &V3<Iv>, u: &V3<Iv>, q0: &V3<Iv>, q1: &V3<Iv>, dd: Iv) -> bool {
     let (h0, h1) = (ring::dot(&r0, &n), ring::dot(&r1, &n));
     let same_side = (h0.neg() && h1.neg()) || (h0.pos() && h1.pos());
     same_side && excess(h0, n2, dd).pos() && excess(h1, n2, dd).pos()
+}
+
+#[cfg(test)]
+mod tests {
+    //! Slow approaches far from the origin are decided in floats, at the exact path's time:
+    //! queries of a real frame step that reached the exact path while the corners were
+    //! enclosed at the coordinates' magnitude, and random ones built the same way.
+    use super::*;
+    use crate::ccd::exact::{self, Kind};
+    use crate::ccd::TOI_TOLERANCE;
+
+    type Q = [[f64; 3]; 4];
+
+    /// The filter's verdict is a decision, the exact path's (`Miss` for none), within the
+    /// tolerance of its time.
+    fn decided_as_exact(vf: bool, x0: &Q, x1: &Q, t_max: f64, delta: f64) -> Verdict {
+        let verdict = decide(vf, x0, x1, t_max, delta);
+        let kind = if vf { Kind::VertexFace } else { Kind::EdgeEdge };
+        let exact = exact::solve(kind, x0, x1, t_max, delta, &|| false).expect("not stopped");
+        let what = format!("vf {vf} delta {delta} t_max {t_max}: {x0:?} -> {x1:?}");
+        match (verdict, exact) {
+            (Verdict::Miss, None) => {}
+            (Verdict::Hit(t), Some(e)) => {
+                assert!((t - e).abs() <= TOI_TOLERANCE, "{what}: {t} vs exact {e}")
+            }
+            (v, e) => panic!("{what}: filter {v:?}, exact {e:?}"),
+        }
+        verdict
+    }
+
+    #[test]
+    fn slow_approaches_of_a_real_frame_are_decided_in_floats() {
+        // armadillo-rollers 326 -> 327 at min distance 1e-3, scaled to unit magnitude (as the
+        // filter sees them): the distance crosses delta at about 2 delta per step.
+        let cases: [(bool, f64, Q, Q); 3] = [
+            (
+                false,
+                2e-3,
+                [
+                    [0.618414463888342, 0.990193255021748, 0.24726471886623],
+                    [0.412274366990376, 1.082475830582516, 0.1556668167611716],
+                    [0.516725481266468, 1.055608282793246, 0.1760532661702556],
+                    [0.507544081271968, 1.035855010456678, 0.1989701828255146],
+                ],
+                [
+                    [0.618414319459444, 0.98124775341931, 0.261300787881548],
+                    [0.412273470324424, 1.068846034870276, 0.1652127900679392],
+                    [0.393683607516584, 1.090360793156924, 0.151214894076181],
+                    [0.39025670508451, 1.064779035203344, 0.1676679903703326],
+                ],
+            ),
+            (
+                false,
+                2e-3,
+                [
+                    [0.24289080134961, 1.0576164263263, 0.16694273984902],
+                    [0.217983405700336, 1.08235341026487, 0.1123143124984568],
+                    [0.239724438607748, 1.086195082542274, 0.1339795230738196],
+                    [0.223306300369366, 1.06032300778678, 0.134644539200551],
+                ],
+                [
+                    [0.1146578226791426, 1.052457500932024, 0.1617257502746522],
+                    [0.088922647501674, 1.04879612342285, 0.131286870971811],
+                    [0.1157995885678746, 1.10670571835424, 0.1048487273593944],
+                    [0.1028152455496084, 1.08655606827778, 0.113789020547906],
+                ],
+            ),
+            (
+                true,
+                4e-3,
+                [
+                    [0.419404090990108, 1.607707679191556, 0.95917875347616],
+                    [0.3883508897377236, 1.6098943862948, 0.90556578848246],
+                    [0.3920529777873988, 1.623343066441316, 0.888245224295756],
+                    [0.468144096882672, 1.627085217561644, 1.021063642434184],
+                ],
+                [
+                    [0.499205258002508, 1.661709273550812, 1.053515209469012],
+                    [0.448035998612544, 1.636296830757752, 1.017332260588852],
+                    [0.42453075663212, 1.63997274307486, 0.983507830176852],
+                    [0.546465536564676, 1.691746623376804, 1.098291825581668],
+                ],
+            ),
+        ];
+        for (vf, delta, x0, x1) in &cases {
+            let verdict = decided_as_exact(*vf, x0, x1, 1.0, *delta);
+            assert!(matches!(verdict, Verdict::Hit(t) if t > 0.0), "{verdict:?}");
+        }
+    }
+
+    #[test]
+    fn slow_random_approaches_far_from_the_origin_are_decided_in_floats() {
+        // Features a ten-thousandth of the coordinates' magnitude, the second one starting
+        // `2.5-4.5 delta` from the first along a random direction and closing in at a few
+        // delta per step (with a slight random drift): the distance crosses delta inside
+        // the step, slowly next to the coordinates' rounding.
+        let mut state = 7u64;
+        let mut unit =
+            || (crate::shapes::splitmix64(&mut state) >> 11) as f64 / (1u64 << 53) as f64;
+        let (mut hits, mut total) = (0, 0);
+        for n in 0..64 {
+            let vf = n % 2 == 0;
+            let delta = 4e-5;
+            let origin = [1.3 + 0.3 * unit(), 1.1 + 0.5 * unit(), 0.6 + 0.3 * unit()];
+            let mut dir = [unit() - 0.5, unit() - 0.5, unit() - 0.5];
+            let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
+            dir = dir.map(|d| d / len);
+            let gap = (2.5 + 2.0 * unit()) * delta;
+            let close = (3.0 + 2.0 * unit()) * delta;
+            let split = if vf { 1 } else { 2 };
+            let mut x0: Q = [[0.0; 3]; 4];
+            let mut x1: Q = [[0.0; 3]; 4];
+            for (i, (p, q)) in x0.iter_mut().zip(x1.iter_mut()).enumerate() {
+                // The first feature around the origin (a point, or an edge across `dir`),
+                // the second beyond the gap (a triangle, or an edge), both small.
+                let jitter: [f64; 3] = std::array::from_fn(|_| 2e-4 * (unit() - 0.5));
+                let jitter = if i < split {
+                    if vf {
+                        [0.0; 3]
+                    } else {
+                        jitter
+                    }
+                } else {
+                    jitter
+                };
+                let along = |k: usize| {
+                    // Project the jitter off `dir` so the features face each other.
+                    let j: f64 = (0..3).map(|c| jitter[c] * dir[c]).sum();
+                    jitter[k] - j * dir[k]
+                };
+                let offset = if i < split { 0.0 } else { gap };
+                let drift: [f64; 3] = std::array::from_fn(|_| 1e-5 * (unit() - 0.5));
+                for k in 0..3 {
+                    p[k] = origin[k] + along(k) + offset * dir[k];
+                    q[k] = p[k] + drift[k] - if i < split { 0.0 } else { close * dir[k] };
+                }
+            }
+            total += 1;
+            if matches!(decided_as_exact(vf, &x0, &x1, 1.0, delta), Verdict::Hit(t) if t > 0.0) {
+                hits += 1;
+            }
+        }
+        // Most come within delta inside the step (the rest never do, or start within it).
+        assert!(hits * 2 > total, "{hits} of {total}");
+    }
 }

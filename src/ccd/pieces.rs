@@ -15,6 +15,9 @@ pub(crate) enum Piece {
     Apart,
     /// Undecided: visit its two halves (or `Unknown` when it cannot be halved).
     Split,
+    /// Undecided: visit `[lo, a]`, then `[a, hi]` (halved instead unless `lo < a < hi`),
+    /// `a` placed by an estimate of the contact time.
+    SplitAt(f64),
     /// The query's verdict.
     Decided(Verdict),
 }
@@ -44,8 +47,13 @@ pub(crate) fn earliest_first(
         match visit(lo, hi, last) {
             Piece::Apart => {}
             Piece::Decided(v) => return v,
-            Piece::Split if last => return Verdict::Unknown,
-            Piece::Split => {
+            Piece::SplitAt(a) if lo < a && a < hi && n + 2 <= MAX_DEPTH => {
+                stack[n] = (a, hi);
+                stack[n + 1] = (lo, a);
+                n += 2;
+            }
+            Piece::Split | Piece::SplitAt(_) if last => return Verdict::Unknown,
+            Piece::Split | Piece::SplitAt(_) => {
                 stack[n] = (mid, hi);
                 stack[n + 1] = (lo, mid);
                 n += 2;
