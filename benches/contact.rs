@@ -11,7 +11,10 @@
 //!   there (else one line says they are skipped);
 //! - procedural 40 x 40 sheets (3,200 triangles), always: a wavy sheet moving a small step,
 //!   the same sheet folded over itself with its layers closing in, and a flat sheet sliding
-//!   in its own plane (coplanar all step: decided by the planar filter of `src/ccd`).
+//!   in its own plane (coplanar all step: decided by the planar filter of `src/ccd`);
+//! - the degenerate motions of `../shared/data/degenerate/` on a 16 x 16 sheet, always:
+//!   `fold-16`, `collapse-16`, `line-16` (thousands of pairs tied at the earliest impact
+//!   and at the step size).
 //!
 //! Ids: `contact/<query>/<case>`, `<query>` one of `contact_set`, `proximity`, `gradients`,
 //! `hessians`, `step_size`, `earliest`. The setup checks what it times (the step size is in
@@ -69,7 +72,7 @@ fn sheets() -> Vec<Case> {
         .collect();
     let mesh =
         |x: &[[f64; 3]]| Mesh::new_f64(x.to_vec(), rest.triangles().to_vec()).expect("a sheet");
-    vec![
+    let mut cases = vec![
         Case {
             name: "wavy-sheet".into(),
             rest: mesh(&wavy(0.0)),
@@ -91,7 +94,49 @@ fn sheets() -> Vec<Case> {
             x1: slid,
             step_size: true,
         },
-    ]
+    ];
+    cases.extend(degenerate_sheets());
+    cases
+}
+
+/// The degenerate motions of `../shared/data/degenerate/sheets.py` on a 16 x 16 sheet of the
+/// unit square (512 triangles): the right half folding flat onto the left (`x -> 1 - x`),
+/// the right half collapsing onto the line `x = 0.5`, the whole sheet collapsing onto the x
+/// axis. Every feature stays in the plane z = 0 (the planar filter), and thousands of pairs
+/// tie at the earliest impact and at the step size (the minimum-distance filter at each
+/// pair's gap).
+fn degenerate_sheets() -> Vec<Case> {
+    let n = 16;
+    let rest = grid(n, n, 1.0 / n as f32, [0.0; 3]);
+    let x0 = f64s(rest.positions());
+    let moved = |motion: fn([f64; 3]) -> [f64; 3]| x0.iter().map(|&p| motion(p)).collect();
+    let motions: [(&str, Vec<[f64; 3]>); 3] = [
+        (
+            "fold",
+            moved(|p| {
+                if p[0] > 0.5 {
+                    [1.0 - p[0], p[1], p[2]]
+                } else {
+                    p
+                }
+            }),
+        ),
+        (
+            "collapse",
+            moved(|p| if p[0] > 0.5 { [0.5, p[1], p[2]] } else { p }),
+        ),
+        ("line", moved(|p| [p[0], 0.0, p[2]])),
+    ];
+    motions
+        .into_iter()
+        .map(|(name, x1)| Case {
+            name: format!("{name}-16"),
+            rest: Mesh::new_f64(x0.clone(), rest.triangles().to_vec()).expect("a sheet"),
+            x0: x0.clone(),
+            x1,
+            step_size: true,
+        })
+        .collect()
 }
 
 fn real_frames() -> Vec<Case> {
