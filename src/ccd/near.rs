@@ -13,31 +13,37 @@
 //! tested with every corner enclosed over the whole piece, which is sharper for features
 //! sliding past each other fast at a nearly constant distance (large `L`).
 //!
-//! **Search.** First the start: within at t = 0 means a contact at 0. Then pieces of
+//! **Search.** First the start: within at t = 0 (tested where the float distance there is
+//! at most `delta (1 + 2^-21)`) means a contact at 0. Then pieces of
 //! `[0, t_max]` are visited earliest first, skipped when apart and split otherwise, down to
 //! width `2^-46`. Each piece is first tested the cheap way: the features' closest direction
 //! at the piece's end, in plain floats, is used as a fixed separating axis over the piece
 //! (`axis.rs`: the gap along a fixed axis is concave in t, so its values at the two ends
 //! bound it, with no margin for the motion). A piece whose end is nearer than `delta` by
 //! that float estimate holds the contact: it is split without trying the certificates that
-//! could not succeed, the first time at the float estimate `t` of the contact time (regula
-//! falsi on the float distance), `2^-41` before it, so that the piece before is apart by
-//! what the features close in `2^-41` and one piece of each side replaces the ~46 halvings
-//! down to the contact; later ones are halved. The Lipschitz tests above come next.
+//! could not succeed: once per query (at the first such piece whose start is farther than
+//! `delta` in floats) at the float estimate `t` of the contact time (regula falsi on the
+//! float distance), `2^-41` before it, so that the piece before is apart by what the
+//! features close in `2^-41` and one piece of each side replaces the ~46 halvings down to
+//! the contact; otherwise halved. The Lipschitz tests above come next.
 //!
 //! **Answer.** When every time before `lo` is apart (the piece after the estimate's split,
 //! or the first leaf `[lo, hi]` that is not apart) and the distance is within `delta` at
 //! one of the points `lo + k 2^-44`, `k = 1..16`, the earliest contact lies in
 //! `[lo, lo + 2^-40]` and `lo` is returned (at most `2^-40` early, the exact path's
-//! tolerance); after an estimate, `t - 2^-44` instead when the piece up to it is apart too.
+//! tolerance); after an estimate, `t - 2^-44` instead when the piece up to it is apart too
+//! (the probes are tried once at the estimate's split).
 //! Otherwise (the distance touches `delta` without crossing it, or crosses it too slowly
 //! for floats to place within `2^-40`), the query is left to the exact path.
 //!
 //! **Relative corners.** The interval tests and the float estimates see the corners
 //! relative to the first one as it moves (`x_i(t) - x_0(t)`, the same distances): their
-//! rounding is a few ulps of the features' separation, not of the coordinates. A feature a
-//! hundredth of the mesh's size approaching at a few `delta` per step is then placed within
-//! `2^-40`; enclosed at the coordinates' magnitude it was not, and took the exact path.
+//! rounding is a few ulps of the features' extent (each corner's distance from the first),
+//! not of the coordinates. A feature a hundredth of the mesh's size approaching at a few
+//! `delta` per step is then placed within `2^-40`; enclosed at the coordinates' magnitude
+//! it was not, and took the exact path. The fixed-axis test (`axis.rs`) still rounds at the
+//! coordinates' magnitude, which is what bounds how close before the estimate its piece
+//! can end ([`ESTIMATE_LEAD`]).
 //!
 //! Every test compares squared distances times a positive squared length with `delta^2`, so no
 //! division or square root is needed, and uses only these facts:
@@ -73,13 +79,14 @@ const MAX_PIECES: u32 = 4096;
 
 /// Width of the narrowest pieces.
 const LEAF_WIDTH: f64 = 1.0 / (1u64 << 46) as f64;
-/// Spacing and number of the probes after the first leaf not apart: up to `2^-40`.
+/// Spacing and number of the probes after the first leaf not apart, or after the split at
+/// the estimate: up to `2^-40`.
 const PROBE_STEP: f64 = 1.0 / (1u64 << 44) as f64;
 const PROBES: u32 = 16;
 
 /// The corners relative to the first one as it moves, `y_i(t) = x_i(t) - x_0(t) = (x0_i -
 /// x0_0) + t u_i`: every distance is the same, and the enclosures are as wide as a few
-/// ulps of the features' separation instead of the coordinates' magnitude. Far from the
+/// ulps of the features' extent instead of the coordinates' magnitude. Far from the
 /// origin (a mesh of unit size, a `delta` and features a hundredth of it) that is what lets
 /// a slow approach be placed within `2^-40`.
 struct Relative {
@@ -155,7 +162,7 @@ fn max_relative_speed(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> f64 {
 }
 
 /// The verdict for the pair (`vf`: vertex-face, else edge-edge) coming within `delta > 0`
-/// during `[0, t_max]`: `Miss`, `Hit(lo)` with the earliest contact in `[lo, lo + 2^-40]`, or
+/// during `[0, t_max]`: `Miss`, `Hit(t)` with the earliest contact in `[t, t + 2^-40]`, or
 /// `Unknown`.
 pub(crate) fn decide(
     vf: bool,
@@ -166,8 +173,10 @@ pub(crate) fn decide(
 ) -> Verdict {
     let relative = Relative::new(x0, x1);
     let at = |t: f64| relative.at(Iv::point(t));
-    // Within at the start, tried only where the float distance is not clearly above delta
-    // (a skipped contact at 0 is still found, at the first leaf).
+    // Within at the start, tried only where the float distance is not clearly above delta.
+    // A contact at 0 skipped by a float error larger than that (large features against a
+    // tiny delta, nearly parallel edges) is still never missed: no piece holding 0 is
+    // certified apart, so the first leaf answers `Hit(0)` or leaves it to the exact path.
     let start = ring_len2(&closest_direction(vf, &relative.estimate_at(0.0)));
     if start <= delta * delta * NEAR_START && within(vf, &at(0.0), delta) {
         return Verdict::Hit(0.0);
@@ -198,14 +207,19 @@ pub(crate) fn decide(
             || apart(vf, &relative.at(Iv { lo, hi }), delta)
     };
     // The float estimate of the contact time, and the end of the piece split off before it
-    // (one estimate per query).
+    // (one estimate per query); `probed`: its probes were tried.
     let mut estimate: Option<(f64, f64)> = None;
+    let mut probed = false;
     earliest_first(t_max, MAX_PIECES, |lo, hi, last| {
-        if let Some((t, a)) = estimate {
+        if let (Some((t, a)), false) = (estimate, probed) {
             // Every time before `a` is apart: within at a probe after it puts the contact
             // in [a, a + 2^-40]; closer when the piece up to one probe step before the
             // estimate is apart too (the probe that was within is less than 2^-40 after
-            // that). Otherwise the piece is searched as any other.
+            // that). Otherwise the piece is searched as any other (its first halves start
+            // at `a` too: the probes are not tried again).
+            if a == lo {
+                probed = true;
+            }
             if a == lo && within_soon(vf, &at, lo, t_max, delta) {
                 let closer = t - PROBE_STEP;
                 let c = closest_direction(vf, &relative.estimate_at(closer));
@@ -221,7 +235,7 @@ pub(crate) fn decide(
         // piece before the contact; and, with the features nearer than delta there, the
         // sign that this piece holds the contact, so the certificates, which could not
         // succeed, are skipped: the piece is split at the float estimate of the contact
-        // time (the first time), or halved.
+        // time (once per query), or halved.
         let c = closest_direction(vf, &relative.estimate_at(hi));
         let splittable = hi - lo > LEAF_WIDTH && !last;
         if splittable && ring_len2(&c) < delta * delta {
@@ -277,8 +291,9 @@ fn within_soon(
 /// all but the slowest approaches.
 const ESTIMATE_LEAD: f64 = 1.0 / (1u64 << 41) as f64;
 
-/// `1 + 2^-20`: a squared float distance at t = 0 above `delta^2` times this is taken as
-/// apart there without the interval test (far wider than the floats' error).
+/// `1 + 2^-20`: a squared float distance at t = 0 above `delta^2` times this skips the
+/// interval test for a contact at 0 (wider than the float error of features not far larger
+/// than `delta`; where it is not, the contact is still found, at the first leaf).
 const NEAR_START: f64 = 1.000_000_953_674_316_4;
 
 /// Most evaluations of the distance by [`crossing_estimate`].

@@ -1,12 +1,14 @@
 //! The one walk over time pieces that the interval filters share (`near.rs`, `planar.rs`):
-//! pieces of `[0, t_max]` visited earliest first, each certified apart, halved, or decided.
+//! pieces of `[0, t_max]` visited earliest first, each certified apart, halved, split at a
+//! point, or decided.
 //! Visiting earliest first is what lets a filter read a contact time off the first piece
 //! it cannot certify apart: every earlier time was.
 
 use super::filter::Verdict;
 
-/// Most halvings: above the 47 that a piece of `[0, 1]` narrower than `2^-46` needs (the
-/// midpoints of float endpoints are exact or rounded between them).
+/// Most splits in a row: above the 47 halvings that a piece of `[0, 1]` narrower than `2^-46`
+/// needs (the midpoints of float endpoints are exact or rounded between them), plus a
+/// split at a point.
 const MAX_DEPTH: usize = 64;
 
 /// What a filter says of one piece `[lo, hi]`.
@@ -15,8 +17,9 @@ pub(crate) enum Piece {
     Apart,
     /// Undecided: visit its two halves (or `Unknown` when it cannot be halved).
     Split,
-    /// Undecided: visit `[lo, a]`, then `[a, hi]` (halved instead unless `lo < a < hi`),
-    /// `a` placed by an estimate of the contact time.
+    /// Undecided: visit `[lo, a]`, then `[a, hi]`, `a` placed by an estimate of the contact
+    /// time; halved instead unless `lo < a < hi` and the depth bound allows (`Unknown` when
+    /// it cannot be halved either).
     SplitAt(f64),
     /// The query's verdict.
     Decided(Verdict),
