@@ -132,7 +132,7 @@
 //! crosses it too slowly for floats to place within `2^-40`, go to the exact path. On a
 //! folding 8 x 8 sheet with `delta = 0.004` (1,065 colliding pairs of 3,581 tested) none
 //! reaches it; on armadillo-rollers 326 -> 327 with `delta = 0.001` (68,387 colliding
-//! pairs), 16 do.
+//! pairs), 19 do.
 
 //! # Limits
 //!
