@@ -182,11 +182,7 @@ pub(crate) fn decide(
         return Verdict::Hit(0.0);
     }
     let speed = max_relative_speed(vf, x0, x1);
-    let magnitude = x0
-        .iter()
-        .chain(x1)
-        .flatten()
-        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let magnitude = super::max_magnitude(x0, x1);
     // `[lo, hi]` certainly apart, `c` the features' closest direction at `hi` (plain
     // floats): along `c` as a fixed axis; by the Lipschitz bound from `mid`; or with the
     // corners enclosed over the whole piece, sharper where they slide past each other fast
@@ -219,16 +215,16 @@ pub(crate) fn decide(
             // at `a` too: the probes are not tried again).
             if a == lo {
                 probed = true;
-            }
-            if a == lo && within_soon(vf, &at, lo, t_max, delta) {
-                let closer = t - PROBE_STEP;
-                let c = closest_direction(vf, &relative.estimate_at(closer));
-                let from = if closer > lo && apart_over(lo, closer, &c) {
-                    closer
-                } else {
-                    lo
-                };
-                return Piece::Decided(Verdict::Hit(from));
+                if within_soon(vf, &at, lo, t_max, delta) {
+                    let closer = t - PROBE_STEP;
+                    let c = closest_direction(vf, &relative.estimate_at(closer));
+                    let from = if closer > lo && apart_over(lo, closer, &c) {
+                        closer
+                    } else {
+                        lo
+                    };
+                    return Piece::Decided(Verdict::Hit(from));
+                }
             }
         }
         // The features' closest direction at the piece's end: the separating axis of a
@@ -770,15 +766,7 @@ mod tests {
                 // The first feature around the origin (a point, or an edge across `dir`),
                 // the second beyond the gap (a triangle, or an edge), both small.
                 let jitter: [f64; 3] = std::array::from_fn(|_| 2e-4 * (unit() - 0.5));
-                let jitter = if i < split {
-                    if vf {
-                        [0.0; 3]
-                    } else {
-                        jitter
-                    }
-                } else {
-                    jitter
-                };
+                let jitter = if vf && i < split { [0.0; 3] } else { jitter };
                 let along = |k: usize| {
                     // Project the jitter off `dir` so the features face each other.
                     let j: f64 = (0..3).map(|c| jitter[c] * dir[c]).sum();

@@ -47,21 +47,16 @@ pub(crate) fn earliest_first(
         }
         let mid = 0.5 * (lo + hi);
         let last = n + 2 > MAX_DEPTH || !(lo < mid && mid < hi);
-        match visit(lo, hi, last) {
-            Piece::Apart => {}
+        let at = match visit(lo, hi, last) {
+            Piece::Apart => continue,
             Piece::Decided(v) => return v,
-            Piece::SplitAt(a) if lo < a && a < hi && n + 2 <= MAX_DEPTH => {
-                stack[n] = (a, hi);
-                stack[n + 1] = (lo, a);
-                n += 2;
-            }
+            Piece::SplitAt(a) if lo < a && a < hi && n + 2 <= MAX_DEPTH => a,
             Piece::Split | Piece::SplitAt(_) if last => return Verdict::Unknown,
-            Piece::Split | Piece::SplitAt(_) => {
-                stack[n] = (mid, hi);
-                stack[n + 1] = (lo, mid);
-                n += 2;
-            }
-        }
+            Piece::Split | Piece::SplitAt(_) => mid,
+        };
+        stack[n] = (at, hi);
+        stack[n + 1] = (lo, at);
+        n += 2;
     }
     Verdict::Miss
 }
