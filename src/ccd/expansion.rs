@@ -10,35 +10,7 @@
 //! exact in f64 or has an exact error term: nothing is lost.
 
 use crate::distance::decompose;
-
-/// `a + b = s + e` exactly (Knuth's two-sum), for any finite `a`, `b` whose sum does not
-/// overflow.
-#[inline(always)]
-pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    let bb = s - a;
-    let e = (a - (s - bb)) + (b - bb);
-    (s, e)
-}
-
-/// Dekker's split of `a` into two halves of at most 26 significant bits each.
-#[inline(always)]
-fn split(a: f64) -> (f64, f64) {
-    let c = 134_217_729.0 * a; // 2^27 + 1
-    let hi = c - (c - a);
-    (hi, a - hi)
-}
-
-/// `a b = p + e` exactly (Dekker's two-product), when `|a|, |b| < 2^996` and the partial
-/// products do not underflow (the lowest set bits of `a` and `b` sum to `-1074` or more).
-#[inline(always)]
-pub(crate) fn two_product(a: f64, b: f64) -> (f64, f64) {
-    let p = a * b;
-    let (ah, al) = split(a);
-    let (bh, bl) = split(b);
-    let e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
-    (p, e)
-}
+pub(crate) use crate::distance::{two_product, two_sum};
 
 /// The exponent of the lowest set bit of a nonzero finite `x` (`x` is a multiple of
 /// `2^lowest_bit(x)`); `i32::MAX` for zero.

@@ -47,6 +47,129 @@ impl Ring for BigInt {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Error-free transformations, and the checked float ring.
+
+/// `a + b = s + e` exactly (Knuth's two-sum), for any finite `a`, `b` whose sum does not
+/// overflow.
+#[inline(always)]
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    let e = (a - (s - bb)) + (b - bb);
+    (s, e)
+}
+
+/// Dekker's split of `a` into two halves of at most 26 significant bits each.
+#[inline(always)]
+fn split(a: f64) -> (f64, f64) {
+    let c = 134_217_729.0 * a; // 2^27 + 1
+    let hi = c - (c - a);
+    (hi, a - hi)
+}
+
+/// `a b = p + e` exactly (Dekker's two-product), when `|a|, |b| < 2^996` and the partial
+/// products do not underflow (the lowest set bits of `a` and `b` sum to `-1074` or more).
+#[inline(always)]
+pub(crate) fn two_product(a: f64, b: f64) -> (f64, f64) {
+    let p = a * b;
+    let (ah, al) = split(a);
+    let (bh, bl) = split(b);
+    let e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+    (p, e)
+}
+
+/// A float with whether it is exactly the value of the formula that computed it: the ring
+/// tried before big integers on the signs the filter leaves open. Near-ties are mostly exact
+/// ties whose values are exact in floats: features on a common grid (procedural sheets,
+/// meshes lying on a coordinate plane), coincident points (a zero difference makes every
+/// product with it an exact zero, whatever the other factor). Each operation checks that it
+/// rounded nothing (the error term of Knuth's two-sum or Dekker's two-product is zero); a
+/// value whose `exact` flag holds is the real value, so its sign is exact.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Checked {
+    pub(crate) v: f64,
+    pub(crate) exact: bool,
+}
+
+impl Checked {
+    /// An input (exact by definition).
+    #[inline(always)]
+    pub(crate) fn input(v: f64) -> Self {
+        Self { v, exact: true }
+    }
+
+    /// The exact sign, when the value is exact.
+    #[inline(always)]
+    pub(crate) fn sign(self) -> Option<i8> {
+        let sign = if self.v > 0.0 {
+            1
+        } else if self.v < 0.0 {
+            -1
+        } else {
+            0
+        };
+        self.exact.then_some(sign)
+    }
+
+    #[inline(always)]
+    fn is_exact_zero(self) -> bool {
+        self.exact && self.v == 0.0
+    }
+}
+
+/// Factors at most this large (`2^995`): Dekker's split does not overflow.
+const CHECKED_FACTOR_MAX: f64 = 6.695_567_264_171_945e299;
+/// Products at least this large (`2^-860`, or zero from a zero factor): Dekker's partial
+/// products do not underflow (their lowest bits lie above `2^-970`).
+const CHECKED_PRODUCT_MIN: f64 = 1.364_070_190_012_745_4e-259;
+
+impl Ring for Checked {
+    #[inline(always)]
+    fn add(&self, o: &Self) -> Self {
+        let (v, e) = two_sum(self.v, o.v);
+        Self {
+            v,
+            exact: self.exact & o.exact & (e == 0.0) & v.is_finite(),
+        }
+    }
+    #[inline(always)]
+    fn sub(&self, o: &Self) -> Self {
+        self.add(&Self {
+            v: -o.v,
+            exact: o.exact,
+        })
+    }
+    #[inline(always)]
+    fn mul(&self, o: &Self) -> Self {
+        if self.is_exact_zero() || o.is_exact_zero() {
+            return Self::input(0.0);
+        }
+        let in_range = (self.v.abs() <= CHECKED_FACTOR_MAX) & (o.v.abs() <= CHECKED_FACTOR_MAX);
+        let (v, e) = two_product(self.v, o.v);
+        Self {
+            v,
+            exact: self.exact
+                & o.exact
+                & in_range
+                & (v.abs() >= CHECKED_PRODUCT_MIN)
+                & (e == 0.0)
+                & v.is_finite(),
+        }
+    }
+}
+
+/// The squared distance `num / den` of checked parts, correctly rounded, when both are exact
+/// (IEEE division rounds the exact quotient once).
+pub(crate) fn checked_ratio(parts: Parts<Checked>) -> Option<f64> {
+    let (num, den) = match parts {
+        Parts::Point(r2) => (r2, Checked::input(1.0)),
+        Parts::Line(n, e) => (n, e),
+        Parts::Plane(s, nn) => (s.mul(&s), nn),
+    };
+    (num.exact & den.exact & (den.v > 0.0)).then(|| num.v / den.v)
+}
+
 /// A 3-vector.
 pub(crate) type V<R> = [R; 3];
 
@@ -691,8 +814,81 @@ mod tests {
         (BigInt::from(m), i64::from(e))
     }
 
+    /// `x 2^ex == y 2^ey`.
+    fn same((x, ex): (BigInt, i64), (y, ey): (BigInt, i64)) -> bool {
+        let e = ex.min(ey);
+        (x << (ex - e) as usize) == (y << (ey - e) as usize)
+    }
+
+    #[test]
+    fn checked_floats_flag_what_they_cannot_vouch_for() {
+        let inexact = Checked::input(0.1).mul(&Checked::input(0.1));
+        assert!(!inexact.exact);
+        // An exact zero times anything finite is an exact zero.
+        assert_eq!(Checked::input(0.0).mul(&inexact).sign(), Some(0));
+        assert_eq!(inexact.mul(&Checked::input(-0.0)).sign(), Some(0));
+        // A zero from an inexact value is not.
+        assert_eq!(inexact.sub(&inexact).mul(&Checked::input(1.0)).sign(), None);
+        // Underflow, overflow, and a product too small for Dekker's partial products.
+        let tiny = Checked::input(1e-200);
+        assert!(!tiny.mul(&tiny).exact);
+        assert!(
+            !Checked::input(2f64.powi(-1074))
+                .mul(&Checked::input(1.0))
+                .exact
+        );
+        let huge = Checked::input(1e300);
+        assert!(!huge.mul(&Checked::input(1e10)).exact);
+        assert!(!huge.mul(&huge).exact);
+        assert!(
+            !Checked::input(f64::MAX)
+                .add(&Checked::input(f64::MAX))
+                .exact
+        );
+        assert!(!Checked::input(f64::NAN).add(&Checked::input(0.0)).exact);
+        // Exact sums and products stay exact.
+        let third = Checked::input(3.0)
+            .mul(&Checked::input(0.125))
+            .sub(&Checked::input(0.375));
+        assert_eq!(third.sign(), Some(0));
+        assert_eq!(
+            checked_ratio(Parts::Line(Checked::input(1.0), Checked::input(3.0))),
+            Some(1.0 / 3.0)
+        );
+        assert_eq!(
+            checked_ratio(Parts::Line(inexact, Checked::input(3.0))),
+            None
+        );
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(4000))]
+
+        /// A checked sum or product of any two floats (every binade, subnormals included) that
+        /// claims to be exact is the exact value.
+        #[test]
+        fn checked_floats_are_exact_when_they_say_so(
+            a in any::<u64>(),
+            b in any::<u64>(),
+            (za, zb) in (0u32..53, 0u32..53),
+        ) {
+            // Mantissas cut short at random (exact products and sums are then common).
+            let cut = |x: u64, z: u32| f64::from_bits(x & !((1u64 << z) - 1));
+            let (a, b) = (cut(a, za), cut(b, zb));
+            prop_assume!(a.is_finite() && b.is_finite());
+            let (ca, cb) = (Checked::input(a), Checked::input(b));
+            let (ba, bb) = (big(a), big(b));
+            let p = ca.mul(&cb);
+            if p.exact {
+                prop_assert!(same(big(p.v), (&ba.0 * &bb.0, ba.1 + bb.1)), "{} * {}", a, b);
+            }
+            let s = ca.add(&cb);
+            if s.exact {
+                let e = ba.1.min(bb.1);
+                let sum = (&ba.0 << (ba.1 - e) as usize) + (&bb.0 << (bb.1 - e) as usize);
+                prop_assert!(same(big(s.v), (sum, e)), "{} + {}", a, b);
+            }
+        }
 
         /// Exact values come back unchanged; midpoints of neighbours round to even; a third
         /// rounds to nearest.

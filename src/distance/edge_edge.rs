@@ -28,10 +28,10 @@
 use num_bigint::BigInt;
 
 use super::arith::{
-    across, apart_along, certified, cross, dot, exact_ratio, float_value, gap_exceeds, hmax,
-    lagrange, ldexp, line_parts, max3, min3, plane_parts, plane_q, point_parts, ratio_to_f64,
-    scale_of, sign_of, sub3, to_grid, Bound, Parts, Powers, Ring, DOT, DOT2, DOT3, LAGRANGE,
-    LAGRANGE2, LINE, PLANE, POINT, V,
+    across, apart_along, certified, checked_ratio, cross, dot, exact_ratio, float_value,
+    gap_exceeds, hmax, lagrange, ldexp, line_parts, max3, min3, plane_parts, plane_q, point_parts,
+    ratio_to_f64, scale_of, sign_of, sub3, to_grid, Bound, Checked, Parts, Powers, Ring, DOT, DOT2,
+    DOT3, LAGRANGE, LAGRANGE2, LINE, PLANE, POINT, V,
 };
 use super::EdgeEdge as Ee;
 
@@ -251,18 +251,68 @@ impl Signs for Exact {
     }
 }
 
-/// The exact context, built on the first sign the filter cannot certify.
+/// The inputs in the checked float ring ([`Checked`]): exact signs and values of exact ties
+/// without big integers, where every operation of their formula rounds nothing.
+struct CheckedFloats {
+    l: Leaves<Checked>,
+    d: [Checked; 5],
+    dd: Checked,
+}
+
+impl CheckedFloats {
+    fn new(e: &[[f64; 3]; 4], d: f64) -> Self {
+        let [a0, a1, b0, b1] = e.map(|p| p.map(Checked::input));
+        let l = Leaves::new(&a0, &a1, &b0, &b1);
+        let d = Checked::input(d);
+        Self {
+            d: l.dots(),
+            dd: d.mul(&d),
+            l,
+        }
+    }
+
+    /// The sign of `q` when its value is exact in floats.
+    fn sign(&self, q: Q) -> Option<i8> {
+        quantity(&self.l, &self.d, &self.dd, q).sign()
+    }
+
+    /// The squared distance between the features of `ty`, correctly rounded, when its parts
+    /// are exact in floats.
+    fn distance(&self, ty: Ee) -> Option<f64> {
+        checked_ratio(parts(&self.l, ty))
+    }
+}
+
+/// The exact contexts, built on the first sign the filter cannot certify: checked floats,
+/// then big integers for a sign they leave open.
 struct Lazy {
     e: [[f64; 3]; 4],
     d: f64,
+    checked: Option<CheckedFloats>,
     ex: Option<Box<Exact>>,
 }
 
 impl Lazy {
+    fn new(e: [[f64; 3]; 4], d: f64) -> Self {
+        Self {
+            e,
+            d,
+            checked: None,
+            ex: None,
+        }
+    }
+
     #[cold]
     #[inline(never)]
     fn sign(&mut self, q: Q) -> i8 {
-        self.get().sign(q)
+        let (e, d) = (self.e, self.d);
+        let checked = self
+            .checked
+            .get_or_insert_with(|| CheckedFloats::new(&e, d));
+        match checked.sign(q) {
+            Some(s) => s,
+            None => self.get().sign(q),
+        }
     }
 
     #[cold]
@@ -464,11 +514,7 @@ fn classify_uncertain(l: &Leaves<f64>, dots: &[f64; 5], pw: Powers, e: [[f64; 3]
         l: l.clone(),
         d: *dots,
         pw,
-        lazy: Lazy {
-            e,
-            d: 0.0,
-            ex: None,
-        },
+        lazy: Lazy::new(e, 0.0),
     })
 }
 
@@ -476,16 +522,17 @@ fn classify_uncertain(l: &Leaves<f64>, dots: &[f64; 5], pw: Powers, e: [[f64; 3]
 #[cold]
 #[inline(never)]
 fn exact_distance(e: [[f64; 3]; 4], ty: Ee) -> f64 {
-    let [a0, a1, b0, b1] = e;
-    Exact::new(&a0, &a1, &b0, &b1, 0.0).distance(ty)
+    CheckedFloats::new(&e, 0.0).distance(ty).unwrap_or_else(|| {
+        let [a0, a1, b0, b1] = e;
+        Exact::new(&a0, &a1, &b0, &b1, 0.0).distance(ty)
+    })
 }
 
 /// The exact sign of one quantity (cold: a near-tie).
 #[cold]
 #[inline(never)]
 fn exact_sign(e: [[f64; 3]; 4], d: f64, q: Q) -> i8 {
-    let [a0, a1, b0, b1] = e;
-    Exact::new(&a0, &a1, &b0, &b1, d).sign(q)
+    Lazy::new(e, d).sign(q)
 }
 
 /// The exact path: extents beyond the filter's range, and non-finite input (`None`).
@@ -638,12 +685,19 @@ mod tests {
                 Q::M0, Q::M1,
             ];
             all.extend(Ee::ALL.map(Q::Dist));
+            let checked = CheckedFloats::new(&e, d);
             for q in all {
                 if let Some(s) = certified(quantity(&l, &dots, &dd, q), pw.of(bound(q))) {
                     prop_assert_eq!(s, ex.sign(q), "{:?}", q);
                 }
+                if let Some(s) = checked.sign(q) {
+                    prop_assert_eq!(s, ex.sign(q), "checked {:?}", q);
+                }
             }
             let exact = classify(&mut ex);
+            if let Some(v) = checked.distance(exact) {
+                prop_assert_eq!(v.to_bits(), ex.distance(exact).to_bits(), "checked {:?}", exact);
+            }
             if let Some(ty) = classify_certified(&l, &dots, &pw) {
                 prop_assert_eq!(ty, exact);
             }
@@ -654,6 +708,37 @@ mod tests {
             if apart_across(&l, d, m) {
                 prop_assert!(!within, "claimed apart, within {}", d);
             }
+        }
+
+        /// Exact ties on a grid (no nudge: every difference and product is exact in floats)
+        /// are decided by the checked floats alone, with the exact signs and values.
+        #[test]
+        fn ties_on_a_grid_are_exact_in_checked_floats(
+            pts in prop::array::uniform4(prop::array::uniform3(-4i32..=4)),
+            e in -40i32..40,
+            d in 0i32..=6,
+        ) {
+            let unit = 2f64.powi(e);
+            let e = pts.map(|p| p.map(|x| f64::from(x) * unit));
+            let d = f64::from(d) * unit;
+            let [a0, a1, b0, b1] = e;
+            let mut ex = Exact::new(&a0, &a1, &b0, &b1, d);
+            let checked = CheckedFloats::new(&e, d);
+            let mut all = vec![
+                Q::Ru, Q::Rv, Q::R01u, Q::R01v, Q::R10u, Q::R10v, Q::R11u, Q::R11v, Q::L0, Q::L1,
+                Q::M0, Q::M1,
+            ];
+            all.extend(Ee::ALL.map(Q::Dist));
+            for q in all {
+                prop_assert_eq!(checked.sign(q), Some(ex.sign(q)), "{:?}", q);
+            }
+            let ty = classify(&mut ex);
+            prop_assert_eq!(
+                checked.distance(ty).map(f64::to_bits),
+                Some(ex.distance(ty).to_bits()),
+                "{:?}",
+                ty
+            );
         }
 
         /// Parallel and nearly parallel segments (the case the separation across a segment

@@ -81,10 +81,16 @@
 //!    configurations are first scaled by a power of two (exact), so that no product overflows
 //!    and an underflow stays far below the bound's slack. The classification is first tried
 //!    branch-free, all its signs at once; if one is not certified, it is redone sign by sign.
-//! 3. **Exact fallback**, only for a sign the filter leaves open: all inputs become integers on
-//!    their common binary grid (every `f64` is `m 2^e`), and the same generic formula (one
-//!    source for the filter and the fallback) is evaluated in `num_bigint::BigInt`. Extents
-//!    above `2^60` take this path for every sign.
+//! 3. **Checked floats**, for a sign the filter leaves open: the same generic formula is
+//!    evaluated in floats whose every operation is checked to round nothing (the error term of
+//!    Knuth's two-sum or Dekker's two-product is zero; a product with an exact zero is an exact
+//!    zero). When none rounded, the value is exact, and so is its sign. Near-ties are mostly
+//!    exact ties of this kind: features on a common grid (procedural and coplanar sheets),
+//!    coincident points, a coordinate shared exactly.
+//! 4. **Exact fallback**, only for a sign the checked floats leave open: all inputs become
+//!    integers on their common binary grid (every `f64` is `m 2^e`), and the same generic
+//!    formula (one source for the filter and both exact tiers) is evaluated in
+//!    `num_bigint::BigInt`. Extents above `2^60` take this path for every sign.
 //!
 //! # Cost and limits
 //!
@@ -95,8 +101,10 @@
 //! - Exact ties and near-ties (a point on an edge's line or on a region boundary, parallel
 //!   edges whose closest pair involves an edge's interior, coplanar features with `d = 0`,
 //!   zero-length edges, degenerate triangles, a distance equal to `d` to about `1e-13`
-//!   relative) reach the exact fallback: 1-2 microseconds a call on small integer
-//!   coordinates (`tie` in the bench), more for coordinates spread over many binades.
+//!   relative) leave the float filter. Ties whose formulas are exact in floats (coordinates
+//!   on a common grid, coincident points) are decided by the checked floats, about a tenth of
+//!   a microsecond; the rest reach the exact fallback: 1-2 microseconds a call on small
+//!   integer coordinates, more for coordinates spread over many binades.
 //! - Extents above `2^60` (about `1.15e18`) are always exact and slow; no input is rejected,
 //!   so there is no range check to call.
 
@@ -105,7 +113,7 @@ mod edge_edge;
 mod point_triangle;
 
 /// `x = m 2^e` of a finite f64, shared with the CCD's error-free arithmetic.
-pub(crate) use arith::decompose;
+pub(crate) use arith::{decompose, two_product, two_sum};
 
 /// Which sub-features of a point-triangle pair are closest: IPC's `PointTriangleDistanceType`
 /// (same order and numeric values). Edge `i` joins corners `i` and `i + 1 (mod 3)`.

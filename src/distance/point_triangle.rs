@@ -27,10 +27,10 @@
 use num_bigint::BigInt;
 
 use super::arith::{
-    across, apart_along, certified, cross, dot, exact_ratio, float_value, gap_exceeds, hmax,
-    lagrange, ldexp, line_parts, max3, min3, plane_parts, plane_q, point_parts, ratio_to_f64,
-    scale_of, sign_of, sub3, to_grid, Bound, Parts, Powers, Ring, DOT, DOT2, LAGRANGE, LINE, PLANE,
-    POINT, V,
+    across, apart_along, certified, checked_ratio, cross, dot, exact_ratio, float_value,
+    gap_exceeds, hmax, lagrange, ldexp, line_parts, max3, min3, plane_parts, plane_q, point_parts,
+    ratio_to_f64, scale_of, sign_of, sub3, to_grid, Bound, Checked, Parts, Powers, Ring, DOT, DOT2,
+    LAGRANGE, LINE, PLANE, POINT, V,
 };
 use super::PointTriangle as Pt;
 
@@ -235,19 +235,69 @@ impl Signs for Exact {
     }
 }
 
-/// The exact context, built on the first sign the filter cannot certify.
+/// The inputs in the checked float ring ([`Checked`]): exact signs and values of exact ties
+/// without big integers, where every operation of their formula rounds nothing.
+struct CheckedFloats {
+    l: Leaves<Checked>,
+    d: [Checked; 6],
+    dd: Checked,
+}
+
+impl CheckedFloats {
+    fn new(p: &[f64; 3], t: &[[f64; 3]; 3], d: f64) -> Self {
+        let l = Leaves::new(&p.map(Checked::input), &t.map(|c| c.map(Checked::input)));
+        let d = Checked::input(d);
+        Self {
+            d: l.dots(),
+            dd: d.mul(&d),
+            l,
+        }
+    }
+
+    /// The sign of `q` when its value is exact in floats.
+    fn sign(&self, q: Q) -> Option<i8> {
+        quantity(&self.l, &self.d, &self.dd, q).sign()
+    }
+
+    /// The squared distance to the feature `ty`, correctly rounded, when its parts are exact
+    /// in floats.
+    fn distance(&self, ty: Pt) -> Option<f64> {
+        checked_ratio(parts(&self.l, ty))
+    }
+}
+
+/// The exact contexts, built on the first sign the filter cannot certify: checked floats,
+/// then big integers for a sign they leave open.
 struct Lazy {
     p: [f64; 3],
     t: [[f64; 3]; 3],
     d: f64,
+    checked: Option<CheckedFloats>,
     ex: Option<Box<Exact>>,
 }
 
 impl Lazy {
+    fn new(p: [f64; 3], t: [[f64; 3]; 3], d: f64) -> Self {
+        Self {
+            p,
+            t,
+            d,
+            checked: None,
+            ex: None,
+        }
+    }
+
     #[cold]
     #[inline(never)]
     fn sign(&mut self, q: Q) -> i8 {
-        self.get().sign(q)
+        let (p, t, d) = (self.p, self.t, self.d);
+        let checked = self
+            .checked
+            .get_or_insert_with(|| CheckedFloats::new(&p, &t, d));
+        match checked.sign(q) {
+            Some(s) => s,
+            None => self.get().sign(q),
+        }
     }
 
     #[cold]
@@ -453,12 +503,7 @@ fn classify_uncertain(
         l: l.clone(),
         d: *dots,
         pw,
-        lazy: Lazy {
-            p,
-            t,
-            d: 0.0,
-            ex: None,
-        },
+        lazy: Lazy::new(p, t, 0.0),
     })
 }
 
@@ -466,14 +511,16 @@ fn classify_uncertain(
 #[cold]
 #[inline(never)]
 fn exact_distance(p: [f64; 3], t: [[f64; 3]; 3], ty: Pt) -> f64 {
-    Exact::new(&p, &t, 0.0).distance(ty)
+    CheckedFloats::new(&p, &t, 0.0)
+        .distance(ty)
+        .unwrap_or_else(|| Exact::new(&p, &t, 0.0).distance(ty))
 }
 
 /// The exact sign of one quantity (cold: a near-tie).
 #[cold]
 #[inline(never)]
 fn exact_sign(p: [f64; 3], t: [[f64; 3]; 3], d: f64, q: Q) -> i8 {
-    Exact::new(&p, &t, d).sign(q)
+    Lazy::new(p, t, d).sign(q)
 }
 
 /// The exact path: extents beyond the filter's range, and non-finite input (`None`).
@@ -600,12 +647,19 @@ mod tests {
             let mut ex = Exact::new(&p, &t, d);
             let mut all = vec![Q::D1, Q::D2, Q::D3, Q::D6, Q::D43, Q::D56, Q::Va, Q::Vb, Q::Vc];
             all.extend(Pt::ALL.map(Q::Dist));
+            let checked = CheckedFloats::new(&p, &t, d);
             for q in all {
                 if let Some(s) = certified(quantity(&l, &dots, &dd, q), pw.of(bound(q))) {
                     prop_assert_eq!(s, ex.sign(q), "{:?}", q);
                 }
+                if let Some(s) = checked.sign(q) {
+                    prop_assert_eq!(s, ex.sign(q), "checked {:?}", q);
+                }
             }
             let exact = classify(&mut ex);
+            if let Some(v) = checked.distance(exact) {
+                prop_assert_eq!(v.to_bits(), ex.distance(exact).to_bits(), "checked {:?}", exact);
+            }
             if let Some(ty) = classify_certified(&l, &dots, &pw) {
                 prop_assert_eq!(ty, exact);
             }
@@ -616,6 +670,34 @@ mod tests {
             if apart_beside(&l, d, m) {
                 prop_assert!(!within, "claimed apart, within {}", d);
             }
+        }
+
+        /// Exact ties on a grid (no nudge: every difference and product is exact in floats)
+        /// are decided by the checked floats alone, with the exact signs and values.
+        #[test]
+        fn ties_on_a_grid_are_exact_in_checked_floats(
+            pts in prop::array::uniform4(prop::array::uniform3(-4i32..=4)),
+            e in -40i32..40,
+            d in 0i32..=6,
+        ) {
+            let unit = 2f64.powi(e);
+            let [p, t0, t1, t2] = pts.map(|p| p.map(|x| f64::from(x) * unit));
+            let t = [t0, t1, t2];
+            let d = f64::from(d) * unit;
+            let mut ex = Exact::new(&p, &t, d);
+            let checked = CheckedFloats::new(&p, &t, d);
+            let mut all = vec![Q::D1, Q::D2, Q::D3, Q::D6, Q::D43, Q::D56, Q::Va, Q::Vb, Q::Vc];
+            all.extend(Pt::ALL.map(Q::Dist));
+            for q in all {
+                prop_assert_eq!(checked.sign(q), Some(ex.sign(q)), "{:?}", q);
+            }
+            let ty = classify(&mut ex);
+            prop_assert_eq!(
+                checked.distance(ty).map(f64::to_bits),
+                Some(ex.distance(ty).to_bits()),
+                "{:?}",
+                ty
+            );
         }
     }
 }
