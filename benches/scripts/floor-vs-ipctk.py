@@ -36,6 +36,8 @@ import re
 import subprocess
 import sys
 
+# numpy's BLAS threads spin after a call and take a core from the one-thread timings.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 
 import dhcd
