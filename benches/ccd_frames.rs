@@ -1,9 +1,11 @@
 //! CCD over the real simulation steps (`../shared/data/real-frames/`, frame N -> N+1, `f64`):
 //! one iteration = `self_ccd` over the whole step, one thread, default options.
 //!
-//! Ids: `ccd/<frame>/<method>` (every colliding pair with its time of impact) and
-//! `ccd-earliest/<frame>/<method>` (the earliest time of impact, what a line search asks). The
-//! setup asserts that every method finds the same pairs. Without the folder, nothing is
+//! Ids: `ccd/<frame>/<method>` (every colliding pair with its time of impact),
+//! `ccd-earliest/<frame>/<method>` (the earliest time of impact, what a line search asks) and
+//! `ccd-near/<frame>/dh` (every pair coming within `NEAR` = 1e-3 of each other, with its
+//! time: the minimum-distance filter, against `ccd/<frame>/dh` at distance 0). The setup
+//! asserts that every method finds the same pairs. Without the folder, nothing is
 //! registered and a message says so. The IPC Toolkit's figure on the same steps comes from
 //! `benches/scripts/ccd-vs-ipctk.sh`. (The per-query bench on the sample queries is
 //! `benches/ccd.rs`.)
@@ -18,6 +20,9 @@ use std::path::{Path, PathBuf};
 use criterion::{criterion_group, criterion_main, Criterion};
 use dhcd::{AnyHierarchy, CcdQuery, Method, Motion, Options, Par, Workspace};
 use frames::{frame_pairs, load_f64};
+
+/// The minimum distance of the `ccd-near` group (absolute; the frames' extents are 1-10).
+const NEAR: f64 = 1e-3;
 
 fn ccd(c: &mut Criterion) {
     let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real-frames");
@@ -54,6 +59,17 @@ fn ccd(c: &mut Criterion) {
                     b.iter(|| {
                         let p = h
                             .self_ccd(motion, &query, &mut ws, Par::Seq)
+                            .expect("a step");
+                        black_box(p.toi)
+                    })
+                });
+            }
+            if method == Method::Dh {
+                let near = CcdQuery::all().with_min_distance(NEAR);
+                c.bench_function(&format!("ccd-near/{first}/dh"), |b| {
+                    b.iter(|| {
+                        let p = h
+                            .self_ccd(motion, &near, &mut ws, Par::Seq)
                             .expect("a step");
                         black_box(p.toi)
                     })

@@ -282,9 +282,23 @@ rows = [measure(*c) for c in (([] if a.no_real else real_frames()) + sheets() + 
 commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
                         cwd=here).stdout.strip()
 load = open("/proc/loadavg").read().split()[:3]
+
+
+def machine():
+    """The CPU model, its core count and its widest SIMD (the figures move between machines)."""
+    try:
+        info = open("/proc/cpuinfo").read()
+    except OSError:
+        return "unknown machine"
+    model = re.search(r"^model name\s*:\s*(.*)$", info, re.M)
+    flags = set((re.search(r"^flags\s*:\s*(.*)$", info, re.M) or [None, ""])[1].split())
+    simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "no AVX2"
+    return f"{os.cpu_count()}-core {model[1].strip() if model else 'CPU'} ({simd})"
+
+
 header = (
-    f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, commit {commit}, load "
-    f"{' '.join(load)}, `python benches/scripts/floor-vs-ipctk.py --repeat {a.repeat} --n {a.n} "
+    f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, commit {commit}, "
+    f"{machine()}, load {' '.join(load)}, `python benches/scripts/floor-vs-ipctk.py --repeat {a.repeat} --n {a.n} "
     f"--timeout {a.timeout:g}`; one thread, f64, least of {a.repeat}, dhat = {a.relative:g} x "
     "diagonal; ratio = ipctk time / dhcd time:"
 )
