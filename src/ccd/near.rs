@@ -253,9 +253,7 @@ pub(crate) fn decide(
         // Everything before lo is apart: within at a probe puts the contact in
         // [lo, lo + 2^-40].
         Piece::Decided(
-            if within_soon(vf, &at, lo, t_max, delta)
-                || touches_by(vf, x0, x1, t_max, lo + TOUCH_SLACK)
-            {
+            if within_soon(vf, &at, lo, t_max, delta) || touches_by(vf, x0, x1, t_max, lo) {
                 Verdict::Hit(lo)
             } else {
                 Verdict::Unknown
@@ -441,15 +439,12 @@ fn closest_direction(vf: bool, x: &[P3; 4]) -> P3 {
     }
 }
 
-/// How far after the first piece not apart (`lo`) the delta-0 filter's contact time may lie
-/// for [`touches_by`] to place the earliest time within `delta` in `[lo, lo + 2^-40 +
-/// 2^-44]` (below [`super::TOI_TOLERANCE`]).
-const TOUCH_SLACK: f64 = 1.0 / (1u64 << 44) as f64;
-
 /// The features certainly touch (distance 0, so within any `delta`) at some time `<= by +
 /// 2^-40`: the delta-0 float filter finds a contact at a time it places at most `2^-40`
 /// before the true one, and no later than `by`. A `delta` too small to certify "within" in
-/// floats (`5e-324` next to unit coordinates) is then decided by the contact itself.
+/// floats (`5e-324` next to unit coordinates) is then decided by the contact itself; called
+/// with `by` = the first piece not apart (`lo`), the earliest time within `delta` lies in
+/// `[lo, lo + 2^-40]`, the module's contract.
 fn touches_by(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64, by: f64) -> bool {
     let verdict = if vf {
         super::filter::vertex_face(x0, x1, t_max)
