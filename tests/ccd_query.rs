@@ -176,6 +176,34 @@ fn coplanar_sliding_and_contact_at_the_end() {
     for_each_method!(K => check_pair::<K>(&a, am, &b, bm, &[0.0], "contact at t = 1"));
 }
 
+/// Two coincident sheets in one mesh, the second sliding over the first: every pair of
+/// the two touches at t = 0 (the earliest time, hundreds of pairs tied there), with and
+/// without a minimum distance, and with a time limit.
+#[test]
+fn sheets_resting_on_each_other_tie_at_the_start() {
+    let g = grid(4, 4, 0.25, [0.0; 3]);
+    let base = f64s(g.positions());
+    let n = base.len() as u32;
+    let tris: Vec<[u32; 3]> = g
+        .triangles()
+        .iter()
+        .copied()
+        .chain(g.triangles().iter().map(|t| t.map(|v| v + n)))
+        .collect();
+    let x0: Vec<[f64; 3]> = base.iter().chain(base.iter()).copied().collect();
+    let x1: Vec<[f64; 3]> = base
+        .iter()
+        .copied()
+        .chain(base.iter().map(|p| [p[0] + 0.125, p[1] + 0.0625, p[2]]))
+        .collect();
+    let m = Mesh::new_f64(x0.clone(), tris).unwrap();
+    let all = brute_force_self_ccd(&m, Motion::new(&x0, &x1), &CcdOptions::default());
+    assert_eq!(all.toi, Some(0.0));
+    let tied = earliest_of(&all, all.toi).counters.contacts;
+    assert!(tied > 100, "{tied} pairs tie at 0");
+    for_each_method!(K => check_self::<K>(&m, &x0, &x1, &[0.0, 0.01], "resting sheets"));
+}
+
 /// A minimum distance `delta > 0` (pairs collide when they come within it): two spheres
 /// passing each other and a folding sheet.
 #[test]
@@ -430,4 +458,10 @@ fn earliest_mode_returns_every_pair_tied_at_the_earliest_time() {
 #[test]
 fn earliest_ties_near_the_start_survive_the_walks_restart() {
     check_planted_ties(32.0);
+}
+
+/// The ties at the end of the step (`t = t_max = 1`).
+#[test]
+fn earliest_ties_at_the_end_of_the_step() {
+    check_planted_ties(0.5);
 }

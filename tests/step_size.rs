@@ -199,6 +199,40 @@ fn a_folding_sheet_equals_the_brute_force() {
     }
 }
 
+/// Two coincident sheets in one mesh, the second sliding over the first: pairs touching at
+/// t0 keep a gap of 0 under the rule with `min_distance = 0` (the step is 0), and with a
+/// minimum distance they are already inside it.
+#[test]
+fn sheets_resting_on_each_other_allow_no_step() {
+    let g = grid(4, 4, 0.25, [0.0, 0.0, 0.0]);
+    let base = f64s(g.positions());
+    let n = base.len() as u32;
+    let tris: Vec<[u32; 3]> = g
+        .triangles()
+        .iter()
+        .copied()
+        .chain(g.triangles().iter().map(|t| t.map(|v| v + n)))
+        .collect();
+    let x0: Vec<[f64; 3]> = base.iter().chain(base.iter()).copied().collect();
+    let x1: Vec<[f64; 3]> = base
+        .iter()
+        .copied()
+        .chain(base.iter().map(|p| [p[0] + 0.125, p[1] + 0.0625, p[2]]))
+        .collect();
+    let m = Mesh::new_f64(x0.clone(), tris).unwrap();
+    for o in [
+        StepOptions::default(),
+        StepOptions {
+            min_distance: 0.01,
+            rescaling: 0.8,
+        },
+    ] {
+        let want = brute_force_step(&m, &x0, &x1, &o);
+        assert_eq!(want, 0.0, "{o:?}");
+        for_each_method!(K => check::<K>(&m, &x0, &x1, &o, want));
+    }
+}
+
 /// The falling vertex stopping short of the triangle (z from 1 to 0.1: it never touches, but
 /// passes its gap 0.2 at t = 8/9) while the whole mesh drifts far: the drift dwarfs the
 /// pair's approach, so only the relative motion bounds which pairs the gap walk must test.

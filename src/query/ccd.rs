@@ -796,43 +796,36 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     }
 
     /// Earliest mode, after the walk: every pair found within [`PRUNE_SLACK`] of the best is
-    /// tested again over the whole interval; the least of those times and the pairs that tie
-    /// with it ([`ties_with`]) are the answer (the same whatever the order of the walk).
+    /// given the time a test over the whole interval gives it ([`Self::settled_toi`]); the
+    /// least of those times and the pairs that tie with it ([`ties_with`]) are the answer
+    /// (the same whatever the order of the walk).
     fn settle_earliest(&self, out: &mut ImpactOut) {
         let best = out.least_toi().unwrap_or(f64::INFINITY);
         let near = |toi: f64| toi <= best + PRUNE_SLACK;
-        let stop = || self.budget.poll();
         let (a, b) = (self.a, self.b);
-        let o = &self.options;
         // Original -> internal indices of each side.
         let [va, vb] = [a, b].map(|s| inverse(s.tree().vert_order()));
         let [ta, tb] = [a, b].map(|s| inverse(s.tree().tri_order()));
         let (va, vb, ta, tb) = (&va, &vb, &ta, &tb);
-        let vf = |v: u32, t: u32, a_has_vertex: bool| {
+        let vf = |v: u32, t: u32, a_has_vertex: bool, toi: f64| {
             let (sv, st, iv, it) = if a_has_vertex {
                 (a, b, va, tb)
             } else {
                 (b, a, vb, ta)
             };
-            vertex_face_toi(
-                sv,
-                iv[v as usize] as usize,
-                st,
-                it[t as usize] as usize,
-                o,
-                self.gap.as_ref(),
-                &stop,
-            )
+            let (x0, x1) =
+                vertex_face_points(sv, iv[v as usize] as usize, st, it[t as usize] as usize);
+            self.settled_toi(true, &x0, &x1, toi)
         };
         let mut vertex_face: Vec<VertexImpact> = Vec::new();
         for x in out.vertex_face.iter().filter(|x| near(x.toi)) {
-            if let Some(toi) = vf(x.vertex, x.triangle, true) {
+            if let Some(toi) = vf(x.vertex, x.triangle, true, x.toi) {
                 vertex_face.push(VertexImpact { toi, ..*x });
             }
         }
         let mut face_vertex: Vec<FaceImpact> = Vec::new();
         for x in out.face_vertex.iter().filter(|x| near(x.toi)) {
-            if let Some(toi) = vf(x.vertex, x.triangle, false) {
+            if let Some(toi) = vf(x.vertex, x.triangle, false, x.toi) {
                 face_vertex.push(FaceImpact { toi, ..*x });
             }
         }
@@ -841,7 +834,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             // Pair queries: `a` is the first mesh's; self queries: both are one mesh's.
             let pa = x.a.map(|v| a.step_at(va[v as usize] as usize));
             let pb = x.b.map(|v| b.step_at(vb[v as usize] as usize));
-            if let Some(toi) = edge_edge_toi(pa, pb, o, self.gap.as_ref(), &stop) {
+            let (x0, x1) = edge_edge_points(pa, pb);
+            if let Some(toi) = self.settled_toi(false, &x0, &x1, x.toi) {
                 edge_edge.push(EdgeImpact { toi, ..*x });
             }
         }
@@ -855,6 +849,33 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         settled.face_vertex.retain(|x| ties_with(x.toi, least));
         settled.edge_edge.retain(|x| ties_with(x.toi, least));
         *out = settled;
+    }
+
+    /// The time the exact test over the query's whole interval `[0, t_max]` gives a pair
+    /// the walk found at `toi` (under a bound pruned to the best time so far), tested
+    /// again only when it may differ:
+    /// - `toi == t_max`: the walk's test ran with the query's own `t_max` (a pruned bound
+    ///   lies below it, and a time never exceeds its bound), so with the same options: the
+    ///   same answer;
+    /// - `toi == 0` and the pair within its minimum distance at t0 (exact): its earliest
+    ///   contact `t*` is 0, and every answer lies in `[t* - TOI_TOLERANCE, t*]` and in
+    ///   `[0, t_max]`: 0.
+    ///
+    /// Steps whose earliest time is 0 (sheets resting on each other) or `t_max` (contact
+    /// at the end of the step) settle their tied pairs without a second test.
+    fn settled_toi(
+        &self,
+        vertex_face: bool,
+        x0: &[[f64; 3]; 4],
+        x1: &[[f64; 3]; 4],
+        toi: f64,
+    ) -> Option<f64> {
+        let (o, gap) = (&self.options, self.gap.as_ref());
+        if toi == o.t_max || (toi == 0.0 && within_at_start(vertex_face, x0, x1, o, gap)) {
+            return Some(toi);
+        }
+        let stop = || self.budget.poll();
+        pair_toi(vertex_face, x0, x1, o, gap, &stop)
     }
 }
 
@@ -875,18 +896,15 @@ impl<K: BoundingVolume> Swept<'_, K> {
     }
 }
 
-/// The exact vertex-face test of internal vertex `v` of `sv` and internal triangle `t` of
-/// `st`.
+/// The corners of internal vertex `v` of `sv` and internal triangle `t` of `st` at t0 and
+/// t1 (`[v, t0, t1, t2]`).
 #[inline(always)]
-fn vertex_face_toi<K: BoundingVolume>(
+fn vertex_face_points<K: BoundingVolume>(
     sv: &Swept<'_, K>,
     v: usize,
     st: &Swept<'_, K>,
     t: usize,
-    options: &CcdOptions,
-    gap: Option<&Gap>,
-    stop: &dyn Fn() -> bool,
-) -> Option<f64> {
+) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
     let c = st.tree().triangles()[t].map(|c| c as usize);
     let x0 = [
         sv.step.x0[v],
@@ -900,12 +918,88 @@ fn vertex_face_toi<K: BoundingVolume>(
         st.step.x1[c[1]],
         st.step.x1[c[2]],
     ];
-    let options = match gap {
-        None => *options,
-        Some(g) => g.options(true, &x0, &x1, *options)?,
-    };
+    (x0, x1)
+}
+
+/// The corners of two edges given as their endpoints at t0 and t1 (`[a0, a1, b0, b1]`).
+#[inline(always)]
+fn edge_edge_points(
+    a: [([f64; 3], [f64; 3]); 2],
+    b: [([f64; 3], [f64; 3]); 2],
+) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
+    (
+        [a[0].0, a[1].0, b[0].0, b[1].0],
+        [a[0].1, a[1].1, b[0].1, b[1].1],
+    )
+}
+
+/// A pair's own options: the query's, or with the step-size rule its minimum distance from
+/// its distance at t0 (`None`: it cannot reach it before `t_max`).
+#[inline(always)]
+fn pair_options(
+    vertex_face: bool,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    gap: Option<&Gap>,
+) -> Option<CcdOptions> {
+    match gap {
+        None => Some(*options),
+        Some(g) => g.options(vertex_face, x0, x1, *options),
+    }
+}
+
+/// The exact test of one pair (`vertex_face`: `x0 = [v, t0, t1, t2]`, else `[a0, a1, b0,
+/// b1]`).
+#[inline(always)]
+fn pair_toi(
+    vertex_face: bool,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    gap: Option<&Gap>,
+    stop: &dyn Fn() -> bool,
+) -> Option<f64> {
+    let options = pair_options(vertex_face, x0, x1, options, gap)?;
     // Stopped: no answer; the budget has stopped the query, which returns the error.
-    ccd::pair_until(true, &x0, &x1, &options, stop).unwrap_or(None)
+    ccd::pair_until(vertex_face, x0, x1, &options, stop).unwrap_or(None)
+}
+
+/// The pair is within its minimum distance at t0, exactly (closed features, as the CCD
+/// itself sees contact): its earliest contact time is then 0.
+fn within_at_start(
+    vertex_face: bool,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    gap: Option<&Gap>,
+) -> bool {
+    use crate::distance::{edge_edge_within, point_triangle_within};
+    let Some(o) = pair_options(vertex_face, x0, x1, options, gap) else {
+        return false;
+    };
+    let d = o.min_distance;
+    if vertex_face {
+        point_triangle_within(x0[0], [x0[1], x0[2], x0[3]], d).is_some()
+    } else {
+        edge_edge_within(x0[0], x0[1], x0[2], x0[3], d).is_some()
+    }
+}
+
+/// The exact vertex-face test of internal vertex `v` of `sv` and internal triangle `t` of
+/// `st`.
+#[inline(always)]
+fn vertex_face_toi<K: BoundingVolume>(
+    sv: &Swept<'_, K>,
+    v: usize,
+    st: &Swept<'_, K>,
+    t: usize,
+    options: &CcdOptions,
+    gap: Option<&Gap>,
+    stop: &dyn Fn() -> bool,
+) -> Option<f64> {
+    let (x0, x1) = vertex_face_points(sv, v, st, t);
+    pair_toi(true, &x0, &x1, options, gap, stop)
 }
 
 /// The exact edge-edge test of two edges given as their endpoints at t0 and t1.
@@ -917,13 +1011,8 @@ fn edge_edge_toi(
     gap: Option<&Gap>,
     stop: &dyn Fn() -> bool,
 ) -> Option<f64> {
-    let x0 = [a[0].0, a[1].0, b[0].0, b[1].0];
-    let x1 = [a[0].1, a[1].1, b[0].1, b[1].1];
-    let options = match gap {
-        None => *options,
-        Some(g) => g.options(false, &x0, &x1, *options)?,
-    };
-    ccd::pair_until(false, &x0, &x1, &options, stop).unwrap_or(None)
+    let (x0, x1) = edge_edge_points(a, b);
+    pair_toi(false, &x0, &x1, options, gap, stop)
 }
 
 impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
