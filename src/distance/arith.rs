@@ -119,10 +119,10 @@ impl Checked {
 }
 
 /// Factors at most this large (`2^995`): Dekker's split does not overflow.
-const CHECKED_FACTOR_MAX: f64 = 6.695_567_264_171_945e299;
+const CHECKED_FACTOR_MAX: f64 = 3.348_464_397_457_085_4e299; // 2^995
 /// Products at least this large (`2^-860`, or zero from a zero factor): Dekker's partial
 /// products do not underflow (their lowest bits lie above `2^-970`).
-const CHECKED_PRODUCT_MIN: f64 = 1.364_070_190_012_745_4e-259;
+const CHECKED_PRODUCT_MIN: f64 = 1.300_779_634_956_185_9e-259; // 2^-860
 
 impl Ring for Checked {
     #[inline(always)]
@@ -818,6 +818,12 @@ mod tests {
     fn same((x, ex): (BigInt, i64), (y, ey): (BigInt, i64)) -> bool {
         let e = ex.min(ey);
         (x << (ex - e) as usize) == (y << (ey - e) as usize)
+    }
+
+    #[test]
+    fn checked_float_limits_are_the_powers_of_two_they_claim() {
+        assert_eq!(CHECKED_FACTOR_MAX, pow2(995));
+        assert_eq!(CHECKED_PRODUCT_MIN, pow2(-860));
     }
 
     #[test]

@@ -54,6 +54,10 @@
 //!   distance is `d` exactly, and is `+inf` if the squared distance exceeds `f64::MAX`
 //!   (coordinates beyond ~`1e154`). The tests check these bounds against the exact value.
 //!
+//! The filter and the checked floats assume IEEE 754 binary64 arithmetic in round-to-nearest
+//! with gradual underflow (Rust's default): a host that sets flush-to-zero or
+//! denormals-are-zero on the calling thread voids the exactness of the float tiers.
+//!
 //! Non-finite input: `*_within` returns `None`, `*_distance_sq` returns `(NaN, first type)`;
 //! `d = +inf` is within. Nothing here panics; nothing allocates except the exact fallback.
 //!

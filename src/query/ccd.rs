@@ -870,12 +870,16 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         x1: &[[f64; 3]; 4],
         toi: f64,
     ) -> Option<f64> {
-        let (o, gap) = (&self.options, self.gap.as_ref());
-        if toi == o.t_max || (toi == 0.0 && within_at_start(vertex_face, x0, x1, o, gap)) {
+        if toi == self.options.t_max {
+            return Some(toi);
+        }
+        let o = pair_options(vertex_face, x0, x1, &self.options, self.gap.as_ref())?;
+        if toi == 0.0 && within_at_start(vertex_face, x0, &o) {
             return Some(toi);
         }
         let stop = || self.budget.poll();
-        pair_toi(vertex_face, x0, x1, o, gap, &stop)
+        // Stopped: no answer; the budget has stopped the query, which returns the error.
+        ccd::pair_until(vertex_face, x0, x1, &o, &stop).unwrap_or(None)
     }
 }
 
@@ -965,19 +969,10 @@ fn pair_toi(
     ccd::pair_until(vertex_face, x0, x1, &options, stop).unwrap_or(None)
 }
 
-/// The pair is within its minimum distance at t0, exactly (closed features, as the CCD
-/// itself sees contact): its earliest contact time is then 0.
-fn within_at_start(
-    vertex_face: bool,
-    x0: &[[f64; 3]; 4],
-    x1: &[[f64; 3]; 4],
-    options: &CcdOptions,
-    gap: Option<&Gap>,
-) -> bool {
+/// The pair is within the minimum distance of its options `o` at t0, exactly (closed
+/// features, as the CCD itself sees contact): its earliest contact time is then 0.
+fn within_at_start(vertex_face: bool, x0: &[[f64; 3]; 4], o: &CcdOptions) -> bool {
     use crate::distance::{edge_edge_within, point_triangle_within};
-    let Some(o) = pair_options(vertex_face, x0, x1, options, gap) else {
-        return false;
-    };
     let d = o.min_distance;
     if vertex_face {
         point_triangle_within(x0[0], [x0[1], x0[2], x0[3]], d).is_some()
