@@ -93,6 +93,13 @@ pub(crate) struct Checked {
 }
 
 impl Checked {
+    /// A value not computed: inexact, so a formula that reads it by mistake falls to the
+    /// big integers rather than giving a wrong sign.
+    pub(crate) const UNKNOWN: Self = Self {
+        v: f64::NAN,
+        exact: false,
+    };
+
     /// An input (exact by definition).
     #[inline(always)]
     pub(crate) fn input(v: f64) -> Self {

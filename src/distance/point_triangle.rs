@@ -92,14 +92,23 @@ impl<R: Ring> Leaves<R> {
     /// `[d1, .., d6]`.
     #[inline(always)]
     fn dots(&self) -> [R; 6] {
-        [
-            dot(&self.ab, &self.ap),
-            dot(&self.ac, &self.ap),
-            dot(&self.ab, &self.bp),
-            dot(&self.ac, &self.bp),
-            dot(&self.ab, &self.cp),
-            dot(&self.ac, &self.cp),
-        ]
+        std::array::from_fn(|k| self.dot(k))
+    }
+
+    /// `d(k + 1)`: `ab` or `ac` (even or odd `k`) dotted with `ap`, `bp` or `cp`.
+    #[inline(always)]
+    fn dot(&self, k: usize) -> R {
+        let edge = if k.is_multiple_of(2) {
+            &self.ab
+        } else {
+            &self.ac
+        };
+        let point = match k / 2 {
+            0 => &self.ap,
+            1 => &self.bp,
+            _ => &self.cp,
+        };
+        dot(edge, point)
     }
 
     /// The feature's line or plane (or corner) as `(e, w)`: an edge's direction and the
@@ -121,6 +130,24 @@ impl<R: Ring> Leaves<R> {
             Pt::Vertex1 => &self.bp,
             _ => &self.cp,
         }
+    }
+}
+
+/// The dot products `quantity(q)` reads (bit `k` for `d(k + 1)`); `Q::Dist` reads the
+/// leaves only.
+#[inline(always)]
+fn dots_of(q: Q) -> u8 {
+    match q {
+        Q::D1 => 0b1,
+        Q::D2 => 0b10,
+        Q::D3 => 0b100,
+        Q::D6 => 0b10_0000,
+        Q::D43 => 0b1100,
+        Q::D56 => 0b11_0000,
+        Q::Va => 0b11_1100,
+        Q::Vb => 0b11_0011,
+        Q::Vc => 0b1111,
+        Q::Dist(_) => 0,
     }
 }
 
@@ -239,7 +266,10 @@ impl Signs for Exact {
 /// without big integers, where every operation of their formula rounds nothing.
 struct CheckedFloats {
     l: Leaves<Checked>,
+    /// The dot products computed so far (bit `k` of `have` for `d[k]`), the others
+    /// [`Checked::UNKNOWN`]: a sign computes only those it reads ([`dots_of`]).
     d: [Checked; 6],
+    have: u8,
     dd: Checked,
 }
 
@@ -248,14 +278,22 @@ impl CheckedFloats {
         let l = Leaves::new(&p.map(Checked::input), &t.map(|c| c.map(Checked::input)));
         let d = Checked::input(d);
         Self {
-            d: l.dots(),
+            d: [Checked::UNKNOWN; 6],
+            have: 0,
             dd: d.mul(&d),
             l,
         }
     }
 
     /// The sign of `q` when its value is exact in floats.
-    fn sign(&self, q: Q) -> Option<i8> {
+    fn sign(&mut self, q: Q) -> Option<i8> {
+        let missing = dots_of(q) & !self.have;
+        for k in 0..6 {
+            if missing >> k & 1 == 1 {
+                self.d[k] = self.l.dot(k);
+            }
+        }
+        self.have |= missing;
         quantity(&self.l, &self.d, &self.dd, q).sign()
     }
 
@@ -647,7 +685,7 @@ mod tests {
             let mut ex = Exact::new(&p, &t, d);
             let mut all = vec![Q::D1, Q::D2, Q::D3, Q::D6, Q::D43, Q::D56, Q::Va, Q::Vb, Q::Vc];
             all.extend(Pt::ALL.map(Q::Dist));
-            let checked = CheckedFloats::new(&p, &t, d);
+            let mut checked = CheckedFloats::new(&p, &t, d);
             for q in all {
                 if let Some(s) = certified(quantity(&l, &dots, &dd, q), pw.of(bound(q))) {
                     prop_assert_eq!(s, ex.sign(q), "{:?}", q);
@@ -689,7 +727,9 @@ mod tests {
             let mut all = vec![Q::D1, Q::D2, Q::D3, Q::D6, Q::D43, Q::D56, Q::Va, Q::Vb, Q::Vc];
             all.extend(Pt::ALL.map(Q::Dist));
             for q in all {
-                prop_assert_eq!(checked.sign(q), Some(ex.sign(q)), "{:?}", q);
+                // A fresh context per sign: each computes only the dot products it reads.
+                let mut fresh = CheckedFloats::new(&p, &t, d);
+                prop_assert_eq!(fresh.sign(q), Some(ex.sign(q)), "{:?}", q);
             }
             let ty = classify(&mut ex);
             prop_assert_eq!(
