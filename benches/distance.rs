@@ -9,7 +9,8 @@
 //! - `near`: farther than `d` by at most 10% (near misses: the filter works hardest);
 //! - `within`: at most `d` (the pairs a proximity query reports, value and type computed);
 //! - `tie`: exact ties the float filter cannot decide (a point exactly above a triangle's
-//!   edge, parallel overlapping edges; integer coordinates), the exact fallback's cost.
+//!   edge, parallel overlapping edges; integer coordinates), the exact tiers' cost (checked
+//!   floats decide these: every operation on small integers is exact).
 //!
 //! The points are stored once in a position array and each call gathers its 4 points by
 //! index, as a proximity query's inner loop does (`x[v]`, `x[t[0]]`, ...).
@@ -116,7 +117,7 @@ fn edge_edge_sets() -> [Vec<[P; 4]>; 3] {
     sets
 }
 
-/// Exact ties, which the float filter cannot decide and the exact fallback does: a point
+/// Exact ties, which the float filter cannot decide and the checked floats do: a point
 /// exactly above an edge of an axis-aligned right triangle (integer coordinates), with `d`
 /// near its distance.
 fn point_triangle_ties() -> Vec<(P, [P; 3], f64)> {
