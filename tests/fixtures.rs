@@ -213,3 +213,26 @@ pub fn folded_through(x0: &[[f64; 3]], fold: f64) -> Vec<[f64; 3]> {
         })
         .collect()
 }
+
+/// Two coincident 4 x 4 sheets (cell 1/4) in one mesh at z = 0, the second sliding over the
+/// first by (1/8, 1/16) over the step: every pair of the two touches at t0. The mesh and
+/// its poses at t0 and t1.
+pub fn resting_sheets() -> (Mesh, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let g = dhcd::shapes::grid(4, 4, 0.25, [0.0; 3]);
+    let base: Vec<[f64; 3]> = g.positions().iter().map(|q| q.map(f64::from)).collect();
+    let n = base.len() as u32;
+    let tris: Vec<[u32; 3]> = g
+        .triangles()
+        .iter()
+        .copied()
+        .chain(g.triangles().iter().map(|t| t.map(|v| v + n)))
+        .collect();
+    let x0: Vec<[f64; 3]> = base.iter().chain(base.iter()).copied().collect();
+    let x1: Vec<[f64; 3]> = base
+        .iter()
+        .copied()
+        .chain(base.iter().map(|p| [p[0] + 0.125, p[1] + 0.0625, p[2]]))
+        .collect();
+    let m = Mesh::new_f64(x0.clone(), tris).unwrap();
+    (m, x0, x1)
+}

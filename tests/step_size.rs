@@ -204,22 +204,7 @@ fn a_folding_sheet_equals_the_brute_force() {
 /// minimum distance they are already inside it.
 #[test]
 fn sheets_resting_on_each_other_allow_no_step() {
-    let g = grid(4, 4, 0.25, [0.0, 0.0, 0.0]);
-    let base = f64s(g.positions());
-    let n = base.len() as u32;
-    let tris: Vec<[u32; 3]> = g
-        .triangles()
-        .iter()
-        .copied()
-        .chain(g.triangles().iter().map(|t| t.map(|v| v + n)))
-        .collect();
-    let x0: Vec<[f64; 3]> = base.iter().chain(base.iter()).copied().collect();
-    let x1: Vec<[f64; 3]> = base
-        .iter()
-        .copied()
-        .chain(base.iter().map(|p| [p[0] + 0.125, p[1] + 0.0625, p[2]]))
-        .collect();
-    let m = Mesh::new_f64(x0.clone(), tris).unwrap();
+    let (m, x0, x1) = crate::fixtures::resting_sheets();
     for o in [
         StepOptions::default(),
         StepOptions {

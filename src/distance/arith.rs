@@ -166,6 +166,37 @@ impl Ring for Checked {
     }
 }
 
+/// Dot products in the checked ring computed on demand: a sign computes only those its
+/// formula reads. The others stay [`Checked::UNKNOWN`], so a formula that reads one it did
+/// not ask for falls to big integers instead of giving a wrong sign.
+pub(crate) struct CheckedDots<const N: usize> {
+    d: [Checked; N],
+    /// Bit `k` for `d[k]` computed.
+    have: u8,
+}
+
+impl<const N: usize> CheckedDots<N> {
+    pub(crate) fn new() -> Self {
+        Self {
+            d: [Checked::UNKNOWN; N],
+            have: 0,
+        }
+    }
+
+    /// The dot products, with every one of `need` (bit `k` for the `k`-th) computed by
+    /// `dot(k)` if it was not yet.
+    pub(crate) fn with(&mut self, need: u8, dot: impl Fn(usize) -> Checked) -> &[Checked; N] {
+        let missing = need & !self.have;
+        for (k, d) in self.d.iter_mut().enumerate() {
+            if missing >> k & 1 == 1 {
+                *d = dot(k);
+            }
+        }
+        self.have |= missing;
+        &self.d
+    }
+}
+
 /// The squared distance `num / den` of checked parts, correctly rounded, when both are exact
 /// (IEEE division rounds the exact quotient once).
 pub(crate) fn checked_ratio(parts: Parts<Checked>) -> Option<f64> {

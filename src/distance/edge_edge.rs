@@ -30,8 +30,8 @@ use num_bigint::BigInt;
 use super::arith::{
     across, apart_along, certified, checked_ratio, cross, dot, exact_ratio, float_value,
     gap_exceeds, hmax, lagrange, ldexp, line_parts, max3, min3, plane_parts, plane_q, point_parts,
-    ratio_to_f64, scale_of, sign_of, sub3, to_grid, Bound, Checked, Parts, Powers, Ring, DOT, DOT2,
-    DOT3, LAGRANGE, LAGRANGE2, LINE, PLANE, POINT, V,
+    ratio_to_f64, scale_of, sign_of, sub3, to_grid, Bound, Checked, CheckedDots, Parts, Powers,
+    Ring, DOT, DOT2, DOT3, LAGRANGE, LAGRANGE2, LINE, PLANE, POINT, V,
 };
 use super::EdgeEdge as Ee;
 
@@ -282,10 +282,8 @@ impl Signs for Exact {
 /// without big integers, where every operation of their formula rounds nothing.
 struct CheckedFloats {
     l: Leaves<Checked>,
-    /// The dot products computed so far (bit `k` of `have` for `d[k]`), the others
-    /// [`Checked::UNKNOWN`]: a sign computes only those it reads ([`dots_of`]).
-    d: [Checked; 5],
-    have: u8,
+    /// Computed as the signs read them ([`dots_of`]).
+    d: CheckedDots<5>,
     dd: Checked,
 }
 
@@ -295,8 +293,7 @@ impl CheckedFloats {
         let l = Leaves::new(&a0, &a1, &b0, &b1);
         let d = Checked::input(d);
         Self {
-            d: [Checked::UNKNOWN; 5],
-            have: 0,
+            d: CheckedDots::new(),
             dd: d.mul(&d),
             l,
         }
@@ -304,14 +301,9 @@ impl CheckedFloats {
 
     /// The sign of `q` when its value is exact in floats.
     fn sign(&mut self, q: Q) -> Option<i8> {
-        let missing = dots_of(q) & !self.have;
-        for k in 0..5 {
-            if missing >> k & 1 == 1 {
-                self.d[k] = self.l.dot(k);
-            }
-        }
-        self.have |= missing;
-        quantity(&self.l, &self.d, &self.dd, q).sign()
+        let l = &self.l;
+        let d = self.d.with(dots_of(q), |k| l.dot(k));
+        quantity(l, d, &self.dd, q).sign()
     }
 
     /// The squared distance between the features of `ty`, correctly rounded, when its parts

@@ -522,8 +522,7 @@ impl Gap {
         x1: &[[f64; 3]; 4],
         o: CcdOptions,
     ) -> Option<CcdOptions> {
-        use crate::distance::{edge_edge_distance_sq, edge_edge_within};
-        use crate::distance::{point_triangle_distance_sq, point_triangle_within};
+        use crate::distance::{edge_edge_distance_sq, point_triangle_distance_sq};
         let u: [[f64; 3]; 4] = std::array::from_fn(|k| [0, 1, 2].map(|c| x1[k][c] - x0[k][c]));
         let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         let length = u.map(norm);
@@ -543,15 +542,8 @@ impl Gap {
         // of its displacement. Rounded up (each operation above is within a few ulps).
         let reach =
             (self.min_distance + relative * o.t_max / self.rescaling) * (1.0 + 16.0 * f64::EPSILON);
-        if reach.is_finite() {
-            let near = if vertex_face {
-                point_triangle_within(x0[0], [x0[1], x0[2], x0[3]], reach).is_some()
-            } else {
-                edge_edge_within(x0[0], x0[1], x0[2], x0[3], reach).is_some()
-            };
-            if !near {
-                return None;
-            }
+        if reach.is_finite() && !within_at_start(vertex_face, x0, reach) {
+            return None;
         }
         let d0_sq = if vertex_face {
             point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
@@ -874,12 +866,11 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             return Some(toi);
         }
         let o = pair_options(vertex_face, x0, x1, &self.options, self.gap.as_ref())?;
-        if toi == 0.0 && within_at_start(vertex_face, x0, &o) {
+        // t* = 0 when within the pair's minimum distance at t0.
+        if toi == 0.0 && within_at_start(vertex_face, x0, o.min_distance) {
             return Some(toi);
         }
-        let stop = || self.budget.poll();
-        // Stopped: no answer; the budget has stopped the query, which returns the error.
-        ccd::pair_until(vertex_face, x0, x1, &o, &stop).unwrap_or(None)
+        pair_toi_with(vertex_face, x0, x1, &o, &|| self.budget.poll())
     }
 }
 
@@ -965,15 +956,26 @@ fn pair_toi(
     stop: &dyn Fn() -> bool,
 ) -> Option<f64> {
     let options = pair_options(vertex_face, x0, x1, options, gap)?;
-    // Stopped: no answer; the budget has stopped the query, which returns the error.
-    ccd::pair_until(vertex_face, x0, x1, &options, stop).unwrap_or(None)
+    pair_toi_with(vertex_face, x0, x1, &options, stop)
 }
 
-/// The pair is within the minimum distance of its options `o` at t0, exactly (closed
-/// features, as the CCD itself sees contact): its earliest contact time is then 0.
-fn within_at_start(vertex_face: bool, x0: &[[f64; 3]; 4], o: &CcdOptions) -> bool {
+/// [`pair_toi`] with the pair's own options already known.
+#[inline(always)]
+fn pair_toi_with(
+    vertex_face: bool,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    stop: &dyn Fn() -> bool,
+) -> Option<f64> {
+    // Stopped: no answer; the budget has stopped the query, which returns the error.
+    ccd::pair_until(vertex_face, x0, x1, options, stop).unwrap_or(None)
+}
+
+/// The pair (`vertex_face`: `x0 = [v, t0, t1, t2]`, else `[a0, a1, b0, b1]`) is within `d`
+/// at t0, exactly (closed features, as the CCD itself sees contact).
+fn within_at_start(vertex_face: bool, x0: &[[f64; 3]; 4], d: f64) -> bool {
     use crate::distance::{edge_edge_within, point_triangle_within};
-    let d = o.min_distance;
     if vertex_face {
         point_triangle_within(x0[0], [x0[1], x0[2], x0[3]], d).is_some()
     } else {
