@@ -20,9 +20,9 @@
 //! ends, sharper than the boxes over the whole step of stage 0). On armadillo-rollers
 //! 326 -> 327 the first axis ends 84% of the 7.0 M candidate pairs, all seven 96%.
 //!
-//! **Rounding** (`u = 2^-53`, `M` the largest coordinate magnitude, `C = sum_k |c_k|`). The
-//! axis is whatever float vector was computed: any direction is a valid axis, so only the
-//! projections and the gaps need a bound. The poses are the given ones (error 0) or
+//! **Rounding** (`u = 2^-53`, `M` at least the largest coordinate magnitude, `C = sum_k
+//! |c_k|`). The axis is whatever float vector was computed: any direction is a valid axis,
+//! so only the projections and the gaps need a bound. The poses are the given ones (error 0) or
 //! interpolated in floats at a time of `[0, 1]` ([`positions_at`]: each coordinate within
 //! `5.01 u M`, so its projection within `5.01 u M C`). A projection is a 3-term dot product,
 //! within `gamma_3 sum_k |x_k c_k| <= 3.01 u M C` of the exact one, plus `3 * 2^-1075` for
@@ -86,7 +86,7 @@ fn gaps(split: usize, x: &Points, c: &[f64; 3]) -> (f64, f64) {
 
 /// The two features certainly farther than `delta` apart along `c` at every time between
 /// two poses `x0` and `x1` of the points, given or interpolated by [`positions_at`] (see
-/// the module docs); `m` is the query's largest coordinate magnitude, in
+/// the module docs); `m`, at least the query's largest coordinate magnitude, is in
 /// `[2^-400, 2^400]`.
 #[inline(always)]
 fn apart_along(
@@ -144,8 +144,9 @@ fn normal_axis(vf: bool, x: &Points) -> [f64; 3] {
 /// The pair (`vf`: a vertex and a triangle, else two edges, as the CCD queries lay out
 /// their points) certainly farther than `delta` apart at every time between the poses `x0`
 /// and `x1` (given, or interpolated by [`positions_at`]), by separation along the axes of
-/// the module docs. `m` is the largest coordinate magnitude of
-/// the query; outside `[2^-400, 2^400]` nothing is certified.
+/// the module docs. `m` is at least the largest coordinate magnitude of the query (its
+/// own, or the whole step's: any upper bound keeps the error bound of the module docs);
+/// outside `[2^-400, 2^400]` nothing is certified.
 #[inline(always)]
 pub(crate) fn apart(vf: bool, x0: &Points, x1: &Points, delta: f64, m: f64) -> bool {
     if !(TINY..=HUGE).contains(&m) {
@@ -172,8 +173,8 @@ pub(crate) fn positions_at(x0: &Points, x1: &Points, t: f64) -> Points {
 
 /// The features certainly farther than `delta` apart along `c` at every time of `[lo, hi]`,
 /// from their poses at `lo` and `hi` interpolated by [`positions_at`] (the gap is concave on
-/// any time interval). `m`: the query's largest coordinate magnitude; nothing is certified
-/// outside `[2^-400, 2^400]`.
+/// any time interval). `m`: at least the query's largest coordinate magnitude; nothing is
+/// certified outside `[2^-400, 2^400]`.
 #[inline(always)]
 pub(crate) fn apart_between(
     vf: bool,

@@ -276,24 +276,34 @@ pub fn edge_edge_until(
 
 /// The query of one pair that the whole-mesh CCD walk runs: as [`vertex_face`] or
 /// [`edge_edge`], with `stop` asked between the steps of the exact path (`Err` once it
-/// said stop).
+/// said stop). The walk has already done what the entry points do first, so this starts
+/// after them: its positions were checked finite on input, the pair's swept feature boxes
+/// met (stage 0 would end almost none of its pairs), and `magnitude`, at least every
+/// coordinate's magnitude (the whole step's largest), bounds the culls' rounding in place
+/// of the pair's own largest coordinate (any upper bound keeps them certain).
 #[inline(always)]
 pub(crate) fn pair_until(
     vf: bool,
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],
     options: &CcdOptions,
+    magnitude: f64,
     stop: &dyn Fn() -> bool,
 ) -> std::result::Result<Option<f64>, exact::Stopped> {
+    debug_assert!(
+        options.is_valid() && all_finite(x0, x1),
+        "invalid CCD input: {options:?} {x0:?} {x1:?}"
+    );
+    debug_assert!(max_magnitude(x0, x1) <= magnitude);
     let kind = if vf {
         exact::Kind::VertexFace
     } else {
         exact::Kind::EdgeEdge
     };
-    query(kind, x0, x1, options, stop)
+    after_boxes(kind, x0, x1, options, magnitude, None, stop)
 }
 
-/// [`vertex_face`] with its input checked: a typed error instead of an assumption.
+/// [`try_vertex_face`] with its input checked: a typed error instead of an assumption.
 pub fn try_vertex_face(
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],
@@ -328,11 +338,10 @@ fn query(
     if !valid {
         return Ok(None);
     }
-    let vf = kind == exact::Kind::VertexFace;
     let delta = options.min_distance;
     // Stage 0, the swept boxes, on the input as given: comparisons, exact at every scale.
     // Most pairs end here, before paying for the scaling below.
-    let apart = if vf {
+    let apart = if kind == exact::Kind::VertexFace {
         filter::vf_boxes_apart(x0, x1, delta)
     } else {
         filter::ee_boxes_apart(x0, x1, delta)
@@ -340,12 +349,31 @@ fn query(
     if apart {
         return Ok(None);
     }
+    let magnitude = max_magnitude(x0, x1);
+    after_boxes(kind, x0, x1, options, magnitude, Some(magnitude), stop)
+}
+
+/// A valid query whose swept boxes meet: the culls over `[0, t_max]` (their rounding
+/// bounded with `bound`, at least every coordinate's magnitude), then the filters and the
+/// exact path on the query scaled to unit size (by its own largest coordinate magnitude,
+/// `own` when known).
+#[inline(always)]
+fn after_boxes(
+    kind: exact::Kind,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    bound: f64,
+    own: Option<f64>,
+    stop: exact::Stop<'_>,
+) -> std::result::Result<Option<f64>, exact::Stopped> {
+    let vf = kind == exact::Kind::VertexFace;
+    let delta = options.min_distance;
     // A time limit below 1 (the earliest-time mode's pruning): the boxes over [0, t_max],
     // far smaller than over the whole step when t_max is small. Their rounding bound holds
     // for coordinates below 2^1000 (no overflow), at any scale.
-    let magnitude = max_magnitude(x0, x1);
     if options.t_max < 1.0
-        && magnitude <= BOXES_UNTIL_MAX
+        && bound <= BOXES_UNTIL_MAX
         && filter::boxes_apart_until(kind, x0, x1, options.t_max, delta)
     {
         return Ok(None);
@@ -354,9 +382,9 @@ fn query(
     // neighbouring features, which the boxes do not, for a few dot products.
     let apart = if options.t_max < 1.0 {
         let end = axis::positions_at(x0, x1, options.t_max);
-        axis::apart(vf, x0, &end, delta, magnitude)
+        axis::apart(vf, x0, &end, delta, bound)
     } else {
-        axis::apart(vf, x0, x1, delta, magnitude)
+        axis::apart(vf, x0, x1, delta, bound)
     };
     if apart {
         return Ok(None);
@@ -364,6 +392,7 @@ fn query(
     // One power-of-two scaling (when it is exact) brings the largest coordinate near 1:
     // contacts and times do not change, and the float filters never overflow or drown in
     // their underflow terms.
+    let magnitude = own.unwrap_or_else(|| max_magnitude(x0, x1));
     let unit = to_unit_scale(x0, x1, delta, magnitude);
     let (x0, x1, delta) = match &unit {
         Some((y0, y1, d)) => (y0, y1, *d),

@@ -274,6 +274,9 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
     /// A bound on how far `culling`'s positions at `horizon` lie from the exact points of
     /// the motion ([`horizon_error`]; 0 for the whole step).
     horizon_error: f64,
+    /// `step`'s largest coordinate magnitude: the rounding bound of the exact tests' culls
+    /// ([`ccd::pair_until`]).
+    magnitude: f64,
     bounds: K::Swept,
     tri_rows: [Vec<f32>; 6],
     edge_rows: [Vec<f32>; 6],
@@ -285,13 +288,18 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
 /// A bound on how far a position at a time `by` of `steps`, computed in `f64` as `x0 + by
 /// (x1 - x0)` ([`Swept::until`]), lies from the exact point: three roundings of values at
 /// most twice the largest coordinate `M` in size, at most `4 EPSILON M` per coordinate, so
-/// `8 EPSILON M` in norm (rounded up).
-fn horizon_error(step: &Step) -> f64 {
+/// `8 EPSILON M` in norm (rounded up), `M` = `magnitude`, the step's largest coordinate.
+fn horizon_error(magnitude: f64) -> f64 {
+    (8.0 * f64::EPSILON * magnitude).next_up()
+}
+
+/// The largest coordinate magnitude of a step's positions, at t0 and t1.
+fn largest_magnitude(step: &Step) -> f64 {
     let mut largest = 0.0f64;
     for p in step.x0.iter().chain(&step.x1) {
         largest = largest.max(p[0].abs()).max(p[1].abs()).max(p[2].abs());
     }
-    (8.0 * f64::EPSILON * largest).next_up()
+    largest
 }
 
 /// Two leaves' points certainly farther than `margin` apart all step: on some axis, one
@@ -380,7 +388,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         };
         let mut s = Swept::fitted(self.h, step, Some(culling));
         s.horizon = by;
-        s.horizon_error = horizon_error(&s.step);
+        s.horizon_error = horizon_error(s.magnitude);
         s
     }
 
@@ -391,6 +399,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
 
     fn fitted(h: &'h Hierarchy<K>, step: Cow<'h, Step>, culling: Option<Step>) -> Self {
         let tree = h.tree();
+        let magnitude = largest_magnitude(&step);
         let fit = culling.as_ref().unwrap_or(&step);
         let tri_rows = box_rows(tree.triangles().iter().map(|t| t.map(|v| v as usize)), fit);
         let edge_rows = box_rows(
@@ -424,6 +433,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             culling,
             horizon: 1.0,
             horizon_error: 0.0,
+            magnitude,
             tri_rows,
             edge_rows,
             leaf_ends: ends,
@@ -492,6 +502,8 @@ struct SweptQuery<'s, 'h, K: BoundingVolume> {
     /// The step-size rule: each pair's minimum distance from its distance at t0 (the
     /// options' minimum distance is then only the walk's culling distance).
     gap: Option<Gap>,
+    /// Both sides' largest coordinate magnitude ([`ccd::pair_until`]).
+    magnitude: f64,
 }
 
 /// The IPC Toolkit's step-size rule: a pair at distance `d0` at t0 must stay at least
@@ -704,6 +716,7 @@ impl<'s, 'h, K: BoundingVolume> SweptQuery<'s, 'h, K> {
             best,
             budget,
             gap,
+            magnitude: a.magnitude.max(b.magnitude),
         }
     }
 
@@ -824,9 +837,9 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         let mut edge_edge: Vec<EdgeImpact> = Vec::new();
         for x in out.edge_edge.iter().filter(|x| near(x.toi)) {
             // Pair queries: `a` is the first mesh's; self queries: both are one mesh's.
-            let pa = x.a.map(|v| a.step_at(va[v as usize] as usize));
-            let pb = x.b.map(|v| b.step_at(vb[v as usize] as usize));
-            let (x0, x1) = edge_edge_points(pa, pb);
+            let ea = x.a.map(|v| va[v as usize]);
+            let eb = x.b.map(|v| vb[v as usize]);
+            let (x0, x1) = edge_edge_points(a, ea, b, eb);
             if let Some(toi) = self.settled_toi(false, &x0, &x1, x.toi) {
                 edge_edge.push(EdgeImpact { toi, ..*x });
             }
@@ -870,7 +883,30 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         if toi == 0.0 && within_at_start(vertex_face, x0, o.min_distance) {
             return Some(toi);
         }
-        pair_toi_with(vertex_face, x0, x1, &o, &|| self.budget.poll())
+        self.pair_toi_with(vertex_face, x0, x1, &o)
+    }
+
+    /// The exact test of one pair the walk found (`vertex_face`: `x0 = [v, t0, t1, t2]`,
+    /// else `[a0, a1, b0, b1]`), with the options of the moment and the pair's own.
+    #[inline(always)]
+    fn pair_toi(&self, vertex_face: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> Option<f64> {
+        let o = self.options_now();
+        let o = pair_options(vertex_face, x0, x1, &o, self.gap.as_ref())?;
+        self.pair_toi_with(vertex_face, x0, x1, &o)
+    }
+
+    /// [`Self::pair_toi`] with the pair's own options already known.
+    #[inline(always)]
+    fn pair_toi_with(
+        &self,
+        vertex_face: bool,
+        x0: &[[f64; 3]; 4],
+        x1: &[[f64; 3]; 4],
+        options: &CcdOptions,
+    ) -> Option<f64> {
+        let stop = || self.budget.poll();
+        // Stopped: no answer; the budget has stopped the query, which returns the error.
+        ccd::pair_until(vertex_face, x0, x1, options, self.magnitude, &stop).unwrap_or(None)
     }
 }
 
@@ -883,14 +919,6 @@ fn inverse(order: &[u32]) -> Vec<u32> {
     inv
 }
 
-impl<K: BoundingVolume> Swept<'_, K> {
-    /// Internal vertex `v` at t0 and t1.
-    #[inline(always)]
-    fn step_at(&self, v: usize) -> ([f64; 3], [f64; 3]) {
-        (self.step.x0[v], self.step.x1[v])
-    }
-}
-
 /// The corners of internal vertex `v` of `sv` and internal triangle `t` of `st` at t0 and
 /// t1 (`[v, t0, t1, t2]`).
 #[inline(always)]
@@ -900,31 +928,31 @@ fn vertex_face_points<K: BoundingVolume>(
     st: &Swept<'_, K>,
     t: usize,
 ) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
-    let c = st.tree().triangles()[t].map(|c| c as usize);
-    let x0 = [
-        sv.step.x0[v],
-        st.step.x0[c[0]],
-        st.step.x0[c[1]],
-        st.step.x0[c[2]],
-    ];
-    let x1 = [
-        sv.step.x1[v],
-        st.step.x1[c[0]],
-        st.step.x1[c[1]],
-        st.step.x1[c[2]],
-    ];
-    (x0, x1)
+    let [c0, c1, c2] = st.tree().triangles()[t];
+    let [c0, c1, c2] = [c0 as usize, c1 as usize, c2 as usize];
+    let (p, q) = (&sv.step, &st.step);
+    (
+        [p.x0[v], q.x0[c0], q.x0[c1], q.x0[c2]],
+        [p.x1[v], q.x1[c0], q.x1[c1], q.x1[c2]],
+    )
 }
 
-/// The corners of two edges given as their endpoints at t0 and t1 (`[a0, a1, b0, b1]`).
+/// The corners of edge `ea` of `sa` and edge `eb` of `sb` (internal vertex indices) at t0
+/// and t1 (`[a0, a1, b0, b1]`).
+// PERF: indexed loads into the arrays, not `map` over the endpoints: copies of the pieces
+// through the stack stalled on store forwarding (~12% of an all-pairs CCD step).
 #[inline(always)]
-fn edge_edge_points(
-    a: [([f64; 3], [f64; 3]); 2],
-    b: [([f64; 3], [f64; 3]); 2],
+fn edge_edge_points<K: BoundingVolume>(
+    sa: &Swept<'_, K>,
+    [a0, a1]: [u32; 2],
+    sb: &Swept<'_, K>,
+    [b0, b1]: [u32; 2],
 ) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
+    let [a0, a1, b0, b1] = [a0 as usize, a1 as usize, b0 as usize, b1 as usize];
+    let (p, q) = (&sa.step, &sb.step);
     (
-        [a[0].0, a[1].0, b[0].0, b[1].0],
-        [a[0].1, a[1].1, b[0].1, b[1].1],
+        [p.x0[a0], p.x0[a1], q.x0[b0], q.x0[b1]],
+        [p.x1[a0], p.x1[a1], q.x1[b0], q.x1[b1]],
     )
 }
 
@@ -944,34 +972,6 @@ fn pair_options(
     }
 }
 
-/// The exact test of one pair (`vertex_face`: `x0 = [v, t0, t1, t2]`, else `[a0, a1, b0,
-/// b1]`).
-#[inline(always)]
-fn pair_toi(
-    vertex_face: bool,
-    x0: &[[f64; 3]; 4],
-    x1: &[[f64; 3]; 4],
-    options: &CcdOptions,
-    gap: Option<&Gap>,
-    stop: &dyn Fn() -> bool,
-) -> Option<f64> {
-    let options = pair_options(vertex_face, x0, x1, options, gap)?;
-    pair_toi_with(vertex_face, x0, x1, &options, stop)
-}
-
-/// [`pair_toi`] with the pair's own options already known.
-#[inline(always)]
-fn pair_toi_with(
-    vertex_face: bool,
-    x0: &[[f64; 3]; 4],
-    x1: &[[f64; 3]; 4],
-    options: &CcdOptions,
-    stop: &dyn Fn() -> bool,
-) -> Option<f64> {
-    // Stopped: no answer; the budget has stopped the query, which returns the error.
-    ccd::pair_until(vertex_face, x0, x1, options, stop).unwrap_or(None)
-}
-
 /// The pair (`vertex_face`: `x0 = [v, t0, t1, t2]`, else `[a0, a1, b0, b1]`) is within `d`
 /// at t0, exactly (closed features, as the CCD itself sees contact).
 fn within_at_start(vertex_face: bool, x0: &[[f64; 3]; 4], d: f64) -> bool {
@@ -981,35 +981,6 @@ fn within_at_start(vertex_face: bool, x0: &[[f64; 3]; 4], d: f64) -> bool {
     } else {
         edge_edge_within(x0[0], x0[1], x0[2], x0[3], d).is_some()
     }
-}
-
-/// The exact vertex-face test of internal vertex `v` of `sv` and internal triangle `t` of
-/// `st`.
-#[inline(always)]
-fn vertex_face_toi<K: BoundingVolume>(
-    sv: &Swept<'_, K>,
-    v: usize,
-    st: &Swept<'_, K>,
-    t: usize,
-    options: &CcdOptions,
-    gap: Option<&Gap>,
-    stop: &dyn Fn() -> bool,
-) -> Option<f64> {
-    let (x0, x1) = vertex_face_points(sv, v, st, t);
-    pair_toi(true, &x0, &x1, options, gap, stop)
-}
-
-/// The exact edge-edge test of two edges given as their endpoints at t0 and t1.
-#[inline(always)]
-fn edge_edge_toi(
-    a: [([f64; 3], [f64; 3]); 2],
-    b: [([f64; 3], [f64; 3]); 2],
-    options: &CcdOptions,
-    gap: Option<&Gap>,
-    stop: &dyn Fn() -> bool,
-) -> Option<f64> {
-    let (x0, x1) = edge_edge_points(a, b);
-    pair_toi(false, &x0, &x1, options, gap, stop)
 }
 
 impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
@@ -1169,9 +1140,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             &tris,
             counters,
             |v, t| {
-                let stop = || self.budget.poll();
-                let o = self.options_now();
-                if let Some(toi) = vertex_face_toi(sv, v, st, t, &o, self.gap.as_ref(), &stop) {
+                let (x0, x1) = vertex_face_points(sv, v, st, t);
+                if let Some(toi) = self.pair_toi(true, &x0, &x1) {
                     self.found(toi);
                     emit(v, t, toi);
                 }
@@ -1197,11 +1167,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         candidates.edges_vs_edges(simd, &a, &b, same_leaf, counters, |ex, ey| {
             // `ex` is of A (or, in a self query, of the one mesh), `ey` of B; the exact test
             // takes the edges in the reported order.
-            let px = ex.internal.map(|v| sa.step_at(v as usize));
-            let py = ey.internal.map(|v| sb.step_at(v as usize));
-            let stop = || self.budget.poll();
-            let o = self.options_now();
-            if let Some(toi) = edge_edge_toi(px, py, &o, self.gap.as_ref(), &stop) {
+            let (x0, x1) = edge_edge_points(sa, ex.internal, sb, ey.internal);
+            if let Some(toi) = self.pair_toi(false, &x0, &x1) {
                 self.found(toi);
                 self.budget.push(
                     out,
