@@ -11,11 +11,14 @@
 //! 2. Isolation of the roots of `f` in [0, t_max] by subdivision of interval Bernstein
 //!    coefficients, each root narrowed to an interval of width <= 2^-40 by bisection, and
 //!    at each root interval (in increasing order) the in-triangle / crossing signs
-//!    evaluated in interval arithmetic over that interval.
+//!    evaluated in interval arithmetic over that interval. A root of `f` where the
+//!    features miss each other is first ruled out more cheaply, by separation along an
+//!    in-plane normal of one feature's edge over the root's interval ([`apart_over`]).
 //!
 //! Anything not certain (a root at an endpoint, a double root, a sign straddling 0, an
 //! edge or vertex contact, huge coordinates) is `Unknown` and goes to the exact path.
 
+use super::axis;
 use super::interval::Iv;
 use super::ring::{self, Ring, V3};
 
@@ -349,7 +352,14 @@ fn ee_static(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t: Iv) -> Option<bool> {
 
 /// Stages 1 and 2 on the difference vectors.
 #[inline(always)]
-fn decide(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], d: &Diffs, t_max: f64, test: Static) -> Verdict {
+fn decide(
+    vf: bool,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    d: &Diffs,
+    t_max: f64,
+    test: Static,
+) -> Verdict {
     let Some((b, e)) = bernstein(d) else {
         return Verdict::Unknown;
     };
@@ -361,7 +371,7 @@ fn decide(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], d: &Diffs, t_max: f64, test: S
     if (0..4).all(|k| b[k].abs() <= e[k]) {
         return Verdict::Unknown;
     }
-    roots_and_test(x0, x1, b, e, t_max, test)
+    roots_and_test(vf, x0, x1, b, e, t_max, test)
 }
 
 /// f's Bernstein coefficients on [0, 1] as plain floats with one error bound, for the
@@ -424,8 +434,41 @@ fn bisect(c: &PointCubic, sign0: i8, s0: &mut f64, s1: &mut f64, width: f64) -> 
     true
 }
 
+/// The features certainly apart at every time of `[s0, s1]` (in `[0, 1]`), by separation
+/// along a fixed direction between their poses at `s0` and `s1` ([`axis::apart_between`]:
+/// the gap along a fixed direction is concave in time, and the poses are interpolated with
+/// a bounded error). The directions are the ones that separate coplanar features that miss
+/// each other, as they are at a root of f: a vertex outside a triangle lies beyond the line
+/// of one of its edges within their plane, and of two segments that do not cross one lies
+/// beyond the other's line. So each is an edge's normal within the plane, `n x e` (`n` the
+/// triangle's normal, or the edges' cross product), at `s0`: each edge of the triangle, or
+/// each of the two edges. Any direction is a valid axis, so nothing here needs to be
+/// exact; a root the directions do not separate goes to the interval test.
+#[inline(always)]
+fn apart_over(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], s0: f64, s1: f64) -> bool {
+    let m = x0
+        .iter()
+        .chain(x1)
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let p0 = axis::positions_at(x0, x1, s0);
+    let p1 = axis::positions_at(x0, x1, s1);
+    let apart = |c: &[f64; 3]| axis::apart_between(vf, (&p0, &p1), c, 0.0, m);
+    let edge = |from: usize, to: usize| d3(&p0[to], &p0[from]);
+    if vf {
+        let (e1, e2, e3) = (edge(1, 2), edge(2, 3), edge(3, 1));
+        let n = cross(&e1, &e2);
+        apart(&cross(&n, &e1)) || apart(&cross(&n, &e2)) || apart(&cross(&n, &e3))
+    } else {
+        let (u, v) = (edge(0, 1), edge(2, 3));
+        let n = cross(&u, &v);
+        apart(&cross(&n, &u)) || apart(&cross(&n, &v))
+    }
+}
+
 #[inline(never)]
 fn roots_and_test(
+    vf: bool,
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],
     b: [f64; 4],
@@ -466,14 +509,15 @@ fn roots_and_test(
                 _ => s1 = t_max,
             }
         }
-        // Most roots of f are plane crossings away from the feature: the static test on the
-        // root's interval at 2^-10, then 2^-20, rules them out before the narrowing to
-        // 2^-40 that only a contact's time needs.
+        // Most roots of f are plane crossings away from the feature: separation in the
+        // plane, then the static test, on the root's interval at 2^-10, then 2^-20, rule
+        // them out before the narrowing to 2^-40 that only a contact's time needs.
         let mut narrow = true;
         let mut ruled_out = false;
         for width in COARSE_WIDTHS {
             narrow = bisect(&point, r.sign0, &mut s0, &mut s1, width);
-            if test(x0, x1, Iv { lo: s0, hi: s1 }) == Some(false) {
+            if apart_over(vf, x0, x1, s0, s1) || test(x0, x1, Iv { lo: s0, hi: s1 }) == Some(false)
+            {
                 ruled_out = true;
                 break;
             }
@@ -504,12 +548,112 @@ fn roots_and_test(
 #[inline]
 pub(crate) fn vertex_face(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
     let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
-    decide(x0, x1, &[at(x0), at(x1)], t_max, vf_static)
+    decide(true, x0, x1, &[at(x0), at(x1)], t_max, vf_static)
 }
 
 /// The edge-edge filter (stages 1-2; the caller has run stage 0).
 #[inline]
 pub(crate) fn edge_edge(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
     let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
-    decide(x0, x1, &[at(x0), at(x1)], t_max, ee_static)
+    decide(false, x0, x1, &[at(x0), at(x1)], t_max, ee_static)
+}
+
+#[cfg(test)]
+mod tests {
+    //! The in-plane separation that rules out roots of f: every interval it calls apart
+    //! holds no contact for the exact path, on motions built to be coplanar at some time
+    //! (grid coordinates: a vertex or an edge crossing the plane of the other feature, at,
+    //! beside or away from it), and it rules out a fair share of them, so the check is not
+    //! vacuous.
+    use super::super::exact::{solve, Kind};
+    use super::super::testing::Rng;
+    use super::*;
+
+    type Points = [[f64; 3]; 4];
+
+    /// The other feature in the plane z = 0 (still, or sliding in it) and the first crossing
+    /// that plane during the step (vertex-face: the vertex; edge-edge: the first edge).
+    fn crossing(rng: &mut Rng, vf: bool) -> (Points, Points) {
+        let in_plane = |rng: &mut Rng| [rng.small(), rng.small(), 0.0];
+        let mut x0: Points = std::array::from_fn(|_| in_plane(rng));
+        let mut x1 = x0;
+        if rng.below(2) == 0 {
+            let slide = in_plane(rng).map(|c| c / 4.0);
+            x1 = x0.map(|p| [p[0] + slide[0], p[1] + slide[1], 0.0]);
+        }
+        for i in 0..if vf { 1 } else { 2 } {
+            let (z0, z1) = (rng.small().abs().max(0.25), -rng.small().abs().max(0.25));
+            x0[i] = [rng.small(), rng.small(), z0];
+            x1[i] = [rng.small(), rng.small(), z1];
+        }
+        (x0, x1)
+    }
+
+    #[test]
+    fn every_interval_called_apart_holds_no_contact() {
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let (mut ruled_out, mut total) = (0u32, 0u32);
+        for case in 0..6000 {
+            let vf = case % 2 == 0;
+            let (x0, x1) = crossing(&mut rng, vf);
+            let kind = if vf { Kind::VertexFace } else { Kind::EdgeEdge };
+            // From t = 0, whose pose is exact: no contact in [0, hi] at all.
+            let hi = [1.0, 0.75, 0.5, 0.25][rng.below(4) as usize];
+            total += 1;
+            if apart_over(vf, &x0, &x1, 0.0, hi) {
+                ruled_out += 1;
+                let exact = solve(kind, &x0, &x1, hi, 0.0, &|| false).unwrap();
+                assert_eq!(exact, None, "vf {vf} {x0:?} -> {x1:?} over [0, {hi}]");
+            }
+            // From an interpolated pose, over a whole tail of the step or over 2^-10 around
+            // the time the first vertex crosses the plane (as the filter calls it, around a
+            // root of f): the earliest contact, if any, is before the interval.
+            let crossing = x0[0][2] / (x0[0][2] - x1[0][2]);
+            let (lo, hi) = if rng.below(2) == 0 {
+                ([0.125, 0.375, 0.5][rng.below(3) as usize], 1.0)
+            } else {
+                let w = 2f64.powi(-10);
+                ((crossing - w).max(0.0), (crossing + w).min(1.0))
+            };
+            total += 1;
+            if apart_over(vf, &x0, &x1, lo, hi) {
+                ruled_out += 1;
+                if let Some(t) = solve(kind, &x0, &x1, hi, 0.0, &|| false).unwrap() {
+                    assert!(
+                        t < lo,
+                        "vf {vf} {x0:?} -> {x1:?}: contact at {t} in [{lo}, {hi}]"
+                    );
+                }
+            }
+        }
+        assert!(ruled_out > total / 5, "{ruled_out} of {total}");
+    }
+
+    /// A vertex crossing a triangle's plane at t = 1/2, through the face, through an edge, or
+    /// beside it: over an interval of 2^-10 around the crossing (and over the whole step)
+    /// the last is ruled out, the others never.
+    #[test]
+    fn a_vertex_through_the_face_is_never_ruled_out() {
+        let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let pass = |x: f64, y: f64| {
+            (
+                [[x, y, 1.0], tri[0], tri[1], tri[2]],
+                [[x, y, -1.0], tri[0], tri[1], tri[2]],
+            )
+        };
+        let (lo, hi) = (0.5 - 2f64.powi(-10), 0.5 + 2f64.powi(-10));
+        for (x, y) in [(0.25, 0.25), (0.5, 0.5), (0.0, 0.0)] {
+            let (x0, x1) = pass(x, y);
+            assert!(!apart_over(true, &x0, &x1, lo, hi), "through ({x}, {y})");
+        }
+        for (x, y) in [(0.75, 0.5), (-0.25, 0.5), (0.5, -0.001)] {
+            let (x0, x1) = pass(x, y);
+            assert!(apart_over(true, &x0, &x1, lo, hi), "beside ({x}, {y})");
+            // Straight down beside the face: apart over the whole step as well.
+            assert!(
+                apart_over(true, &x0, &x1, 0.0, 1.0),
+                "({x}, {y}), whole step"
+            );
+        }
+    }
 }
