@@ -382,7 +382,9 @@ struct PointCubic {
     /// `e` (de Casteljau combinations are convex, so they do not grow it), their rounding (the
     /// division by 3) and the rounding of three levels of `a (1 - s) + b s` (each within
     /// `3u` of the largest magnitude `M`): `e + 2^-48 M` with an absolute `2^-1000` for
-    /// underflow. `1 - s` is exact: `s` is a dyadic midpoint of at most 42 bits.
+    /// underflow. `1 - s` is exact when `s` is a dyadic midpoint of at most 42 bits; after
+    /// a root interval is clipped to a `t_max` that is not, it may round (within `u`), which
+    /// adds at most `3u M` to the `9u M` above, far inside `2^-48 M = 32u M`.
     err: f64,
 }
 
@@ -447,12 +449,7 @@ fn bisect(c: &PointCubic, sign0: i8, s0: &mut f64, s1: &mut f64, width: f64) -> 
 /// each of the two edges. Any direction is a valid axis, so nothing here needs to be
 /// exact; a root the directions do not separate goes to the interval test.
 #[inline(always)]
-fn apart_over(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], s0: f64, s1: f64) -> bool {
-    let m = x0
-        .iter()
-        .chain(x1)
-        .flatten()
-        .fold(0.0f64, |m, x| m.max(x.abs()));
+fn apart_over(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], s0: f64, s1: f64, m: f64) -> bool {
     let p0 = axis::positions_at(x0, x1, s0);
     let p1 = axis::positions_at(x0, x1, s1);
     let apart = |c: &[f64; 3]| axis::apart_between(vf, (&p0, &p1), c, 0.0, m);
@@ -466,6 +463,15 @@ fn apart_over(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], s0: f64, s1: f64
         let n = cross(&u, &v);
         apart(&cross(&n, &u)) || apart(&cross(&n, &v))
     }
+}
+
+/// The largest coordinate magnitude of a query.
+#[inline(always)]
+fn magnitude(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> f64 {
+    x0.iter()
+        .chain(x1)
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 #[inline(never)]
@@ -491,6 +497,7 @@ fn roots_and_test(
     }; 3];
     let point = PointCubic::new(b, e);
     let mut n = 0;
+    let m = magnitude(x0, x1);
     let whole = Piece {
         s0: 0.0,
         s1: 1.0,
@@ -518,7 +525,7 @@ fn roots_and_test(
         let mut ruled_out = false;
         for width in COARSE_WIDTHS {
             narrow = bisect(&point, r.sign0, &mut s0, &mut s1, width);
-            if apart_over(vf, x0, x1, s0, s1) {
+            if apart_over(vf, x0, x1, s0, s1, m) {
                 ruled_out = true;
                 break;
             }
@@ -545,14 +552,15 @@ fn roots_and_test(
     Verdict::Miss
 }
 
-/// The vertex-face filter (stages 1-2; the caller has run stage 0).
+/// The vertex-face filter (stages 1-2; stage 0 is the caller's, which the walk's pairs skip:
+/// see `ccd::pair_until`).
 #[inline]
 pub(crate) fn vertex_face(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
     let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
     decide(true, x0, x1, &[at(x0), at(x1)], t_max, vf_static)
 }
 
-/// The edge-edge filter (stages 1-2; the caller has run stage 0).
+/// The edge-edge filter (stages 1-2, as [`vertex_face`]).
 #[inline]
 pub(crate) fn edge_edge(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], t_max: f64) -> Verdict {
     let at = |x: &[[f64; 3]; 4]| [d3(&x[1], &x[0]), d3(&x[2], &x[0]), d3(&x[3], &x[0])];
@@ -601,7 +609,7 @@ mod tests {
             // From t = 0, whose pose is exact: no contact in [0, hi] at all.
             let hi = [1.0, 0.75, 0.5, 0.25][rng.below(4) as usize];
             total += 1;
-            if apart_over(vf, &x0, &x1, 0.0, hi) {
+            if apart_over(vf, &x0, &x1, 0.0, hi, magnitude(&x0, &x1)) {
                 ruled_out += 1;
                 let exact = solve(kind, &x0, &x1, hi, 0.0, &|| false).unwrap();
                 assert_eq!(exact, None, "vf {vf} {x0:?} -> {x1:?} over [0, {hi}]");
@@ -617,7 +625,7 @@ mod tests {
                 ((crossing - w).max(0.0), (crossing + w).min(1.0))
             };
             total += 1;
-            if apart_over(vf, &x0, &x1, lo, hi) {
+            if apart_over(vf, &x0, &x1, lo, hi, magnitude(&x0, &x1)) {
                 ruled_out += 1;
                 if let Some(t) = solve(kind, &x0, &x1, hi, 0.0, &|| false).unwrap() {
                     assert!(
@@ -645,14 +653,17 @@ mod tests {
         let (lo, hi) = (0.5 - 2f64.powi(-10), 0.5 + 2f64.powi(-10));
         for (x, y) in [(0.25, 0.25), (0.5, 0.5), (0.0, 0.0)] {
             let (x0, x1) = pass(x, y);
-            assert!(!apart_over(true, &x0, &x1, lo, hi), "through ({x}, {y})");
+            assert!(
+                !apart_over(true, &x0, &x1, lo, hi, 1.0),
+                "through ({x}, {y})"
+            );
         }
         for (x, y) in [(0.75, 0.5), (-0.25, 0.5), (0.5, -0.001)] {
             let (x0, x1) = pass(x, y);
-            assert!(apart_over(true, &x0, &x1, lo, hi), "beside ({x}, {y})");
+            assert!(apart_over(true, &x0, &x1, lo, hi, 1.0), "beside ({x}, {y})");
             // Straight down beside the face: apart over the whole step as well.
             assert!(
-                apart_over(true, &x0, &x1, 0.0, 1.0),
+                apart_over(true, &x0, &x1, 0.0, 1.0, 1.0),
                 "({x}, {y}), whole step"
             );
         }

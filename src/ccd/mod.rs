@@ -74,7 +74,8 @@
 //! of each member changes no sign variation) and all evaluation points are dyadic, so no
 //! rational arithmetic (and no gcd per operation) is needed.
 //!
-//! **Separation first** (`axis.rs`), after the swept boxes of stage 0 below: the features'
+//! **Separation first** (`axis.rs`), after the swept boxes of stage 0 below (which the
+//! walk's pairs skip: their feature boxes already met, `pair_until`): the features'
 //! gap along a fixed axis is concave in t (their points move linearly), so a gap above
 //! `delta` at t = 0 and at t = `t_max` holds in between. Tested in floats with a proven
 //! error bound along the centroids' line, the face normal or the edges' cross product, and
