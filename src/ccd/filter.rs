@@ -465,15 +465,6 @@ fn apart_over(vf: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], s0: f64, s1: f64
     }
 }
 
-/// The largest coordinate magnitude of a query.
-#[inline(always)]
-fn magnitude(x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> f64 {
-    x0.iter()
-        .chain(x1)
-        .flatten()
-        .fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
 #[inline(never)]
 fn roots_and_test(
     vf: bool,
@@ -497,7 +488,7 @@ fn roots_and_test(
     }; 3];
     let point = PointCubic::new(b, e);
     let mut n = 0;
-    let m = magnitude(x0, x1);
+    let m = super::max_magnitude(x0, x1);
     let whole = Piece {
         s0: 0.0,
         s1: 1.0,
@@ -609,7 +600,7 @@ mod tests {
             // From t = 0, whose pose is exact: no contact in [0, hi] at all.
             let hi = [1.0, 0.75, 0.5, 0.25][rng.below(4) as usize];
             total += 1;
-            if apart_over(vf, &x0, &x1, 0.0, hi, magnitude(&x0, &x1)) {
+            if apart_over(vf, &x0, &x1, 0.0, hi, super::super::max_magnitude(&x0, &x1)) {
                 ruled_out += 1;
                 let exact = solve(kind, &x0, &x1, hi, 0.0, &|| false).unwrap();
                 assert_eq!(exact, None, "vf {vf} {x0:?} -> {x1:?} over [0, {hi}]");
@@ -625,7 +616,7 @@ mod tests {
                 ((crossing - w).max(0.0), (crossing + w).min(1.0))
             };
             total += 1;
-            if apart_over(vf, &x0, &x1, lo, hi, magnitude(&x0, &x1)) {
+            if apart_over(vf, &x0, &x1, lo, hi, super::super::max_magnitude(&x0, &x1)) {
                 ruled_out += 1;
                 if let Some(t) = solve(kind, &x0, &x1, hi, 0.0, &|| false).unwrap() {
                     assert!(

@@ -363,7 +363,8 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
 
     /// `h` over `step` (its positions in `h`'s internal order, checked).
     pub(crate) fn of_step(h: &'h Hierarchy<K>, step: Cow<'h, Step>) -> Self {
-        Self::fitted(h, step, None)
+        let magnitude = largest_magnitude(&step);
+        Self::fitted(h, step, magnitude, None)
     }
 
     /// The same hierarchy and step, its bounds and boxes fitted over `[0, by]` only, for a
@@ -377,7 +378,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
     pub(crate) fn until<'s>(&'s self, by: f64) -> Swept<'s, K> {
         let step = Cow::Borrowed(self.step.as_ref());
         if by >= 1.0 {
-            return Swept::fitted(self.h, step, None);
+            return Swept::fitted(self.h, step, self.magnitude, None);
         }
         let at = |(p, q): (&[f64; 3], &[f64; 3])| -> [f64; 3] {
             std::array::from_fn(|k| p[k] + by * (q[k] - p[k]))
@@ -386,7 +387,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             x0: self.step.x0.clone(),
             x1: self.step.x0.iter().zip(&self.step.x1).map(at).collect(),
         };
-        let mut s = Swept::fitted(self.h, step, Some(culling));
+        let mut s = Swept::fitted(self.h, step, self.magnitude, Some(culling));
         s.horizon = by;
         s.horizon_error = horizon_error(s.magnitude);
         s
@@ -397,9 +398,15 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         self.horizon
     }
 
-    fn fitted(h: &'h Hierarchy<K>, step: Cow<'h, Step>, culling: Option<Step>) -> Self {
+    /// `h`'s bounds and boxes fitted to `culling` (or `step`); `magnitude` is `step`'s
+    /// largest coordinate magnitude ([`largest_magnitude`]).
+    fn fitted(
+        h: &'h Hierarchy<K>,
+        step: Cow<'h, Step>,
+        magnitude: f64,
+        culling: Option<Step>,
+    ) -> Self {
         let tree = h.tree();
-        let magnitude = largest_magnitude(&step);
         let fit = culling.as_ref().unwrap_or(&step);
         let tri_rows = box_rows(tree.triangles().iter().map(|t| t.map(|v| v as usize)), fit);
         let edge_rows = box_rows(
