@@ -42,7 +42,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use pulp::Simd;
 
 use super::features::{points_box_f64, Candidates, FeatureBox, LeafEdges, LeafTriangles};
-use crate::bv::swept::{f32_down, f32_up, widen, Step};
+use crate::bv::swept::{f32_down, f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
 use crate::control::Budget;
@@ -328,26 +328,54 @@ pub(crate) fn checked_step(tree: &RegionTree, motion: Motion<'_>) -> Result<Step
     Ok(Step::gather(tree, motion.x0, motion.x1))
 }
 
-/// Six rows of boxes, one per point set.
+/// Every vertex's position at t0 and at t1 of `step`, each rounded outward to `f32`: `[lo0,
+/// hi0, lo1, hi1]`. Rounding outward is monotone (`f32_down(min(x, y)) = min(f32_down(x),
+/// f32_down(y))`), so the box of any set of these points is the `f32` min and max of its
+/// vertices' entries, the same box as rounding the `f64` box once: each vertex is rounded
+/// once rather than once per feature and node that holds it.
+fn vertex_ends(step: &Step) -> Vec<[[f32; 3]; 4]> {
+    step.x0
+        .iter()
+        .zip(&step.x1)
+        .map(|(p, q)| {
+            [
+                p.map(f32_down),
+                p.map(f32_up),
+                q.map(f32_down),
+                q.map(f32_up),
+            ]
+        })
+        .collect()
+}
+
+/// Each vertex's box over the step (both ends), from [`vertex_ends`].
+fn vertex_boxes(ends: &[[[f32; 3]; 4]]) -> Vec<[f32; 6]> {
+    ends.iter()
+        .map(|[lo0, hi0, lo1, hi1]| {
+            let lo = std::array::from_fn::<f32, 3, _>(|k| lo0[k].min(lo1[k]));
+            let hi = std::array::from_fn::<f32, 3, _>(|k| hi0[k].max(hi1[k]));
+            [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]]
+        })
+        .collect()
+}
+
+/// Six rows of boxes, one per point set: the union of its vertices' boxes ([`vertex_boxes`]).
 fn box_rows<const N: usize>(
-    sets: impl ExactSizeIterator<Item = [usize; N]>,
-    step: &Step,
+    sets: impl ExactSizeIterator<Item = [u32; N]>,
+    boxes: &[[f32; 6]],
 ) -> [Vec<f32>; 6] {
     let mut rows: [Vec<f32>; 6] = std::array::from_fn(|_| Vec::with_capacity(sets.len()));
     for s in sets {
-        let mut p = [[0.0; 3]; 8];
-        for (k, &v) in s.iter().enumerate() {
-            p[2 * k] = step.x0[v];
-            p[2 * k + 1] = step.x1[v];
+        let mut b = boxes[s[0] as usize];
+        for &v in &s[1..] {
+            let c = &boxes[v as usize];
+            for k in 0..3 {
+                b[k] = b[k].min(c[k]);
+                b[3 + k] = b[3 + k].max(c[3 + k]);
+            }
         }
-        // The box of the 2N points: the unused entries repeat the first.
-        for k in 2 * N..8 {
-            p[k] = p[0];
-        }
-        let (lo, hi) = points_box_f64(p);
-        for k in 0..3 {
-            rows[k].push(lo[k]);
-            rows[3 + k].push(hi[k]);
+        for (row, x) in rows.iter_mut().zip(b) {
+            row.push(x);
         }
     }
     rows
@@ -408,30 +436,30 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
     ) -> Self {
         let tree = h.tree();
         let fit = culling.as_ref().unwrap_or(&step);
-        let tri_rows = box_rows(tree.triangles().iter().map(|t| t.map(|v| v as usize)), fit);
-        let edge_rows = box_rows(
-            tree.leaf_edges()
-                .all()
-                .iter()
-                .map(|e| e.map(|v| v as usize)),
-            fit,
-        );
+        let vertex_ends = vertex_ends(fit);
+        let boxes = vertex_boxes(&vertex_ends);
+        let tri_rows = box_rows(tree.triangles().iter().copied(), &boxes);
+        let edge_rows = box_rows(tree.leaf_edges().all().iter().copied(), &boxes);
         let triangles = tree.triangles();
         let mut ends = Vec::with_capacity(tree.node_count());
         for n in 0..tree.node_count() {
-            // In `f64`, rounded outward once (an empty box stays empty: infinities convert
-            // to themselves).
-            let mut lo = [[f64::INFINITY; 3]; 2];
-            let mut hi = [[f64::NEG_INFINITY; 3]; 2];
+            // An empty box stays `+inf..-inf`.
+            let mut lo = [[f32::INFINITY; 3]; 2];
+            let mut hi = [[f32::NEG_INFINITY; 3]; 2];
             if tree.is_leaf(n) {
                 // Its triangles' corners and its own vertices (free points included).
                 let corners = triangles[tree.tri_range(n)].iter().flatten();
                 for v in corners.map(|&v| v as usize).chain(tree.vert_run(n)) {
-                    widen(&mut lo[0], &mut hi[0], &fit.x0[v]);
-                    widen(&mut lo[1], &mut hi[1], &fit.x1[v]);
+                    let [lo0, hi0, lo1, hi1] = &vertex_ends[v];
+                    for k in 0..3 {
+                        lo[0][k] = lo[0][k].min(lo0[k]);
+                        hi[0][k] = hi[0][k].max(hi0[k]);
+                        lo[1][k] = lo[1][k].min(lo1[k]);
+                        hi[1][k] = hi[1][k].max(hi1[k]);
+                    }
                 }
             }
-            ends.push([0, 1].map(|e| (lo[e].map(f32_down), hi[e].map(f32_up))));
+            ends.push([0, 1].map(|e| (lo[e], hi[e])));
         }
         Self {
             h,
