@@ -260,8 +260,15 @@ pub type BoxRows<'a> = [&'a [f32]; 6];
 /// The longest block [`boxes_meet_with`] tests: the bits of a `u64`.
 pub const MAX_BOX_ROW: usize = 64;
 
+#[inline]
 pub(crate) fn box_rows_len(rows: &BoxRows, n: usize) -> usize {
     assert!(n <= MAX_BOX_ROW, "at most {MAX_BOX_ROW} boxes a call");
+    rows_len_at_least(rows, n)
+}
+
+/// The rows' common length, checked to be at least `n`.
+#[inline(always)]
+fn rows_len_at_least(rows: &BoxRows, n: usize) -> usize {
     let len = rows[0].len();
     assert!(
         rows.iter().all(|r| r.len() == len) && n <= len,
@@ -281,7 +288,25 @@ pub fn boxes_meet_with<S: Simd>(
     rows: BoxRows,
     n: usize,
 ) -> u64 {
-    let len = box_rows_len(&rows, n);
+    assert!(n <= MAX_BOX_ROW, "at most {MAX_BOX_ROW} boxes a call");
+    boxes_meet_from(simd, lo, hi, &rows, 0, n)
+}
+
+/// [`boxes_meet_with`] on the boxes `from..min(from + 64, n)` of the first `n` of `rows`
+/// (`from <= n`): bit `k` for box `from + k`. The rows are read in place, so a caller
+/// walking a long row in blocks of 64 does not build six new slices for each block.
+#[inline(always)]
+pub fn boxes_meet_from<S: Simd>(
+    simd: S,
+    lo: [f32; 3],
+    hi: [f32; 3],
+    rows: &BoxRows,
+    from: usize,
+    n: usize,
+) -> u64 {
+    let len = rows_len_at_least(rows, n);
+    assert!(from <= n, "the first box tested is at most n");
+    let n = (n - from).min(MAX_BOX_ROW);
     let plo = [
         simd.splat_f32s(lo[0]),
         simd.splat_f32s(lo[1]),
@@ -292,24 +317,21 @@ pub fn boxes_meet_with<S: Simd>(
         simd.splat_f32s(hi[1]),
         simd.splat_f32s(hi[2]),
     ];
+    let row =
+        |k: usize, base: usize, end: usize| load_prefix(simd, &rows[k][from + base..from + end]);
     let mut bits = 0u64;
     let mut base = 0;
     while base < n {
-        let end = (base + S::F32_LANES).min(len);
-        let mut hit = simd.less_than_or_equal_f32s(plo[0], load_prefix(simd, &rows[3][base..end]));
-        hit = simd.and_m32s(
-            hit,
-            simd.less_than_or_equal_f32s(load_prefix(simd, &rows[0][base..end]), phi[0]),
-        );
+        // Within the rows (padding past `n` included), at most one vector.
+        let end = (base + S::F32_LANES).min(len - from);
+        let mut hit = simd.less_than_or_equal_f32s(plo[0], row(3, base, end));
+        hit = simd.and_m32s(hit, simd.less_than_or_equal_f32s(row(0, base, end), phi[0]));
         for k in 1..3 {
             hit = simd.and_m32s(
                 hit,
-                simd.less_than_or_equal_f32s(plo[k], load_prefix(simd, &rows[3 + k][base..end])),
+                simd.less_than_or_equal_f32s(plo[k], row(3 + k, base, end)),
             );
-            hit = simd.and_m32s(
-                hit,
-                simd.less_than_or_equal_f32s(load_prefix(simd, &rows[k][base..end]), phi[k]),
-            );
+            hit = simd.and_m32s(hit, simd.less_than_or_equal_f32s(row(k, base, end), phi[k]));
         }
         let valid = if n - base >= 64 {
             u64::MAX

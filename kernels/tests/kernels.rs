@@ -265,6 +265,33 @@ fn check_box_rows<S: Simd>(simd: S) {
     }
 }
 
+/// `boxes_meet_from`: on rows longer than 64 boxes, the bits of the block from any start
+/// are those of `boxes_meet_with` on the rows cut at that start.
+fn check_box_rows_from<S: Simd>(simd: S) {
+    let mut rng = Rng::new(13);
+    for n in [0, 1, 63, 64, 65, 130, 200] {
+        let b = boxes(&mut rng, n + 5, 3);
+        let rows = [&b[0][..], &b[1], &b[2], &b[3], &b[4], &b[5]];
+        let p = boxes(&mut rng, 1, 0);
+        let (lo, hi) = ([p[0][0], p[1][0], p[2][0]], [p[3][0], p[4][0], p[5][0]]);
+        for from in [0, 1, 7, 64, 65, n.saturating_sub(3), n] {
+            if from > n {
+                continue;
+            }
+            let cut: [&[f32]; 6] = std::array::from_fn(|f| &rows[f][from..]);
+            let m = (n - from).min(overlap::MAX_BOX_ROW);
+            let want = reference::boxes_meet_scalar(lo, hi, cut, m);
+            let got = overlap::boxes_meet_from(simd, lo, hi, &rows, from, n);
+            assert_eq!(got, want, "{simd:?} n={n} from={from}");
+        }
+    }
+}
+
+#[test]
+fn box_rows_from_match_reference_on_all_backends() {
+    on_all_backends!(check_box_rows_from);
+}
+
 #[test]
 fn box_rows_match_reference_on_all_backends() {
     on_all_backends!(check_box_rows);

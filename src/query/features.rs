@@ -10,7 +10,7 @@
 //! leaf's union box grown by the query's margin, then pair by pair by their boxes grown by it
 //! ([`Candidates`]); in a self query, pairs sharing a vertex are skipped. Boxes are `f32`,
 //! closed, rounded outward from the positions; a leaf's boxes are six rows (`lo xyz`, `hi
-//! xyz`) tested 64 at a time by [`boxes_meet_with`].
+//! xyz`) tested 64 at a time by [`boxes_meet_from`].
 
 use std::ops::Range;
 
@@ -19,7 +19,7 @@ use pulp::Simd;
 use crate::counters::Counters;
 
 use crate::bv::swept::{f32_down, f32_up, widen};
-use dhcd_kernels::overlap::{boxes_meet_with, BoxRows, MAX_BOX_ROW};
+use dhcd_kernels::overlap::{boxes_meet_from, BoxRows, MAX_BOX_ROW};
 
 pub(crate) type FeatureBox = ([f32; 3], [f32; 3]);
 
@@ -38,9 +38,7 @@ fn union_of(rows: &BoxRows, n: usize) -> FeatureBox {
 /// `j` for box `base + j`).
 #[inline(always)]
 fn meeting<S: Simd>(simd: S, probe: &FeatureBox, rows: &BoxRows, base: usize, n: usize) -> u64 {
-    let m = (n - base).min(MAX_BOX_ROW);
-    let part: BoxRows = std::array::from_fn(|f| &rows[f][base..]);
-    boxes_meet_with(simd, probe.0, probe.1, part, m)
+    boxes_meet_from(simd, probe.0, probe.1, rows, base, n)
 }
 
 /// Whether two closed boxes meet.
