@@ -282,6 +282,8 @@ pub fn edge_edge_until(
 /// met (stage 0 would end almost none of its pairs), and `magnitude`, at least every
 /// coordinate's magnitude (the whole step's largest), bounds the culls' rounding in place
 /// of the pair's own largest coordinate (any upper bound keeps them certain).
+/// `boxes_until`: test the pair's boxes over `[0, t_max]` (when `t_max < 1`), which the
+/// walk skips where its own boxes covered nearly that interval (they would meet again).
 #[inline(always)]
 pub(crate) fn pair_until(
     vf: bool,
@@ -289,6 +291,7 @@ pub(crate) fn pair_until(
     x1: &[[f64; 3]; 4],
     options: &CcdOptions,
     magnitude: f64,
+    boxes_until: bool,
     stop: &dyn Fn() -> bool,
 ) -> std::result::Result<Option<f64>, exact::Stopped> {
     debug_assert!(
@@ -301,6 +304,9 @@ pub(crate) fn pair_until(
     } else {
         exact::Kind::EdgeEdge
     };
+    if boxes_until && apart_until(kind, x0, x1, options, magnitude) {
+        return Ok(None);
+    }
     after_boxes(kind, x0, x1, options, magnitude, None, stop)
 }
 
@@ -351,13 +357,33 @@ fn query(
         return Ok(None);
     }
     let magnitude = max_magnitude(x0, x1);
+    if apart_until(kind, x0, x1, options, magnitude) {
+        return Ok(None);
+    }
     after_boxes(kind, x0, x1, options, magnitude, Some(magnitude), stop)
 }
 
-/// A valid query whose swept boxes meet: the culls over `[0, t_max]` (their rounding
-/// bounded with `bound`, at least every coordinate's magnitude), then the filters and the
-/// exact path on the query scaled to unit size (by its own largest coordinate magnitude,
-/// `own` when known).
+/// With a time limit below 1 (the earliest-time mode's pruning), the pair's boxes over
+/// `[0, t_max]` apart: far smaller than over the whole step when `t_max` is small. Their
+/// rounding bound holds for coordinates below 2^1000 (no overflow), at any scale; `bound`
+/// is at least every coordinate's magnitude.
+#[inline(always)]
+fn apart_until(
+    kind: exact::Kind,
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    options: &CcdOptions,
+    bound: f64,
+) -> bool {
+    options.t_max < 1.0
+        && bound <= BOXES_UNTIL_MAX
+        && filter::boxes_apart_until(kind, x0, x1, options.t_max, options.min_distance)
+}
+
+/// A valid query whose swept boxes meet (over the step, and over `[0, t_max]` where tested:
+/// [`apart_until`]): the axes over `[0, t_max]` (their rounding bounded with `bound`, at
+/// least every coordinate's magnitude), then the filters and the exact path on the query
+/// scaled to unit size (by its own largest coordinate magnitude, `own` when known).
 #[inline(always)]
 fn after_boxes(
     kind: exact::Kind,
@@ -370,15 +396,6 @@ fn after_boxes(
 ) -> std::result::Result<Option<f64>, exact::Stopped> {
     let vf = kind == exact::Kind::VertexFace;
     let delta = options.min_distance;
-    // A time limit below 1 (the earliest-time mode's pruning): the boxes over [0, t_max],
-    // far smaller than over the whole step when t_max is small. Their rounding bound holds
-    // for coordinates below 2^1000 (no overflow), at any scale.
-    if options.t_max < 1.0
-        && bound <= BOXES_UNTIL_MAX
-        && filter::boxes_apart_until(kind, x0, x1, options.t_max, delta)
-    {
-        return Ok(None);
-    }
     // Separation along a few fixed axes at both ends of [0, t_max]: ends most pairs of
     // neighbouring features, which the boxes do not, for a few dot products.
     let apart = if options.t_max < 1.0 {
