@@ -41,7 +41,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{points_box_f64, Candidates, FeatureBox, LeafEdges, LeafTriangles};
+use super::features::{Candidates, FeatureBox, LeafEdges, LeafTriangles};
 use crate::bv::swept::{f32_down, f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
@@ -278,6 +278,8 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
     /// ([`ccd::pair_until`]).
     magnitude: f64,
     bounds: K::Swept,
+    /// Each vertex's box over the culling positions ([`vertex_boxes`]): `[lo xyz, hi xyz]`.
+    vertex_boxes: Vec<[f32; 6]>,
     tri_rows: [Vec<f32>; 6],
     edge_rows: [Vec<f32>; 6],
     /// Per node (filled for leaves): the box of its triangles' corners and its own vertices,
@@ -469,6 +471,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             horizon: 1.0,
             horizon_error: 0.0,
             magnitude,
+            vertex_boxes: boxes,
             tri_rows,
             edge_rows,
             leaf_ends: ends,
@@ -1190,8 +1193,10 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             first: st.tree().tri_range(y).start,
             corners: st.tree().triangles(),
         };
-        let fit = sv.culling();
-        let vertex_box = |v: usize| points_box_f64([fit.x0[v], fit.x1[v]]);
+        let vertex_box = |v: usize| {
+            let b = &sv.vertex_boxes[v];
+            ([b[0], b[1], b[2]], [b[3], b[4], b[5]])
+        };
         candidates.vertices_vs_triangles(
             simd,
             sv.tree().vert_run(x),

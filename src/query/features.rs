@@ -18,7 +18,6 @@ use pulp::Simd;
 
 use crate::counters::Counters;
 
-use crate::bv::swept::{f32_down, f32_up, widen};
 use dhcd_kernels::overlap::{boxes_meet_from, BoxRows, MAX_BOX_ROW};
 
 pub(crate) type FeatureBox = ([f32; 3], [f32; 3]);
@@ -70,17 +69,6 @@ pub(crate) fn points_box<const N: usize>(p: [[f32; 3]; N], rounded: bool) -> Fea
     } else {
         b
     }
-}
-
-/// The closed box of `f64` points (finite: checked on input), rounded outward to `f32`.
-#[inline(always)]
-pub(crate) fn points_box_f64<const N: usize>(p: [[f64; 3]; N]) -> FeatureBox {
-    let mut lo = p[0];
-    let mut hi = p[0];
-    for q in &p[1..] {
-        widen(&mut lo, &mut hi, q);
-    }
-    (lo.map(f32_down), hi.map(f32_up))
 }
 
 /// An edge (internal vertex indices) as its original indices, smaller first, and its
