@@ -602,21 +602,32 @@ impl Gap {
         o: CcdOptions,
     ) -> Option<CcdOptions> {
         use crate::distance::{edge_edge_distance_sq, point_triangle_distance_sq};
-        let u: [[f64; 3]; 4] = std::array::from_fn(|k| [0, 1, 2].map(|c| x1[k][c] - x0[k][c]));
-        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        let length = u.map(norm);
-        let split = if vertex_face { 1 } else { 2 };
-        // The largest |u_i - u_j| over a vertex i of the first feature and j of the second,
-        // plus the rounding of the computed displacements and differences (a few ulps of
-        // |u_i| + |u_j|).
-        let mut relative = 0.0f64;
-        for i in 0..split {
-            for j in split..4 {
-                let d = [0, 1, 2].map(|c| u[i][c] - u[j][c]);
-                let slack = 4.0 * f64::EPSILON * (length[i] + length[j]);
-                relative = relative.max(norm(d) + slack);
+        // PERF: indexed loops, not `array::map`: copies of the arrays through the stack
+        // stalled on store forwarding.
+        let norm_sq = |v: &[f64; 3]| v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        let mut u = [[0.0f64; 3]; 4];
+        for k in 0..4 {
+            for c in 0..3 {
+                u[k][c] = x1[k][c] - x0[k][c];
             }
         }
+        let split = if vertex_face { 1 } else { 2 };
+        // The largest |u_i - u_j| over a vertex i of the first feature and j of the second
+        // (the square root of the largest square: sqrt is monotone), plus the rounding of
+        // the computed displacements and differences (a few ulps of |u_i| + |u_j|, at most
+        // twice the longest |u_k|).
+        let mut longest_sq = 0.0f64;
+        for v in &u {
+            longest_sq = longest_sq.max(norm_sq(v));
+        }
+        let mut relative_sq = 0.0f64;
+        for i in 0..split {
+            for j in split..4 {
+                let d = [u[i][0] - u[j][0], u[i][1] - u[j][1], u[i][2] - u[j][2]];
+                relative_sq = relative_sq.max(norm_sq(&d));
+            }
+        }
+        let relative = relative_sq.sqrt() + 8.0 * f64::EPSILON * longest_sq.sqrt();
         // Within [0, t_max] (in earliest mode the best time so far) a vertex moves `t_max`
         // of its displacement. Rounded up (each operation above is within a few ulps).
         let reach =
