@@ -41,7 +41,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{union_of, Candidates, FeatureBox, LeafEdges, LeafTriangles};
+use super::features::{Candidates, FeatureBox, LeafEdges, LeafTriangles};
 use crate::bv::swept::{f32_down, f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
@@ -285,9 +285,6 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
     /// Per node (filled for leaves): the box of its triangles' corners and its own vertices,
     /// at t0 and at t1.
     leaf_ends: Vec<[FeatureBox; 2]>,
-    /// Per node (filled for leaves): the union of its triangles' boxes and of its own
-    /// edges' boxes, the first cull of a leaf pair's candidates (kept: a leaf meets many).
-    leaf_unions: Vec<[FeatureBox; 2]>,
 }
 
 /// A bound on how far a position at a time `by` of `steps`, computed in `f64` as `x0 + by
@@ -466,19 +463,6 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             }
             ends.push([0, 1].map(|e| (lo[e], hi[e])));
         }
-        let union = |rows: &[Vec<f32>; 6], r: std::ops::Range<usize>| {
-            let part: BoxRows = std::array::from_fn(|f| &rows[f][r.clone()]);
-            union_of(&part, r.len())
-        };
-        let unions = (0..tree.node_count())
-            .map(|n| match tree.leaf_rank(n) {
-                Some(rank) => [
-                    union(&tri_rows, tree.tri_range(n)),
-                    union(&edge_rows, tree.leaf_edges().range_of_rank(rank)),
-                ],
-                None => [(); 2].map(|_| ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3])),
-            })
-            .collect();
         Self {
             h,
             bounds: K::swept(tree),
@@ -491,7 +475,6 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             tri_rows,
             edge_rows,
             leaf_ends: ends,
-            leaf_unions: unions,
         }
     }
 
@@ -518,7 +501,6 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         let r = edges.range_of_rank(rank);
         LeafEdges {
             edges: edges.of_rank(rank),
-            union: Some(self.leaf_unions[leaf][1]),
             rows: std::array::from_fn(|f| &self.edge_rows[f][r.clone()]),
             order: tree.vert_order(),
         }
@@ -1217,7 +1199,6 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     ) {
         let rows = st.tri_boxes(y);
         let tris = LeafTriangles {
-            union: Some(st.leaf_unions[y][0]),
             len: rows[0].len(),
             rows,
             first: st.tree().tri_range(y).start,

@@ -23,7 +23,7 @@ use dhcd_kernels::overlap::{boxes_meet_from, BoxRows, MAX_BOX_ROW};
 pub(crate) type FeatureBox = ([f32; 3], [f32; 3]);
 
 /// The union of the first `n` boxes of `rows` (empty: `+inf..-inf`).
-pub(crate) fn union_of(rows: &BoxRows, n: usize) -> FeatureBox {
+fn union_of(rows: &BoxRows, n: usize) -> FeatureBox {
     let lo = |k: usize| rows[k][..n].iter().fold(f32::INFINITY, |m, &x| m.min(x));
     let hi = |k: usize| {
         rows[3 + k][..n]
@@ -87,8 +87,6 @@ fn ordered_edge(order: &[u32], [s, t]: [u32; 2]) -> ([u32; 2], [u32; 2]) {
 /// index of the first, and every triangle's corners (internal indices).
 pub(crate) struct LeafTriangles<'a> {
     pub(crate) rows: BoxRows<'a>,
-    /// The union of the `len` boxes when the caller keeps it ([`union_of`] otherwise).
-    pub(crate) union: Option<FeatureBox>,
     pub(crate) len: usize,
     pub(crate) first: usize,
     pub(crate) corners: &'a [[u32; 3]],
@@ -99,8 +97,6 @@ pub(crate) struct LeafTriangles<'a> {
 pub(crate) struct LeafEdges<'a> {
     pub(crate) edges: &'a [[u32; 2]],
     pub(crate) rows: BoxRows<'a>,
-    /// The union of the edges' boxes when the caller keeps it ([`union_of`] otherwise).
-    pub(crate) union: Option<FeatureBox>,
     pub(crate) order: &'a [u32],
 }
 
@@ -140,10 +136,7 @@ impl Candidates<'_> {
         mut decide: impl FnMut(usize, usize),
     ) {
         let (rows, n) = (&tris.rows, tris.len);
-        let near = grown(
-            &tris.union.unwrap_or_else(|| union_of(rows, n)),
-            self.margin,
-        );
+        let near = grown(&union_of(rows, n), self.margin);
         for v in vertices {
             let vbox = vertex_box(v);
             if !meet(&vbox, &near) {
@@ -185,10 +178,7 @@ impl Candidates<'_> {
     ) {
         let (ea, eb) = (a.edges, b.edges);
         let (ra, rb) = (&a.rows, &b.rows);
-        let near = grown(
-            &b.union.unwrap_or_else(|| union_of(rb, eb.len())),
-            self.margin,
-        );
+        let near = grown(&union_of(rb, eb.len()), self.margin);
         for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
             let mut near_bits = meeting(simd, &near, ra, base_a, ea.len());
             while near_bits != 0 {

@@ -197,7 +197,6 @@ impl<'h, K: BoundingVolume> Leaf<'h, K> {
                 .leaf_edges()
                 .of_rank(tree.leaf_rank(self.node).expect("a leaf")),
             rows: self.h.leaf_edge_boxes(self.node),
-            union: None,
             order: tree.vert_order(),
         }
     }
@@ -326,7 +325,6 @@ impl Features<'_, '_> {
                 soa.hi(1),
                 soa.hi(2),
             ],
-            union: None,
             len: leaf_tris.len,
             first: tt.tri_range(lt.node).start,
             corners: tt.triangles(),
