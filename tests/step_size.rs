@@ -199,6 +199,51 @@ fn a_folding_sheet_equals_the_brute_force() {
     }
 }
 
+/// A vertex sweeping past a triangle's edge (0.1 above it at its closest, 1.0 away at t0)
+/// reaches its gap (0.2 of its distance) at t ~ 0.05 and never touches; another vertex
+/// falls onto a triangle at t = 0.1, the first impact. The passing pair limits the step,
+/// though at the first impact it is far from its triangle again: the gap rule must test it
+/// although the first impact's walk, fitted up to that impact, need not meet it.
+#[test]
+fn a_pair_passing_by_limits_the_step_before_the_first_impact() {
+    let x0 = vec![
+        // The triangle the vertex passes by, and the passing vertex with its companions.
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.1],
+        [-1.0, -3.0, 0.1],
+        [-2.0, -3.0, 0.1],
+        // The triangle the falling vertex meets, and the falling vertex with its companions.
+        [5.0, 5.0, 5.0],
+        [6.0, 5.0, 5.0],
+        [5.0, 6.0, 5.0],
+        [5.25, 5.25, 5.1],
+        [5.25, 8.0, 5.1],
+        [6.25, 8.0, 5.1],
+    ];
+    let mut x1 = x0.clone();
+    for p in &mut x1[3..6] {
+        p[0] += 16.5;
+    }
+    for p in &mut x1[9..12] {
+        p[2] -= 1.0;
+    }
+    let tris = vec![[0, 1, 2], [3, 4, 5], [6, 7, 8], [9, 10, 11]];
+    let m = Mesh::new_f64(x0.clone(), tris).unwrap();
+    let o = StepOptions::default();
+    let want = brute_force_step(&m, &x0, &x1, &o);
+    assert!(want < 0.08, "the passing pair limits the step: {want}");
+    for_each_method!(K => {
+        check::<K>(&m, &x0, &x1, &o, want);
+        let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
+        let s = collision_free_stepsize(&h, Motion::new(&x0, &x1), &o).unwrap();
+        // The passing vertex against the triangle (tied with the features at the corner).
+        let passing = |x: &dhcd::query::VertexImpact| x.vertex == 3 && x.triangle == 0;
+        assert!(s.limiting.vertex_face.iter().any(passing), "{:?}", s.limiting);
+    });
+}
+
 /// Two coincident sheets in one mesh, the second sliding over the first: pairs touching at
 /// t0 keep a gap of 0 under the rule with `min_distance = 0` (the step is 0), and with a
 /// minimum distance they are already inside it.

@@ -47,7 +47,10 @@ use crate::counters::Counters;
 use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
-use crate::query::ccd::{earliest_bound, horizon_for, run, Gap, Swept};
+use crate::query::ccd::{
+    earliest_bound, gap_over_listed, horizon_for, run, run_passes, Gap, Listed, Listing, Swept,
+    MAX_LISTED,
+};
 use crate::query::{CcdMode, CcdQuery, Impacts, Motion};
 use crate::walk::Workspace;
 
@@ -161,15 +164,13 @@ pub(crate) fn query_for(
         },
         mode: CcdMode::Earliest,
     };
-    let gap = Gap {
-        min_distance: options.min_distance,
-        rescaling: options.rescaling,
-    };
-    (query, gap)
+    (query, Gap::of(options))
 }
 
 /// The step size of `a` against `b` (the same for a self query) moving by `motions`: the
-/// first impact at the minimum distance, then the walk at each pair's gap, bounded by it.
+/// first impact at the minimum distance, then each pair's gap up to it, on the pairs the
+/// first impact's last pass listed (when it listed them, at most `most_listed`) or by a
+/// second walk.
 #[allow(clippy::too_many_arguments)]
 fn step_between<K: BoundingVolume>(
     a: &Swept<'_, K>,
@@ -177,25 +178,34 @@ fn step_between<K: BoundingVolume>(
     self_query: bool,
     motions: &[Motion<'_>],
     options: &StepOptions,
+    most_listed: usize,
     ws: &mut Workspace,
     par: Par,
 ) -> Result<StepSize> {
     let control = ws.control.clone();
     let budget = Budget::new(&control);
-    let (best, first_work) = first_impact(a, b, self_query, options, &budget, ws, par)?;
-    // The walk fits its bounds over `[0, by]` only, knowing the first impact.
-    let (query, gap) = query_for(options, motions, false, by(&best));
-    let (mut limiting, _) = run(
-        a,
-        b,
-        self_query,
-        &query,
-        Some(&best),
-        &budget,
-        Some(gap),
-        ws,
-        par,
-    )?;
+    // The first impact's passes fitted short of the step list their pairs, culled at the
+    // gap walk's distance for their horizon (see `query::ccd::listed`).
+    let cull_for = |horizon: f64| cull_distance(options, motions, false, horizon);
+    let listing = Listing {
+        cull_for: &cull_for,
+        gap: Gap::of(options),
+        most: most_listed,
+    };
+    let (best, first_work, listed) =
+        first_impact(a, b, self_query, options, Some(&listing), &budget, ws, par)?;
+    let by = by(&best);
+    let (query, gap) = query_for(options, motions, false, by);
+    let mut limiting = match listed {
+        Some(listed) => gap_over_listed(
+            a, b, self_query, &query, &best, &budget, gap, by, &listed, par,
+        )?,
+        // The walk fits its bounds over `[0, by]` only, knowing the first impact.
+        None => {
+            let gap = Some(gap);
+            run(a, b, self_query, &query, Some(&best), &budget, gap, ws, par)?.0
+        }
+    };
     add_first_walk(&mut limiting.counters, first_work);
     Ok(StepSize {
         step: step_at(limiting.toi),
@@ -206,21 +216,35 @@ fn step_between<K: BoundingVolume>(
 /// The earliest impact at the minimum distance (plain CCD, cheap: culled at that
 /// distance), as the starting bound of the step-size walk: every pair reaches its gap (at
 /// least the minimum distance) no later than it reaches the minimum distance, so the step is
-/// at most this time, and pairs that cannot reach their gap by then are never tested.
+/// at most this time, and pairs that cannot reach their gap by then are never tested. Also
+/// the feature pairs of its last pass when that pass listed them under `listing`
+/// ([`run_passes`]).
 #[allow(clippy::too_many_arguments)]
 fn first_impact<K: BoundingVolume>(
     a: &Swept<'_, K>,
     b: &Swept<'_, K>,
     self_query: bool,
     options: &StepOptions,
+    listing: Option<&Listing<'_>>,
     budget: &Budget<'_>,
     ws: &mut Workspace,
     par: Par,
-) -> Result<(AtomicU64, Counters)> {
+) -> Result<(AtomicU64, Counters, Option<Listed>)> {
     let query = first_impact_query(options);
     let best = earliest_bound(&query).expect("earliest mode");
-    let (impacts, _) = run(a, b, self_query, &query, Some(&best), budget, None, ws, par)?;
-    Ok((bound_at(impacts.toi), impacts.counters))
+    let (impacts, _, listed) = run_passes(
+        a,
+        b,
+        self_query,
+        &query,
+        Some(&best),
+        budget,
+        None,
+        listing,
+        ws,
+        par,
+    )?;
+    Ok((bound_at(impacts.toi), impacts.counters, listed))
 }
 
 /// The plain CCD query of the first impact at the minimum distance.
@@ -281,7 +305,7 @@ pub fn collision_free_stepsize_with<K: BoundingVolume>(
 ) -> Result<StepSize> {
     options.validate()?;
     let s = Swept::new(h, motion)?;
-    step_between(&s, &s, true, &[motion], options, ws, par)
+    step_between(&s, &s, true, &[motion], options, MAX_LISTED, ws, par)
 }
 
 /// The collision-free step size of `a` and `b` moving by their motions (the pairs between
@@ -298,7 +322,8 @@ pub fn collision_free_stepsize_pair<K: BoundingVolume>(
     options.validate()?;
     let sa = Swept::new(a, a_motion)?;
     let sb = Swept::new(b, b_motion)?;
-    step_between(&sa, &sb, false, &[a_motion, b_motion], options, ws, par)
+    let motions = [a_motion, b_motion];
+    step_between(&sa, &sb, false, &motions, options, MAX_LISTED, ws, par)
 }
 
 #[cfg(test)]
@@ -323,6 +348,79 @@ mod tests {
             }
         }
         most
+    }
+
+    /// A jittered sheet folded onto itself, its far layer just above the near one at t0 and
+    /// pushed through it by t1: the first impact comes early in the step, so its walk
+    /// restarts on bounds fitted short of the step and its last pass lists its pairs. The
+    /// step from that list is the second walk's (the list refused: at most no pair, or
+    /// fewer than it meets), with the same limiting pairs, for every method, rule and
+    /// thread count.
+    #[test]
+    fn the_listed_pairs_give_the_second_walks_step() {
+        use crate::shapes::{fold_x, grid, jitter};
+        use crate::{Hierarchy, Mesh, Options};
+        let rest = grid(12, 12, 0.1, [0.0; 3]);
+        let far: Vec<bool> = rest.positions().iter().map(|p| p[0] > 0.6).collect();
+        let layered = |lift: f32, seed: u64| -> Vec<[f64; 3]> {
+            let folded = fold_x(rest.positions(), 0.6);
+            let jittered = jitter(&folded, [1e-3, 1e-3, 2e-4], seed);
+            let at = jittered.iter().zip(&far);
+            at.map(|(p, &f)| [p[0], p[1], p[2] + if f { lift } else { 0.0 }])
+                .map(|p| p.map(f64::from))
+                .collect()
+        };
+        let (x0, x1) = (layered(2e-3, 1), layered(-0.05, 2));
+        let m = Mesh::new_f64(x0.clone(), rest.triangles().to_vec()).unwrap();
+        let motion = Motion::new(&x0, &x1);
+        let rules = [
+            StepOptions::default(),
+            StepOptions {
+                min_distance: 1e-4,
+                rescaling: 0.8,
+            },
+            StepOptions {
+                min_distance: 0.0,
+                rescaling: 0.5,
+            },
+        ];
+        crate::for_each_method!(K => {
+            let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
+            let s = Swept::new(&h, motion).unwrap();
+            for o in &rules {
+                let control = crate::control::Control::default();
+                let budget = Budget::new(&control);
+                let cull_for = |horizon: f64| cull_distance(o, &[motion], false, horizon);
+                let listing = Listing { cull_for: &cull_for, gap: Gap::of(o), most: MAX_LISTED };
+                let mut ws = Workspace::default();
+                let (best, _, listed) =
+                    first_impact(&s, &s, true, o, Some(&listing), &budget, &mut ws, Par::Seq)
+                        .unwrap();
+                let first = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
+                assert!(first < 1.0 / 16.0, "{:?} {o:?}: the first impact at {first}", K::METHOD);
+                let listed = listed.expect("the last pass was fitted short of the step").len();
+                assert!(listed > 3, "{:?} {o:?}: {listed} pairs listed", K::METHOD);
+                for par in [Par::Seq, Par::Rayon(2)] {
+                    let mut step = |most: usize| {
+                        let motions = [motion];
+                        step_between(&s, &s, true, &motions, o, most, &mut ws, par).unwrap()
+                    };
+                    let from_list = step(MAX_LISTED);
+                    for most in [0, 3, listed / 2] {
+                        let walked = step(most);
+                        let at = format!("{:?} {o:?} {par:?} at most {most}", K::METHOD);
+                        assert!(walked.step < 1.0, "{at}");
+                        assert_eq!(from_list.step, walked.step, "{at}");
+                        let (l, w) = (&from_list.limiting, &walked.limiting);
+                        assert_eq!(l.vertex_face, w.vertex_face, "{at}");
+                        assert_eq!(l.edge_edge, w.edge_edge, "{at}");
+                        assert_eq!(l.toi, w.toi, "{at}");
+                        // The walk's node tests are counted, the list's only its pairs.
+                        assert!(w.counters.bv_tests > l.counters.bv_tests, "{at}");
+                    }
+                }
+            }
+        });
     }
 
     #[test]

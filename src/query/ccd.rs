@@ -54,6 +54,10 @@ use crate::par::Par;
 use crate::tree::RegionTree;
 use crate::walk::{self, Query, Side, Workspace};
 use dhcd_kernels::overlap::BoxRows;
+use listed::ListedCount;
+pub(crate) use listed::{gap_over_listed, Listed, Listing, MAX_LISTED};
+
+mod listed;
 
 /// One mesh's motion over a step: every vertex's position at t0 and at t1, in the mesh's
 /// vertex order (`f64`, finite and within the `f32` range, as [`crate::Mesh::new_f64`]
@@ -532,6 +536,11 @@ struct SweptQuery<'s, 'h, K: BoundingVolume> {
     restart_below: Option<f64>,
     /// The walk stopped for that.
     abandoned: AtomicBool,
+    /// The walk lists the feature pairs it meets that may reach their gap under the
+    /// listing's rule by the walk's horizon ([`run_passes`]), up to the listing's `most`
+    /// (counted in `listed`).
+    listing: Option<&'s Listing<'s>>,
+    listed: ListedCount,
     /// Earliest mode: the least time of impact found so far, by this walk or any other
     /// sharing the bound ([`earliest_bound`]).
     best: Option<&'s AtomicU64>,
@@ -564,6 +573,14 @@ pub(crate) struct Gap {
 }
 
 impl Gap {
+    /// The rule of the step-size options.
+    pub(crate) fn of(options: &crate::contact::StepOptions) -> Self {
+        Self {
+            min_distance: options.min_distance,
+            rescaling: options.rescaling,
+        }
+    }
+
     /// The options of one pair (`vertex_face`: `x0` is `[v, t0, t1, t2]`, else `[a0, a1,
     /// b0, b1]`, at t0): its minimum distance by the rule, from its distance at t0 (the
     /// exact closest features' `f64` distance, rounded up a few ulps so that the kept gap is
@@ -584,6 +601,34 @@ impl Gap {
         o: CcdOptions,
     ) -> Option<CcdOptions> {
         use crate::distance::{edge_edge_distance_sq, point_triangle_distance_sq};
+        if !self.may_reach(vertex_face, x0, x1, o.t_max) {
+            return None;
+        }
+        let d0_sq = if vertex_face {
+            point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
+        } else {
+            edge_edge_distance_sq(x0[0], x0[1], x0[2], x0[3]).0
+        };
+        let d0 = d0_sq.sqrt();
+        let g = self.min_distance + (1.0 - self.rescaling) * (d0 - self.min_distance);
+        let g = (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0);
+        let g = if g.is_finite() { g } else { f64::MAX };
+        Some(CcdOptions {
+            min_distance: g,
+            ..o
+        })
+    }
+
+    /// Whether the pair can reach its gap before `t_max` (see [`Gap::options`]): `false`
+    /// when `d0 > dmin + A / s`, decided exactly on the positions at t0.
+    #[inline]
+    pub(crate) fn may_reach(
+        &self,
+        vertex_face: bool,
+        x0: &[[f64; 3]; 4],
+        x1: &[[f64; 3]; 4],
+        t_max: f64,
+    ) -> bool {
         // PERF: indexed loops, not `array::map`: copies of the arrays through the stack
         // stalled on store forwarding.
         let norm_sq = |v: &[f64; 3]| v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
@@ -613,23 +658,8 @@ impl Gap {
         // Within [0, t_max] (in earliest mode the best time so far) a vertex moves `t_max`
         // of its displacement. Rounded up (each operation above is within a few ulps).
         let reach =
-            (self.min_distance + relative * o.t_max / self.rescaling) * (1.0 + 16.0 * f64::EPSILON);
-        if reach.is_finite() && !within_at_start(vertex_face, x0, reach) {
-            return None;
-        }
-        let d0_sq = if vertex_face {
-            point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
-        } else {
-            edge_edge_distance_sq(x0[0], x0[1], x0[2], x0[3]).0
-        };
-        let d0 = d0_sq.sqrt();
-        let g = self.min_distance + (1.0 - self.rescaling) * (d0 - self.min_distance);
-        let g = (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0);
-        let g = if g.is_finite() { g } else { f64::MAX };
-        Some(CcdOptions {
-            min_distance: g,
-            ..o
-        })
+            (self.min_distance + relative * t_max / self.rescaling) * (1.0 + 16.0 * f64::EPSILON);
+        !reach.is_finite() || within_at_start(vertex_face, x0, reach)
     }
 }
 
@@ -638,6 +668,8 @@ struct ImpactOut {
     vertex_face: Vec<VertexImpact>,
     face_vertex: Vec<FaceImpact>,
     edge_edge: Vec<EdgeImpact>,
+    /// The feature pairs met, when the walk lists them.
+    listed: Listed,
 }
 
 impl ImpactOut {
@@ -710,6 +742,28 @@ pub(crate) fn run<K: BoundingVolume>(
     ws: &mut Workspace,
     par: Par,
 ) -> Result<(Impacts, [u64; 2])> {
+    let (impacts, fitted, _) =
+        run_passes(a, b, self_query, query, best, budget, gap, None, ws, par)?;
+    Ok((impacts, fitted))
+}
+
+/// [`run`], and with `listing` the feature pairs met by its last pass that may reach their
+/// gap by the pass's horizon, when that pass's bounds were fitted short of the whole step
+/// (see [`listed`]): each such pass culls at the listing's distance for its horizon at
+/// least. `None` when no such pass ran or it met more pairs than the listing's `most`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run_passes<K: BoundingVolume>(
+    a: &Swept<'_, K>,
+    b: &Swept<'_, K>,
+    self_query: bool,
+    query: &CcdQuery,
+    best: Option<&AtomicU64>,
+    budget: &Budget<'_>,
+    gap: Option<Gap>,
+    listing: Option<&Listing<'_>>,
+    ws: &mut Workspace,
+    par: Par,
+) -> Result<(Impacts, [u64; 2], Option<Listed>)> {
     let mut counters = Counters::default();
     let mut fitted = [0u64; 2];
     let mut restarts = 0;
@@ -723,7 +777,18 @@ pub(crate) fn run<K: BoundingVolume>(
         };
         let restart_below = (best.is_some() && restarts < MAX_RESTARTS)
             .then(|| sa.horizon().min(sb.horizon()) / RESTART_FACTOR);
-        let q = SweptQuery::new(sa, sb, self_query, query.options, best, budget, gap);
+        // Only a pass fitted short of the step lists (see `listed`).
+        let listing = listing.filter(|_| sa.horizon().min(sb.horizon()) < 1.0);
+        let q = SweptQuery::new(
+            sa,
+            sb,
+            self_query,
+            query.options,
+            listing,
+            best,
+            budget,
+            gap,
+        );
         let q = SweptQuery { restart_below, ..q };
         let w = walk::walk(&q, ws, par);
         budget.finish()?;
@@ -737,27 +802,34 @@ pub(crate) fn run<K: BoundingVolume>(
             continue;
         }
         let mut out = w.out;
+        let listed = std::mem::take(&mut out.listed);
+        let listed = (q.listing.is_some() && !q.listed.full()).then_some(listed);
         if query.mode == CcdMode::Earliest {
             q.settle_earliest(&mut out);
             budget.finish()?;
         }
-        return Ok((q.impacts(out, counters), fitted));
+        return Ok((q.impacts(out, counters), fitted, listed));
     }
 }
 
 impl<'s, 'h, K: BoundingVolume> SweptQuery<'s, 'h, K> {
     /// The walk of `a` against `b`, its culling distance grown by the rounding of the
     /// positions their bounds are fitted to (each within its `horizon_error`).
+    #[allow(clippy::too_many_arguments)]
     fn new(
         a: &'s Swept<'h, K>,
         b: &'s Swept<'h, K>,
         self_query: bool,
         options: CcdOptions,
+        listing: Option<&'s Listing<'s>>,
         best: Option<&'s AtomicU64>,
         budget: &'s Budget<'s>,
         gap: Option<Gap>,
     ) -> Self {
-        let mut cull = options.min_distance;
+        let horizon = a.horizon.min(b.horizon);
+        // A listing walk culls at the larger of its own distance and the listing's.
+        let listing_cull = listing.map_or(0.0, |l| (l.cull_for)(horizon));
+        let mut cull = options.min_distance.max(listing_cull);
         if a.horizon_error > 0.0 || b.horizon_error > 0.0 {
             cull = (cull + a.horizon_error + b.horizon_error).next_up();
             if !cull.is_finite() {
@@ -773,11 +845,13 @@ impl<'s, 'h, K: BoundingVolume> SweptQuery<'s, 'h, K> {
             margin: f32_up(cull),
             restart_below: None,
             abandoned: AtomicBool::new(false),
+            listing,
+            listed: ListedCount::default(),
             best,
             budget,
             gap,
             magnitude: a.magnitude.max(b.magnitude),
-            horizon: a.horizon.min(b.horizon),
+            horizon,
         }
     }
 
@@ -835,6 +909,13 @@ pub(crate) fn ties_with(toi: f64, least: f64) -> bool {
 }
 
 impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
+    /// A listing walk's rule: the pair may reach its gap by the walk's horizon.
+    #[inline(always)]
+    fn may_reach_gap(&self, vertex_face: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> bool {
+        self.listing
+            .is_some_and(|l| l.gap.may_reach(vertex_face, x0, x1, self.horizon))
+    }
+
     fn side(&self, side: Side) -> &Swept<'_, K> {
         match side {
             Side::A => self.a,
@@ -909,6 +990,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             vertex_face,
             face_vertex,
             edge_edge,
+            listed: Listed::default(),
         };
         let least = settled.least_toi().unwrap_or(f64::INFINITY);
         settled.vertex_face.retain(|x| ties_with(x.toi, least));
@@ -1114,47 +1196,83 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
             vertex_face,
             face_vertex,
             edge_edge,
+            listed,
         } = out;
+        let listed_before = listed.len();
+        let mut lists = self.listing.filter(|_| !self.listed.full()).map(|_| listed);
         let stopped = || budget.stopped();
         let candidates = Candidates {
             self_query,
             margin: self.margin,
             stopped: &stopped,
         };
-        self.vertices_vs_triangles(simd, &candidates, a, x, b, y, counters, |v, t, toi| {
-            budget.push(
-                vertex_face,
-                VertexImpact {
-                    vertex: tv(a, v),
-                    triangle: tt(b, t),
-                    toi,
-                },
-            )
-        });
+        let list = lists.as_mut().map(|l| &mut l.vertex_face);
+        self.vertices_vs_triangles(
+            simd,
+            &candidates,
+            a,
+            x,
+            b,
+            y,
+            counters,
+            list,
+            |v, t, toi| {
+                budget.push(
+                    vertex_face,
+                    VertexImpact {
+                        vertex: tv(a, v),
+                        triangle: tt(b, t),
+                        toi,
+                    },
+                )
+            },
+        );
         if !(self_query && x == y) {
-            self.vertices_vs_triangles(simd, &candidates, b, y, a, x, counters, |v, t, toi| {
+            // In a self query both sides are the one mesh: a vertex of `b` is one of `a`.
+            let list = lists.as_mut().map(|l| {
                 if self_query {
-                    budget.push(
-                        vertex_face,
-                        VertexImpact {
-                            vertex: tv(b, v),
-                            triangle: tt(a, t),
-                            toi,
-                        },
-                    )
+                    &mut l.vertex_face
                 } else {
-                    budget.push(
-                        face_vertex,
-                        FaceImpact {
-                            triangle: tt(a, t),
-                            vertex: tv(b, v),
-                            toi,
-                        },
-                    )
+                    &mut l.face_vertex
                 }
             });
+            self.vertices_vs_triangles(
+                simd,
+                &candidates,
+                b,
+                y,
+                a,
+                x,
+                counters,
+                list,
+                |v, t, toi| {
+                    if self_query {
+                        budget.push(
+                            vertex_face,
+                            VertexImpact {
+                                vertex: tv(b, v),
+                                triangle: tt(a, t),
+                                toi,
+                            },
+                        )
+                    } else {
+                        budget.push(
+                            face_vertex,
+                            FaceImpact {
+                                triangle: tt(a, t),
+                                vertex: tv(b, v),
+                                toi,
+                            },
+                        )
+                    }
+                },
+            );
         }
-        self.edges_vs_edges(simd, &candidates, x, y, counters, edge_edge);
+        let list = lists.as_mut().map(|l| &mut l.edge_edge);
+        self.edges_vs_edges(simd, &candidates, x, y, counters, list, edge_edge);
+        if let (Some(l), Some(listing)) = (lists, self.listing) {
+            self.listed.add(l, listed_before, listing.most);
+        }
         budget.add(out.len() - before);
     }
 
@@ -1162,6 +1280,9 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
         self.budget.extend(&mut out.vertex_face, &other.vertex_face);
         self.budget.extend(&mut out.face_vertex, &other.face_vertex);
         self.budget.extend(&mut out.edge_edge, &other.edge_edge);
+        if self.listing.is_some() && !self.listed.full() {
+            out.listed.append(other.listed);
+        }
     }
 
     #[inline(always)]
@@ -1183,7 +1304,8 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
 
 impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     /// The own vertices of leaf `x` of `sv` against the triangles of leaf `y` of `st`:
-    /// `emit(vertex, triangle, toi)` (internal indices) for each pair that collides.
+    /// `emit(vertex, triangle, toi)` (internal indices) for each pair that collides, and
+    /// into `list` each that may reach its gap when the walk lists.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn vertices_vs_triangles<S: Simd>(
@@ -1195,6 +1317,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         st: &Swept<'_, K>,
         y: usize,
         counters: &mut Counters,
+        mut list: Option<&mut Vec<[u32; 2]>>,
         mut emit: impl FnMut(usize, usize, f64),
     ) {
         let rows = st.tri_boxes(y);
@@ -1216,6 +1339,11 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             counters,
             |v, t| {
                 let (x0, x1) = vertex_face_points(sv, v, st, t);
+                if let Some(l) = list.as_deref_mut() {
+                    if self.may_reach_gap(true, &x0, &x1) {
+                        l.push([v as u32, t as u32]);
+                    }
+                }
                 if let Some(toi) = self.pair_toi(true, &x0, &x1) {
                     self.found(toi);
                     emit(v, t, toi);
@@ -1225,7 +1353,9 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     }
 
     /// The own edges of leaf `x` of A against those of leaf `y` of B (a leaf with itself:
-    /// each unordered pair once): each pair that collides into `out`.
+    /// each unordered pair once): each pair that collides into `out`, and into `list` each
+    /// that may reach its gap when the walk lists.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn edges_vs_edges<S: Simd>(
         &self,
@@ -1234,6 +1364,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         x: usize,
         y: usize,
         counters: &mut Counters,
+        mut list: Option<&mut Vec<[[u32; 2]; 2]>>,
         out: &mut Vec<EdgeImpact>,
     ) {
         let (sa, sb) = (self.a, self.b);
@@ -1243,6 +1374,11 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             // `ex` is of A (or, in a self query, of the one mesh), `ey` of B; the exact test
             // takes the edges in the reported order.
             let (x0, x1) = edge_edge_points(sa, ex.internal, sb, ey.internal);
+            if let Some(l) = list.as_deref_mut() {
+                if self.may_reach_gap(false, &x0, &x1) {
+                    l.push([ex.internal, ey.internal]);
+                }
+            }
             if let Some(toi) = self.pair_toi(false, &x0, &x1) {
                 self.found(toi);
                 self.budget.push(
