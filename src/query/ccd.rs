@@ -600,10 +600,22 @@ impl Gap {
         x1: &[[f64; 3]; 4],
         o: CcdOptions,
     ) -> Option<CcdOptions> {
-        use crate::distance::{edge_edge_distance_sq, point_triangle_distance_sq};
         if !self.may_reach(vertex_face, x0, x1, o.t_max) {
             return None;
         }
+        Some(self.at_gap(vertex_face, x0, o))
+    }
+
+    /// `o` with the pair's gap as its minimum distance, from its distance at t0 (`x0`),
+    /// without [`Gap::may_reach`]'s cull (the test at the gap decides the same pairs).
+    #[inline]
+    pub(crate) fn at_gap(
+        &self,
+        vertex_face: bool,
+        x0: &[[f64; 3]; 4],
+        o: CcdOptions,
+    ) -> CcdOptions {
+        use crate::distance::{edge_edge_distance_sq, point_triangle_distance_sq};
         let d0_sq = if vertex_face {
             point_triangle_distance_sq(x0[0], [x0[1], x0[2], x0[3]]).0
         } else {
@@ -613,10 +625,10 @@ impl Gap {
         let g = self.min_distance + (1.0 - self.rescaling) * (d0 - self.min_distance);
         let g = (g * (1.0 + 16.0 * f64::EPSILON)).max(0.0);
         let g = if g.is_finite() { g } else { f64::MAX };
-        Some(CcdOptions {
+        CcdOptions {
             min_distance: g,
             ..o
-        })
+        }
     }
 
     /// Whether the pair can reach its gap before `t_max` (see [`Gap::options`]): `false`

@@ -183,12 +183,24 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         })
     }
 
+    /// The time a listed pair reaches its gap: its exact test at the gap, with the options
+    /// of the moment. The list holds only pairs that may reach their gap by the listing
+    /// walk's horizon ([`Gap::may_reach`], an exact distance test that is costly for pairs
+    /// touching at t0); it is not tested again for the shorter time of the moment, as the
+    /// test at the gap decides those pairs anyway.
+    #[inline(always)]
+    fn listed_toi(&self, vertex_face: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> Option<f64> {
+        let gap = self.gap.as_ref().expect("a gap rule");
+        let o = gap.at_gap(vertex_face, x0, self.options_now());
+        self.pair_toi_with(vertex_face, x0, x1, &o)
+    }
+
     /// A listed vertex of `a` against a triangle of `b`.
     #[inline(always)]
     fn vertex_face(&self, &[v, t]: &[u32; 2], out: &mut ImpactOut) {
         let (v, t) = (v as usize, t as usize);
         let (x0, x1) = vertex_face_points(self.a, v, self.b, t);
-        if let Some(toi) = self.pair_toi(true, &x0, &x1) {
+        if let Some(toi) = self.listed_toi(true, &x0, &x1) {
             self.found(toi);
             let impact = VertexImpact {
                 vertex: self.a.tree().vert_order()[v],
@@ -204,7 +216,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     fn face_vertex(&self, &[v, t]: &[u32; 2], out: &mut ImpactOut) {
         let (v, t) = (v as usize, t as usize);
         let (x0, x1) = vertex_face_points(self.b, v, self.a, t);
-        if let Some(toi) = self.pair_toi(true, &x0, &x1) {
+        if let Some(toi) = self.listed_toi(true, &x0, &x1) {
             self.found(toi);
             let impact = FaceImpact {
                 triangle: self.a.tree().tri_order()[t],
@@ -219,7 +231,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     #[inline(always)]
     fn edge_edge(&self, &[ea, eb]: &[[u32; 2]; 2], out: &mut ImpactOut) {
         let (x0, x1) = edge_edge_points(self.a, ea, self.b, eb);
-        if let Some(toi) = self.pair_toi(false, &x0, &x1) {
+        if let Some(toi) = self.listed_toi(false, &x0, &x1) {
             self.found(toi);
             let ids = |s: &Swept<'_, K>, e: [u32; 2]| e.map(|v| s.tree().vert_order()[v as usize]);
             let impact = EdgeImpact {
