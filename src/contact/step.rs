@@ -37,6 +37,14 @@
 //! its exact motion, as every other. Per pair, [`Gap`] culls before computing any distance:
 //! a pair reaches its gap only if `d0 <= min_distance + A / rescaling`, `A` the largest
 //! relative displacement of a vertex of one feature and one of the other by `T`.
+//!
+//! Where the first impact is early (its walk restarted on bounds fitted short of the step,
+//! as on most simulation steps), the gap walk would meet nearly the pairs of the first
+//! impact's last pass again. That pass then culls at the gap walk's distance for its own
+//! horizon (at least the one for `T`: the distance grows with the time) and lists the pairs
+//! that may reach their gap by that horizon; the gap rule is tested on the list and no
+//! second walk runs ([`crate::query::ccd`]'s `listed`). A list past [`MAX_LISTED`] pairs is
+//! dropped for the walk.
 
 use std::sync::atomic::AtomicU64;
 
