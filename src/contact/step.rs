@@ -202,13 +202,14 @@ fn step_between<K: BoundingVolume>(
     };
     let (best, first_work, listed) =
         first_impact(a, b, self_query, options, Some(&listing), &budget, ws, par)?;
-    let by = by(&best);
-    let (query, gap) = query_for(options, motions, false, by);
+    // The latest time a pair that limits the step can reach its gap.
+    let until = by(&best);
+    let (query, gap) = query_for(options, motions, false, until);
     let mut limiting = match listed {
         Some(listed) => gap_over_listed(
-            a, b, self_query, &query, &best, &budget, gap, by, &listed, par,
+            a, b, self_query, &query, &best, &budget, gap, until, &listed, par,
         )?,
-        // The walk fits its bounds over `[0, by]` only, knowing the first impact.
+        // The walk fits its bounds over `[0, until]` only, knowing the first impact.
         None => {
             let gap = Some(gap);
             run(a, b, self_query, &query, Some(&best), &budget, gap, ws, par)?.0
