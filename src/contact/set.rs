@@ -10,17 +10,15 @@
 //! the IPC Toolkit's rules (`NormalCollisions::build`). A point-point or point-edge contact
 //! found by several rows (a vertex near an edge is near both its triangles, and near the
 //! edges at its ends) is emitted once, by the one row the rules of [`Sides`] name its
-//! producer; no duplicate is made, so none is removed.
+//! producer: the rows are keyed by their contact and sorted, and each run of one key keeps
+//! its producer, so the other rows' contacts are never built.
 
 use super::geometry::{ContactType, Formula};
 use crate::bv::BoundingVolume;
 use crate::counters::Counters;
 use rayon::prelude::*;
 
-use crate::distance::{
-    edge_edge_distance_sq, edges_cross_sq_below, point_line_distance_sq,
-    point_triangle_distance_sq, EdgeEdge, PointTriangle,
-};
+use crate::distance::{edges_cross_sq_below, point_line_distance_sq, EdgeEdge, PointTriangle};
 use crate::error::{Error, Positions, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
@@ -265,17 +263,18 @@ enum Which {
     B,
 }
 
-/// A proximity row, named by its features: a vertex of side `side` and a triangle of the
-/// other side (the same side in a self query), or two edges (ids: side A's first, or the
-/// smaller first in a self query).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Row {
-    VertexFace { side: Which, v: u32, t: u32 },
-    EdgeEdge { a: u32, b: u32 },
-}
-
 /// A contact's identity: its type and global vertices ([`Contact::vertices`]).
 type Key = (ContactType, [u32; 4]);
+
+/// A proximity row keyed by its contact, as the merge sorts them: the contact, then the row
+/// (its index among the vertex-face, then face-vertex, then edge-edge rows), and whether an
+/// edge-edge row's edges are nearly parallel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Keyed {
+    key: Key,
+    row: usize,
+    mollified: bool,
+}
 
 /// The two sides of a query (the same side twice in a self query), and the rules naming
 /// each row's contact and each contact's one producer.
@@ -292,8 +291,10 @@ type Key = (ContactType, [u32; 4]);
 ///   triangles at `v`, then the edges at `v` against the edges at `w`.
 ///
 /// A row is one of the query's when the query meets it: in a self query, never a triangle
-/// containing its vertex nor edges sharing a vertex. Types are exact and tie-broken one way
-/// ([`crate::distance`]), so every row of a contact names the same producer.
+/// containing its vertex nor edges sharing a vertex. Every row of a contact measures the
+/// contact's own distance (types are exact and tie-broken one way, [`crate::distance`]), so
+/// all of them are among the proximity rows, and the producer is picked there
+/// ([`Sides::producer`]) without testing any feature pair again.
 struct Sides<'s, 'h, K: BoundingVolume> {
     a: &'s Side<'h, K>,
     b: &'s Side<'h, K>,
@@ -399,115 +400,6 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
         edges_cross_sq_below(x, MOLLIFIER_FACTOR * rest(0) * rest(2))
     }
 
-    /// The row of vertex `v` of side `p` and triangle `t`, if the query has it and its
-    /// contact is `key`.
-    fn vertex_face_producing(&self, p: Which, v: u32, t: u32, key: &Key, row: Row) -> Option<Row> {
-        let me = Row::VertexFace { side: p, v, t };
-        if me == row {
-            // The row asking: its contact is `key`.
-            return Some(me);
-        }
-        let (sp, sf) = (self.side(p), self.side(self.faces_of(p)));
-        let c = sf.tables.triangles[t as usize];
-        if self.self_query && c.contains(&v) {
-            return None;
-        }
-        let (_, kind) = point_triangle_distance_sq(sp.position(v), c.map(|w| sf.position(w)));
-        (self.vertex_face_key(p, v, t, kind) == *key).then_some(me)
-    }
-
-    /// The row of edge `x` of side `px` and edge `y` of side `py`, if the query has it and
-    /// its contact is `key`.
-    fn edge_edge_producing(
-        &self,
-        (px, x): (Which, u32),
-        (py, y): (Which, u32),
-        key: &Key,
-        row: Row,
-    ) -> Option<Row> {
-        let ((pa, a), (pb, b)) = match (self.self_query, px) {
-            (true, _) => ((Which::A, x.min(y)), (Which::A, x.max(y))),
-            (false, Which::A) => ((px, x), (py, y)),
-            (false, Which::B) => ((py, y), (px, x)),
-        };
-        let me = Row::EdgeEdge { a, b };
-        if me == row {
-            return Some(me);
-        }
-        let (sa, sb) = (self.side(pa), self.side(pb));
-        let (ea, eb) = (sa.tables.edges[a as usize], sb.tables.edges[b as usize]);
-        if self.self_query && (ea.contains(&eb[0]) || ea.contains(&eb[1])) {
-            return None;
-        }
-        let g = Self::global_edges(sa, ea, sb, eb);
-        let x = g.map(|g| self.position(g));
-        let (_, kind) = edge_edge_distance_sq(x[0], x[1], x[2], x[3]);
-        // Only a point-edge or point-point key is looked for: an edge-edge row gives one
-        // when its closest features are not interior to both edges and it is not mollified.
-        if kind == EdgeEdge::EaEb || Self::edge_edge_key(g, kind, false) != *key {
-            return None;
-        }
-        (!self.mollified(g, x)).then_some(me)
-    }
-
-    /// The producer of a point-point or point-edge contact (see [`Sides`]); `None` for the
-    /// other types (their one row) and if no row of the query has it.
-    fn producer(&self, key: &Key, row: Row) -> Option<Row> {
-        let [g0, g1, g2, _] = key.1;
-        match key.0 {
-            ContactType::PointEdge => {
-                let (pv, v) = self.local(g0);
-                let ((pe, e0), (_, e1)) = (self.local(g1), self.local(g2));
-                let se = self.side(pe);
-                let e = se.tables.edge_id(e0, e1).expect("an edge of a triangle");
-                let mut faces = se.tables.edge_triangles.of(e).iter();
-                let mut edges = self.side(pv).tables.vertex_edges.of(v).iter();
-                faces
-                    .find_map(|&t| self.vertex_face_producing(pv, v, t, key, row))
-                    .or_else(|| {
-                        edges.find_map(|&x| self.edge_edge_producing((pv, x), (pe, e), key, row))
-                    })
-            }
-            ContactType::PointPoint => {
-                let ((pv, v), (pw, w)) = (self.local(g0), self.local(g1));
-                let (tv, tw) = (self.side(pv).tables, self.side(pw).tables);
-                let (faces_at_v, faces_at_w) =
-                    (tv.vertex_triangles.of(v), tw.vertex_triangles.of(w));
-                let (edges_at_v, edges_at_w) = (tv.vertex_edges.of(v), tw.vertex_edges.of(w));
-                faces_at_w
-                    .iter()
-                    .find_map(|&t| self.vertex_face_producing(pv, v, t, key, row))
-                    .or_else(|| {
-                        faces_at_v
-                            .iter()
-                            .find_map(|&t| self.vertex_face_producing(pw, w, t, key, row))
-                    })
-                    .or_else(|| {
-                        edges_at_v.iter().find_map(|&x| {
-                            edges_at_w
-                                .iter()
-                                .find_map(|&y| self.edge_edge_producing((pv, x), (pw, y), key, row))
-                        })
-                    })
-            }
-            ContactType::PointTriangle | ContactType::EdgeEdge => None,
-        }
-    }
-
-    /// Whether `row` emits its contact `key`: always for point-triangle and edge-edge
-    /// contacts, only from their producer for the others.
-    fn emits(&self, row: impl FnOnce() -> Row, key: &Key) -> bool {
-        match key.0 {
-            ContactType::PointTriangle | ContactType::EdgeEdge => true,
-            ContactType::PointPoint | ContactType::PointEdge => {
-                let row = row();
-                let producer = self.producer(key, row);
-                debug_assert!(producer.is_some(), "a row of {key:?} names no producer");
-                producer.is_none_or(|p| p == row)
-            }
-        }
-    }
-
     /// The contact of `key` found by a row at squared distance `distance_sq` (`closest`:
     /// an edge-edge row's type), if this row emits it.
     fn contact(
@@ -555,22 +447,22 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
         (c, positions)
     }
 
-    /// Row `i` of `rows` (vertex-face rows, then face-vertex rows, then edge-edge rows) as
-    /// the contact it emits, if it emits one.
-    fn convert(&self, rows: &Proximity, i: usize) -> Option<(Contact, [[f64; 3]; 4])> {
+    /// Row `i` of `rows` (vertex-face rows, then face-vertex rows, then edge-edge rows)
+    /// keyed by its contact.
+    fn keyed(&self, rows: &Proximity, i: usize) -> Keyed {
         let (nv, nf) = (rows.vertex_face.len(), rows.face_vertex.len());
-        let vertex_face = |side: Which, v: u32, t: u32, kind, distance_sq| {
-            let key = self.vertex_face_key(side, v, t, kind);
-            self.emits(|| Row::VertexFace { side, v, t }, &key)
-                .then(|| self.contact(key, distance_sq, false, None))
+        let vertex_face = |side: Which, v: u32, t: u32, kind| Keyed {
+            key: self.vertex_face_key(side, v, t, kind),
+            row: i,
+            mollified: false,
         };
         if i < nv {
             let r = &rows.vertex_face[i];
-            return vertex_face(Which::A, r.vertex, r.triangle, r.kind, r.distance_sq);
+            return vertex_face(Which::A, r.vertex, r.triangle, r.kind);
         }
         if i < nv + nf {
             let r = &rows.face_vertex[i - nv];
-            return vertex_face(Which::B, r.vertex, r.triangle, r.kind, r.distance_sq);
+            return vertex_face(Which::B, r.vertex, r.triangle, r.kind);
         }
         let r = &rows.edge_edge[i - nv - nf];
         let (sa, sb) = (self.a, self.b);
@@ -582,20 +474,72 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
             sb.position(r.b[1]),
         ];
         let mollified = self.mollified(g, x);
-        let key = Self::edge_edge_key(g, r.kind, mollified);
-        let id = |s: &Side<'_, K>, e: [u32; 2]| s.tables.edge_id(e[0], e[1]).expect("an edge");
-        let row = || Row::EdgeEdge {
-            a: id(sa, r.a),
-            b: id(sb, r.b),
+        Keyed {
+            key: Self::edge_edge_key(g, r.kind, mollified),
+            row: i,
+            mollified,
+        }
+    }
+
+    /// The producer among `run`, the rows of one contact sorted by row (see [`Sides`]).
+    ///
+    /// The row order is the producer order but among edge-edge rows: a vertex-triangle row
+    /// comes before every edge-edge row; the rows of one vertex against triangles are sorted
+    /// by triangle (vertex-face rows by vertex then triangle, face-vertex rows by triangle
+    /// then vertex); of a point-point contact `(v, w)`, `v`'s rows come first (the smaller
+    /// vertex, on the first side in a pair query). Edge-edge rows are sorted by their vertex
+    /// pairs, not by the edge at `v`, so among them the producer is the least by the edge at
+    /// `v` (then at `w`): edge ids are in the order of their vertex pairs
+    /// ([`crate::tree::MeshTables`]), so the pairs are compared.
+    fn producer(&self, rows: &Proximity, run: &[Keyed]) -> Keyed {
+        let first = run[0];
+        let vertex_rows = rows.vertex_face.len() + rows.face_vertex.len();
+        if first.row < vertex_rows || run.len() == 1 {
+            return first;
+        }
+        debug_assert!(
+            matches!(
+                first.key.0,
+                ContactType::PointPoint | ContactType::PointEdge
+            ),
+            "one row per point-triangle and edge-edge contact"
+        );
+        let [v, w, ..] = first.key.1;
+        // The edges of an edge-edge row at global vertices `v` and, for a point-point
+        // contact, `w` (local vertex pairs of the one side each is on).
+        let at = |k: &Keyed| {
+            let r = &rows.edge_edge[k.row - vertex_rows];
+            let [a0, a1] = self.a.global(r.a);
+            let on_a = |g: u32| g == a0 || g == a1;
+            let at_w = match first.key.0 {
+                ContactType::PointPoint if on_a(w) => r.a,
+                ContactType::PointPoint => r.b,
+                _ => [0; 2],
+            };
+            (if on_a(v) { r.a } else { r.b }, at_w)
         };
-        self.emits(row, &key)
-            .then(|| self.contact(key, r.distance_sq, mollified, Some(r.kind)))
+        *run.iter().min_by_key(|k| at(k)).expect("a run has a row")
+    }
+
+    /// The contact of row `k`.
+    fn contact_of(&self, rows: &Proximity, k: &Keyed) -> (Contact, [[f64; 3]; 4]) {
+        let (nv, nf) = (rows.vertex_face.len(), rows.face_vertex.len());
+        let (distance_sq, closest) = if k.row < nv {
+            (rows.vertex_face[k.row].distance_sq, None)
+        } else if k.row < nv + nf {
+            (rows.face_vertex[k.row - nv].distance_sq, None)
+        } else {
+            let r = &rows.edge_edge[k.row - nv - nf];
+            (r.distance_sq, Some(r.kind))
+        };
+        self.contact(k.key, distance_sq, k.mollified, closest)
     }
 }
 
 /// The contact set of proximity `rows` between sides `a` and `b` (the same side, and
 /// `self_query`, for a self query): each row's contact, once (from its producer, see
-/// [`Sides`]), sorted by `(kind, vertices)`; rows converted in parallel if `par` says so.
+/// [`Sides`]), sorted by `(kind, vertices)`. The rows are keyed, sorted and their contacts
+/// built in parallel if `par` says so (the result does not depend on it).
 pub(crate) fn from_rows<K: BoundingVolume>(
     rows: Proximity,
     a: &Side<'_, K>,
@@ -605,27 +549,48 @@ pub(crate) fn from_rows<K: BoundingVolume>(
 ) -> ContactSet {
     let sides = Sides { a, b, self_query };
     let n = rows.vertex_face.len() + rows.face_vertex.len() + rows.edge_edge.len();
-    let found: Vec<(Contact, [[f64; 3]; 4])> = if par.is_parallel() {
+    let mut keyed: Vec<Keyed> = if par.is_parallel() {
         par.install(|| {
-            (0..n)
+            let mut k: Vec<Keyed> = (0..n)
                 .into_par_iter()
                 .with_min_len(1024)
-                .filter_map(|i| sides.convert(&rows, i))
-                .collect()
+                .map(|i| sides.keyed(&rows, i))
+                .collect();
+            k.par_sort_unstable();
+            k
         })
     } else {
-        (0..n).filter_map(|i| sides.convert(&rows, i)).collect()
+        let mut k: Vec<Keyed> = (0..n).map(|i| sides.keyed(&rows, i)).collect();
+        k.sort_unstable();
+        k
     };
-    let mut order: Vec<(Key, u32)> = (0u32..)
-        .zip(&found)
-        .map(|(i, (c, _))| ((c.kind, c.vertices), i))
-        .collect();
-    order.sort_unstable();
-    let mut set = ContactSet {
-        contacts: order.iter().map(|&(_, i)| found[i as usize].0).collect(),
-        positions: order.iter().map(|&(_, i)| found[i as usize].1).collect(),
-        counters: rows.counters,
+    // Each contact's rows are one run of the sorted keys; keep its producer, in place.
+    let mut kept = 0;
+    let mut start = 0;
+    while start < keyed.len() {
+        let key = keyed[start].key;
+        let end = start + keyed[start..].partition_point(|k| k.key == key);
+        keyed[kept] = sides.producer(&rows, &keyed[start..end]);
+        kept += 1;
+        start = end;
+    }
+    keyed.truncate(kept);
+    let (contacts, positions): (Vec<Contact>, Vec<[[f64; 3]; 4]>) = if par.is_parallel() {
+        par.install(|| {
+            keyed
+                .par_iter()
+                .with_min_len(1024)
+                .map(|k| sides.contact_of(&rows, k))
+                .unzip()
+        })
+    } else {
+        keyed.iter().map(|k| sides.contact_of(&rows, k)).unzip()
     };
-    set.counters.contacts = set.contacts.len() as u64;
-    set
+    let mut counters = rows.counters;
+    counters.contacts = contacts.len() as u64;
+    ContactSet {
+        contacts,
+        positions,
+        counters,
+    }
 }
