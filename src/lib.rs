@@ -64,6 +64,7 @@ pub mod query;
 pub mod scene;
 pub mod segments;
 pub mod shapes;
+mod sort;
 pub mod tree;
 mod walk;
 

@@ -574,7 +574,17 @@ pub(crate) fn from_rows<K: BoundingVolume>(
     } else {
         (0..n).map(|i| sides.keyed(&rows, i)).collect()
     };
-    let mut keyed = by_contact(keyed, |g| sides.dense(g), sides.vertex_count(), par);
+    // By contact, then row (the producer order, see `Sides::producer`).
+    let vertices = sides.vertex_count();
+    let mut keyed = crate::sort::by_group(
+        keyed,
+        ContactType::ALL.len() * vertices,
+        |k| k.key.0 as usize * vertices + sides.dense(k.key.1[0]),
+        |k| {
+            let [v0, v1, v2, v3] = k.key.1.map(u128::from);
+            (k.key.0, v0 << 96 | v1 << 64 | v2 << 32 | v3, k.row)
+        },
+    );
     // Each contact's rows are one run of the sorted keys; keep its producer, in place.
     let mut kept = 0;
     let mut start = 0;
@@ -603,100 +613,5 @@ pub(crate) fn from_rows<K: BoundingVolume>(
         contacts,
         positions,
         counters,
-    }
-}
-
-/// `keyed` sorted by contact, then row. `vertex_count` bounds `first(v)`, a dense index of
-/// each contact's first vertex `v`.
-///
-/// Where the rows are not few against the vertices, a counting sort by type and first vertex
-/// (`O(rows + vertices)`), then each group (one vertex's few contacts of one type) by its
-/// other vertices and row; else a comparison sort. Both compare the vertices read as one
-/// 128-bit number (the array's order). On cloth-ball's 419,335 rows the comparison sort
-/// took 22 ms (65 ns a row for the 194,823 point-edge rows, which come in no order).
-fn by_contact(
-    keyed: Vec<Keyed>,
-    first: impl Fn(u32) -> usize,
-    vertex_count: usize,
-    par: Par,
-) -> Vec<Keyed> {
-    let order = |k: &Keyed| {
-        let [v0, v1, v2, v3] = k.key.1.map(u128::from);
-        (k.key.0, v0 << 96 | v1 << 64 | v2 << 32 | v3, k.row)
-    };
-    let groups = ContactType::ALL.len() * vertex_count;
-    let Some(&any) = keyed.first() else {
-        return keyed;
-    };
-    if keyed.len() < groups / 4 {
-        let mut keyed = keyed;
-        if par.is_parallel() {
-            par.install(|| keyed.par_sort_unstable_by_key(order));
-        } else {
-            keyed.sort_unstable_by_key(order);
-        }
-        return keyed;
-    }
-    let group = |k: &Keyed| k.key.0 as usize * vertex_count + first(k.key.1[0]);
-    let mut start = vec![0usize; groups + 1];
-    for k in &keyed {
-        start[group(k) + 1] += 1;
-    }
-    for g in 0..groups {
-        start[g + 1] += start[g];
-    }
-    let mut sorted = vec![any; keyed.len()];
-    let mut next = start.clone();
-    for k in keyed {
-        let g = group(&k);
-        sorted[next[g]] = k;
-        next[g] += 1;
-    }
-    for g in start.windows(2) {
-        if g[1] - g[0] > 1 {
-            sorted[g[0]..g[1]].sort_unstable_by_key(order);
-        }
-    }
-    sorted
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use proptest::prelude::*;
-
-    /// Rows of `vertex_count` vertices, with repeated contacts and rows in any order.
-    fn keyed_rows(vertex_count: u32) -> impl Strategy<Value = Vec<Keyed>> {
-        let row = (0..4u8, prop::array::uniform4(0..vertex_count), any::<bool>());
-        prop::collection::vec(row, 0..200).prop_map(|rows| {
-            rows.into_iter()
-                .enumerate()
-                .map(|(row, (kind, v, mollified))| Keyed {
-                    key: (ContactType::ALL[kind as usize], v),
-                    row,
-                    mollified,
-                })
-                .rev()
-                .collect()
-        })
-    }
-
-    proptest! {
-        /// The counting sort (many rows against the vertices) and the comparison sort (few)
-        /// both give the order of a plain sort by contact then row, sequential or parallel.
-        #[test]
-        fn both_sorts_order_rows_by_contact_then_row(
-            rows in keyed_rows(5),
-            more_vertices in 0usize..1000,
-            parallel in any::<bool>(),
-        ) {
-            let mut want = rows.clone();
-            want.sort();
-            let par = if parallel { Par::Rayon(2) } else { Par::Seq };
-            for vertex_count in [5, 5 + more_vertices] {
-                let got = by_contact(rows.clone(), |g| g as usize, vertex_count, par);
-                prop_assert_eq!(&got, &want);
-            }
-        }
     }
 }

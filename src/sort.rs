@@ -1,0 +1,66 @@
+//! Sorting result rows whose leading key is a small dense index (a vertex, a triangle, a
+//! contact type and vertex): a counting sort by that index, then each group's few rows by
+//! their whole key. A contact set's rows (keyed by contact type and first vertex) come in
+//! no order by vertex: on cloth-ball a comparison sort of its 419,335 rows took 22 ms, the
+//! counting sort 10-16 ms.
+
+/// `rows` sorted by `key`, given `group(row) < groups` that orders rows as `key` does (a
+/// row of a smaller group has a smaller key). Rows of equal key keep no particular order.
+///
+/// Where the rows are not few against the groups (at least a quarter as many), a counting
+/// sort by group (`O(rows + groups)` time, one index per group of memory), then each group
+/// by `key`; else a comparison sort by `key`.
+pub(crate) fn by_group<T: Copy, K: Ord>(
+    mut rows: Vec<T>,
+    groups: usize,
+    group: impl Fn(&T) -> usize,
+    key: impl Fn(&T) -> K,
+) -> Vec<T> {
+    if rows.len() < groups / 4 {
+        rows.sort_unstable_by_key(key);
+        return rows;
+    }
+    let mut start = vec![0usize; groups + 1];
+    for r in &rows {
+        start[group(r) + 1] += 1;
+    }
+    for g in 0..groups {
+        start[g + 1] += start[g];
+    }
+    let mut sorted = vec![rows[0]; rows.len()];
+    let mut next = start.clone();
+    for r in rows {
+        let g = group(&r);
+        sorted[next[g]] = r;
+        next[g] += 1;
+    }
+    for g in start.windows(2) {
+        if g[1] - g[0] > 1 {
+            sorted[g[0]..g[1]].sort_unstable_by_key(&key);
+        }
+    }
+    sorted
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The counting sort (many rows against the groups) and the comparison sort (few)
+        /// both give a plain sort's order.
+        #[test]
+        fn both_ways_give_a_plain_sorts_order(
+            rows in prop::collection::vec((0u32..6, any::<u16>()), 0..300),
+            more_groups in 0usize..2000,
+        ) {
+            let mut want = rows.clone();
+            want.sort();
+            for groups in [6, 6 + more_groups] {
+                let got = by_group(rows.clone(), groups, |r| r.0 as usize, |r| *r);
+                prop_assert_eq!(&got, &want);
+            }
+        }
+    }
+}
