@@ -23,14 +23,52 @@ use dhcd_kernels::overlap::{boxes_meet_from, BoxRows, MAX_BOX_ROW};
 pub(crate) type FeatureBox = ([f32; 3], [f32; 3]);
 
 /// The union of the first `n` boxes of `rows` (empty: `+inf..-inf`).
-fn union_of(rows: &BoxRows, n: usize) -> FeatureBox {
-    let lo = |k: usize| rows[k][..n].iter().fold(f32::INFINITY, |m, &x| m.min(x));
-    let hi = |k: usize| {
-        rows[3 + k][..n]
-            .iter()
-            .fold(f32::NEG_INFINITY, |m, &x| m.max(x))
-    };
-    ([lo(0), lo(1), lo(2)], [hi(0), hi(1), hi(2)])
+// PERF: vector min / max on the dispatched backend; a fold of `f32::min` stayed scalar (4-6%
+// of a proximity query). Boxes hold no NaN, so the vector min is `f32::min`.
+#[inline(always)]
+fn union_of<S: Simd>(simd: S, rows: &BoxRows, n: usize) -> FeatureBox {
+    // No closures: one may be compiled without the backend's target features.
+    let lo = [
+        row_min(simd, &rows[0][..n]),
+        row_min(simd, &rows[1][..n]),
+        row_min(simd, &rows[2][..n]),
+    ];
+    let hi = [
+        row_max(simd, &rows[3][..n]),
+        row_max(simd, &rows[4][..n]),
+        row_max(simd, &rows[5][..n]),
+    ];
+    (lo, hi)
+}
+
+/// The least of `row` (`+inf` if empty).
+#[inline(always)]
+fn row_min<S: Simd>(simd: S, row: &[f32]) -> f32 {
+    let (head, tail) = S::as_simd_f32s(row);
+    let mut m = simd.splat_f32s(f32::INFINITY);
+    for &x in head {
+        m = simd.min_f32s(m, x);
+    }
+    let mut least = simd.reduce_min_f32s(m);
+    for &x in tail {
+        least = least.min(x);
+    }
+    least
+}
+
+/// The greatest of `row` (`-inf` if empty).
+#[inline(always)]
+fn row_max<S: Simd>(simd: S, row: &[f32]) -> f32 {
+    let (head, tail) = S::as_simd_f32s(row);
+    let mut m = simd.splat_f32s(f32::NEG_INFINITY);
+    for &x in head {
+        m = simd.max_f32s(m, x);
+    }
+    let mut most = simd.reduce_max_f32s(m);
+    for &x in tail {
+        most = most.max(x);
+    }
+    most
 }
 
 /// The bits of boxes `base..base + 64` of the first `n` of `rows` that meet `probe` (bit
@@ -136,7 +174,7 @@ impl Candidates<'_> {
         mut decide: impl FnMut(usize, usize),
     ) {
         let (rows, n) = (&tris.rows, tris.len);
-        let near = grown(&union_of(rows, n), self.margin);
+        let near = grown(&union_of(simd, rows, n), self.margin);
         for v in vertices {
             let vbox = vertex_box(v);
             if !meet(&vbox, &near) {
@@ -178,7 +216,7 @@ impl Candidates<'_> {
     ) {
         let (ea, eb) = (a.edges, b.edges);
         let (ra, rb) = (&a.rows, &b.rows);
-        let near = grown(&union_of(rb, eb.len()), self.margin);
+        let near = grown(&union_of(simd, rb, eb.len()), self.margin);
         for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
             let mut near_bits = meeting(simd, &near, ra, base_a, ea.len());
             while near_bits != 0 {
