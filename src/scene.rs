@@ -648,7 +648,9 @@ fn proximity_of<K: BoundingVolume>(
         within.margin,
         parallel,
         // A job stopped by the budget gives nothing; `finish` below says why.
-        |posed, ws, par| proximity::run(posed, d, budget, ws, par).unwrap_or_default(),
+        |posed, ws, par| {
+            proximity::run(posed, d, budget, ws, par, proximity::Rows::Sorted).unwrap_or_default()
+        },
         |p: &mut Proximity| &mut p.counters,
     );
     budget.finish()?;

@@ -22,7 +22,7 @@ use crate::distance::{edges_cross_sq_below, point_line_distance_sq, EdgeEdge, Po
 use crate::error::{Error, Positions, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
-use crate::query::proximity::{self, Proximity};
+use crate::query::proximity::{self, Proximity, Rows};
 use crate::tree::MeshTables;
 use crate::walk::Workspace;
 
@@ -151,7 +151,7 @@ pub fn self_contact_set_with<K: BoundingVolume>(
     par: Par,
 ) -> Result<ContactSet> {
     let side = Side::new(h, rest, 0, 0)?;
-    let rows = proximity::self_proximity_with(h, dhat, ws, par)?;
+    let rows = proximity::self_proximity_in(h, dhat, ws, par, Rows::AsFound)?;
     Ok(from_rows(rows, &side, &side, true, par))
 }
 
@@ -188,7 +188,7 @@ pub fn contact_set_with<K: BoundingVolume>(
         offset(a.tree().vertex_total(), b.tree().vertex_total())?,
         offset(a.tree().edges().len(), b.tree().edges().len())?,
     )?;
-    let rows = proximity::proximity_with(a, b, dhat, ws, par)?;
+    let rows = proximity::proximity_in(a, b, dhat, ws, par, Rows::AsFound)?;
     Ok(from_rows(rows, &sa, &sb, false, par))
 }
 
@@ -266,12 +266,14 @@ enum Which {
 /// A contact's identity: its type and global vertices ([`Contact::vertices`]).
 type Key = (ContactType, [u32; 4]);
 
-/// A proximity row keyed by its contact, as the merge sorts them: the contact, then the row
-/// (its index among the vertex-face, then face-vertex, then edge-edge rows), and whether an
-/// edge-edge row's edges are nearly parallel.
+/// A proximity row keyed by its contact, as the merge sorts them: the contact, the row's
+/// place in its contact's producer order ([`Sides::rank`]), the row (its index among the
+/// vertex-face, then face-vertex, then edge-edge rows), and whether an edge-edge row's edges
+/// are nearly parallel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 struct Keyed {
     key: Key,
+    rank: u64,
     row: usize,
     mollified: bool,
 }
@@ -465,10 +467,14 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
     /// keyed by its contact.
     fn keyed(&self, rows: &Proximity, i: usize) -> Keyed {
         let (nv, nf) = (rows.vertex_face.len(), rows.face_vertex.len());
-        let vertex_face = |side: Which, v: u32, t: u32, kind| Keyed {
-            key: self.vertex_face_key(side, v, t, kind),
-            row: i,
-            mollified: false,
+        let vertex_face = |side: Which, v: u32, t: u32, kind| {
+            let key = self.vertex_face_key(side, v, t, kind);
+            Keyed {
+                key,
+                rank: Self::rank(&key, Some((v + self.side(side).vertex_offset, t))),
+                row: i,
+                mollified: false,
+            }
         };
         if i < nv {
             let r = &rows.vertex_face[i];
@@ -488,22 +494,29 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
             sb.position(r.b[1]),
         ];
         let mollified = self.mollified(g, x);
+        let key = Self::edge_edge_key(g, r.kind, mollified);
         Keyed {
-            key: Self::edge_edge_key(g, r.kind, mollified),
+            key,
+            rank: Self::rank(&key, None),
             row: i,
             mollified,
         }
     }
 
-    /// The producer among `run`, the rows of one contact sorted by row (see [`Sides`]).
-    ///
-    /// The row order is the producer order but among edge-edge rows: a vertex-triangle row
-    /// comes before every edge-edge row; the rows of one vertex against triangles are sorted
-    /// by triangle (vertex-face rows by vertex then triangle, face-vertex rows by triangle
-    /// then vertex); of a point-point contact `(v, w)`, `v`'s rows come first (the smaller
-    /// vertex, on the first side in a pair query). Edge-edge rows are sorted by their vertex
-    /// pairs, not by the edge at `v`, so among them the producer is the least by the edge at
-    /// `v` (then at `w`): edge ids are in the order of their vertex pairs
+    /// A row's place in the producer order of its contact `key` (see [`Sides`]), but among
+    /// edge-edge rows (all ranked last, ordered by [`Sides::producer`]): a vertex-triangle
+    /// row (global vertex `g`, triangle `t` of the other side) ranks by whether `g` is the
+    /// contact's second vertex (`w` of a point-point contact `(v, w)`), then by `t`.
+    fn rank(key: &Key, vertex_face: Option<(u32, u32)>) -> u64 {
+        match vertex_face {
+            Some((g, t)) => u64::from(g != key.1[0]) << 32 | u64::from(t),
+            None => 2 << 32,
+        }
+    }
+
+    /// The producer among `run`, the rows of one contact sorted by rank (see [`Sides`]): the
+    /// first if it is a vertex-triangle row or alone; else, among edge-edge rows, the least
+    /// by the edge at `v` (then at `w`): edge ids are in the order of their vertex pairs
     /// ([`crate::tree::MeshTables`]), so the pairs are compared.
     fn producer(&self, rows: &Proximity, run: &[Keyed]) -> Keyed {
         let first = run[0];
@@ -574,7 +587,7 @@ pub(crate) fn from_rows<K: BoundingVolume>(
     } else {
         (0..n).map(|i| sides.keyed(&rows, i)).collect()
     };
-    // By contact, then row (the producer order, see `Sides::producer`).
+    // By contact, then producer order (`Sides::rank`); the row makes the order total.
     let vertices = sides.vertex_count();
     let mut keyed = crate::sort::by_group(
         keyed,
@@ -582,7 +595,7 @@ pub(crate) fn from_rows<K: BoundingVolume>(
         |k| k.key.0 as usize * vertices + sides.dense(k.key.1[0]),
         |k| {
             let [v0, v1, v2, v3] = k.key.1.map(u128::from);
-            (k.key.0, v0 << 96 | v1 << 64 | v2 << 32 | v3, k.row)
+            (k.key.0, v0 << 96 | v1 << 64 | v2 << 32 | v3, k.rank, k.row)
         },
     );
     // Each contact's rows are one run of the sorted keys; keep its producer, in place.

@@ -114,10 +114,23 @@ pub fn proximity_with<K: BoundingVolume>(
     ws: &mut Workspace,
     par: Par,
 ) -> Result<Proximity> {
+    proximity_in(a, b, d, ws, par, Rows::Sorted)
+}
+
+/// [`proximity_with`] with its rows in the order `rows`.
+pub(crate) fn proximity_in<K: BoundingVolume>(
+    a: &Hierarchy<K>,
+    b: &Hierarchy<K>,
+    d: f64,
+    ws: &mut Workspace,
+    par: Par,
+    rows: Rows,
+) -> Result<Proximity> {
     check_distance(d)?;
     let control = ws.control.clone();
     let budget = Budget::new(&control);
-    Ok(run(Posed::pair(a, b, Within::distance(d)), d, &budget, ws, par)?.0)
+    let posed = Posed::pair(a, b, Within::distance(d));
+    Ok(run(posed, d, &budget, ws, par, rows)?.0)
 }
 
 /// Every vertex-triangle pair (the triangle not containing the vertex) and edge-edge pair
@@ -133,13 +146,36 @@ pub fn self_proximity_with<K: BoundingVolume>(
     ws: &mut Workspace,
     par: Par,
 ) -> Result<Proximity> {
+    self_proximity_in(h, d, ws, par, Rows::Sorted)
+}
+
+/// [`self_proximity_with`] with its rows in the order `rows`.
+pub(crate) fn self_proximity_in<K: BoundingVolume>(
+    h: &Hierarchy<K>,
+    d: f64,
+    ws: &mut Workspace,
+    par: Par,
+    rows: Rows,
+) -> Result<Proximity> {
     check_distance(d)?;
     let control = ws.control.clone();
     let budget = Budget::new(&control);
-    Ok(run(Posed::single(h, Within::distance(d)), d, &budget, ws, par)?.0)
+    let posed = Posed::single(h, Within::distance(d));
+    Ok(run(posed, d, &budget, ws, par, rows)?.0)
 }
 
-/// The proximity query on `posed` (distance already checked), counted against `budget`; also
+/// The order of a proximity query's rows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Rows {
+    /// Each kind sorted as [`Proximity`] says (the public queries' order).
+    Sorted,
+    /// As the walk found them, which depends on the thread count: for a caller that orders
+    /// them itself (the contact set sorts them by contact).
+    AsFound,
+}
+
+/// The proximity query on `posed` (distance already checked), its rows in the order `rows`,
+/// counted against `budget`; also
 /// the nodes fitted on each side (the scene credits them per object). An error when the
 /// budget stopped the walk (this walk or another sharing the budget).
 pub(crate) fn run<K: BoundingVolume>(
@@ -148,6 +184,7 @@ pub(crate) fn run<K: BoundingVolume>(
     budget: &Budget<'_>,
     ws: &mut Workspace,
     par: Par,
+    rows: Rows,
 ) -> Result<(Proximity, [u64; 2])> {
     let margin = posed.node_test.margin;
     let q = PosedQuery {
@@ -157,6 +194,16 @@ pub(crate) fn run<K: BoundingVolume>(
     let w = walk::walk(&q, ws, par);
     budget.finish()?;
     let mut p = w.out.result;
+    if rows == Rows::Sorted {
+        sort_rows(&mut p);
+    }
+    p.counters = w.counters;
+    p.counters.contacts = (p.vertex_face.len() + p.face_vertex.len() + p.edge_edge.len()) as u64;
+    Ok((p, w.fitted))
+}
+
+/// Sorts each kind of row as [`Proximity`] says.
+fn sort_rows(p: &mut Proximity) {
     p.vertex_face
         .sort_unstable_by_key(|x| (u64::from(x.vertex) << 32) | u64::from(x.triangle));
     p.face_vertex
@@ -168,9 +215,6 @@ pub(crate) fn run<K: BoundingVolume>(
         let [a0, a1, b0, b1] = [x.a[0], x.a[1], x.b[0], x.b[1]].map(u128::from);
         a0 << 96 | a1 << 64 | b0 << 32 | b1
     });
-    p.counters = w.counters;
-    p.counters.contacts = (p.vertex_face.len() + p.face_vertex.len() + p.edge_edge.len()) as u64;
-    Ok((p, w.fitted))
 }
 
 /// The leaf action: the feature pairs of a leaf pair.
