@@ -16,6 +16,9 @@ pub(crate) fn by_group<T: Copy, K: Ord>(
     group: impl Fn(&T) -> usize,
     key: impl Fn(&T) -> K,
 ) -> Vec<T> {
+    let Some(&any) = rows.first() else {
+        return rows;
+    };
     if rows.len() < groups / 4 {
         rows.sort_unstable_by_key(key);
         return rows;
@@ -27,7 +30,7 @@ pub(crate) fn by_group<T: Copy, K: Ord>(
     for g in 0..groups {
         start[g + 1] += start[g];
     }
-    let mut sorted = vec![rows[0]; rows.len()];
+    let mut sorted = vec![any; rows.len()];
     let mut next = start.clone();
     for r in rows {
         let g = group(&r);
@@ -46,6 +49,15 @@ pub(crate) fn by_group<T: Copy, K: Ord>(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// No rows, with groups too few for the comparison sort: no rows back, no panic.
+    #[test]
+    fn no_rows_sort_to_none() {
+        for groups in [0, 1, 3, 4, 100] {
+            let got = by_group(Vec::<(u32, u16)>::new(), groups, |r| r.0 as usize, |r| *r);
+            assert!(got.is_empty());
+        }
+    }
 
     proptest! {
         /// The counting sort (many rows against the groups) and the comparison sort (few)
