@@ -593,10 +593,7 @@ pub(crate) fn from_rows<K: BoundingVolume>(
         keyed,
         ContactType::ALL.len() * vertices,
         |k| k.key.0 as usize * vertices + sides.dense(k.key.1[0]),
-        |k| {
-            let [v0, v1, v2, v3] = k.key.1.map(u128::from);
-            (k.key.0, v0 << 96 | v1 << 64 | v2 << 32 | v3, k.rank, k.row)
-        },
+        |k| (k.key.0, crate::sort::as_one(k.key.1), k.rank, k.row),
     );
     // Each contact's rows are one run of the sorted keys; keep its producer, in place.
     let mut kept = 0;

@@ -211,10 +211,8 @@ fn sort_rows(p: &mut Proximity) {
     // PERF: one 128-bit key; the arrays compared field by field made the proximity query
     // 3-5% slower on cloth-ball and rod-twist. A counting sort by `a[0]` (`crate::sort`)
     // was no faster on cloth-ball (7 rows a vertex: the scatter and a second buffer).
-    p.edge_edge.sort_unstable_by_key(|x| {
-        let [a0, a1, b0, b1] = [x.a[0], x.a[1], x.b[0], x.b[1]].map(u128::from);
-        a0 << 96 | a1 << 64 | b0 << 32 | b1
-    });
+    p.edge_edge
+        .sort_unstable_by_key(|x| crate::sort::as_one([x.a[0], x.a[1], x.b[0], x.b[1]]));
 }
 
 /// The leaf action: the feature pairs of a leaf pair.
