@@ -22,7 +22,7 @@ use crate::distance::{edges_cross_sq_below, point_line_distance_sq, EdgeEdge, Po
 use crate::error::{Error, Positions, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
-use crate::query::proximity::{self, Proximity, Rows};
+use crate::query::proximity::{self, EdgePair, Proximity, Rows};
 use crate::tree::MeshTables;
 use crate::walk::Workspace;
 
@@ -270,12 +270,57 @@ type Key = (ContactType, [u32; 4]);
 /// place in its contact's producer order ([`Sides::rank`]), the row (its index among the
 /// vertex-face, then face-vertex, then edge-edge rows), and whether an edge-edge row's edges
 /// are nearly parallel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Keyed {
     key: Key,
     rank: u64,
     row: usize,
     mollified: bool,
+}
+
+/// A proximity row by its index among the vertex-face, then face-vertex, then edge-edge rows
+/// ([`Keyed::row`]).
+enum Row<'r> {
+    /// A vertex of side `side` and a triangle of the side its vertices are tested against.
+    VertexFace {
+        side: Which,
+        vertex: u32,
+        triangle: u32,
+        kind: PointTriangle,
+        distance_sq: f64,
+    },
+    EdgeEdge(&'r EdgePair),
+}
+
+impl<'r> Row<'r> {
+    fn of(rows: &'r Proximity, i: usize) -> Self {
+        let (nv, nf) = (rows.vertex_face.len(), rows.face_vertex.len());
+        if i < nv {
+            let r = &rows.vertex_face[i];
+            let (vertex, triangle, kind, distance_sq) =
+                (r.vertex, r.triangle, r.kind, r.distance_sq);
+            Row::VertexFace {
+                side: Which::A,
+                vertex,
+                triangle,
+                kind,
+                distance_sq,
+            }
+        } else if i < nv + nf {
+            let r = &rows.face_vertex[i - nv];
+            let (vertex, triangle, kind, distance_sq) =
+                (r.vertex, r.triangle, r.kind, r.distance_sq);
+            Row::VertexFace {
+                side: Which::B,
+                vertex,
+                triangle,
+                kind,
+                distance_sq,
+            }
+        } else {
+            Row::EdgeEdge(&rows.edge_edge[i - nv - nf])
+        }
+    }
 }
 
 /// The two sides of a query (the same side twice in a self query), and the rules naming
@@ -416,8 +461,8 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
         edges_cross_sq_below(x, MOLLIFIER_FACTOR * rest(0) * rest(2))
     }
 
-    /// The contact of `key` found by a row at squared distance `distance_sq` (`closest`:
-    /// an edge-edge row's type), if this row emits it.
+    /// The contact of `key` emitted by its producer row, at squared distance `distance_sq`
+    /// (`closest`: an edge-edge row's type).
     fn contact(
         &self,
         key: Key,
@@ -463,43 +508,43 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
         (c, positions)
     }
 
-    /// Row `i` of `rows` (vertex-face rows, then face-vertex rows, then edge-edge rows)
-    /// keyed by its contact.
+    /// Row `i` of `rows` keyed by its contact.
     fn keyed(&self, rows: &Proximity, i: usize) -> Keyed {
-        let (nv, nf) = (rows.vertex_face.len(), rows.face_vertex.len());
-        let vertex_face = |side: Which, v: u32, t: u32, kind| {
-            let key = self.vertex_face_key(side, v, t, kind);
-            Keyed {
-                key,
-                rank: Self::rank(&key, Some((v + self.side(side).vertex_offset, t))),
-                row: i,
-                mollified: false,
+        match Row::of(rows, i) {
+            Row::VertexFace {
+                side,
+                vertex,
+                triangle,
+                kind,
+                ..
+            } => {
+                let key = self.vertex_face_key(side, vertex, triangle, kind);
+                let g = vertex + self.side(side).vertex_offset;
+                Keyed {
+                    key,
+                    rank: Self::rank(&key, Some((g, triangle))),
+                    row: i,
+                    mollified: false,
+                }
             }
-        };
-        if i < nv {
-            let r = &rows.vertex_face[i];
-            return vertex_face(Which::A, r.vertex, r.triangle, r.kind);
-        }
-        if i < nv + nf {
-            let r = &rows.face_vertex[i - nv];
-            return vertex_face(Which::B, r.vertex, r.triangle, r.kind);
-        }
-        let r = &rows.edge_edge[i - nv - nf];
-        let (sa, sb) = (self.a, self.b);
-        let g = Self::global_edges(sa, r.a, sb, r.b);
-        let x = [
-            sa.position(r.a[0]),
-            sa.position(r.a[1]),
-            sb.position(r.b[0]),
-            sb.position(r.b[1]),
-        ];
-        let mollified = self.mollified(g, x);
-        let key = Self::edge_edge_key(g, r.kind, mollified);
-        Keyed {
-            key,
-            rank: Self::rank(&key, None),
-            row: i,
-            mollified,
+            Row::EdgeEdge(r) => {
+                let (sa, sb) = (self.a, self.b);
+                let g = Self::global_edges(sa, r.a, sb, r.b);
+                let x = [
+                    sa.position(r.a[0]),
+                    sa.position(r.a[1]),
+                    sb.position(r.b[0]),
+                    sb.position(r.b[1]),
+                ];
+                let mollified = self.mollified(g, x);
+                let key = Self::edge_edge_key(g, r.kind, mollified);
+                Keyed {
+                    key,
+                    rank: Self::rank(&key, None),
+                    row: i,
+                    mollified,
+                }
+            }
         }
     }
 
@@ -520,8 +565,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
     /// ([`crate::tree::MeshTables`]), so the pairs are compared.
     fn producer(&self, rows: &Proximity, run: &[Keyed]) -> Keyed {
         let first = run[0];
-        let vertex_rows = rows.vertex_face.len() + rows.face_vertex.len();
-        if first.row < vertex_rows || run.len() == 1 {
+        if run.len() == 1 || matches!(Row::of(rows, first.row), Row::VertexFace { .. }) {
             return first;
         }
         debug_assert!(
@@ -535,7 +579,9 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
         // The edges of an edge-edge row at global vertices `v` and, for a point-point
         // contact, `w` (local vertex pairs of the one side each is on).
         let at = |k: &Keyed| {
-            let r = &rows.edge_edge[k.row - vertex_rows];
+            let Row::EdgeEdge(r) = Row::of(rows, k.row) else {
+                unreachable!("rows after an edge-edge row in rank order are edge-edge rows")
+            };
             let [a0, a1] = self.a.global(r.a);
             let on_a = |g: u32| g == a0 || g == a1;
             let at_w = match first.key.0 {
@@ -550,14 +596,9 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
 
     /// The contact of row `k`.
     fn contact_of(&self, rows: &Proximity, k: &Keyed) -> (Contact, [[f64; 3]; 4]) {
-        let (nv, nf) = (rows.vertex_face.len(), rows.face_vertex.len());
-        let (distance_sq, closest) = if k.row < nv {
-            (rows.vertex_face[k.row].distance_sq, None)
-        } else if k.row < nv + nf {
-            (rows.face_vertex[k.row - nv].distance_sq, None)
-        } else {
-            let r = &rows.edge_edge[k.row - nv - nf];
-            (r.distance_sq, Some(r.kind))
+        let (distance_sq, closest) = match Row::of(rows, k.row) {
+            Row::VertexFace { distance_sq, .. } => (distance_sq, None),
+            Row::EdgeEdge(r) => (r.distance_sq, Some(r.kind)),
         };
         self.contact(k.key, distance_sq, k.mollified, closest)
     }
