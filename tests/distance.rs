@@ -284,6 +284,13 @@ fn check_pt(p: &P, t: &[P; 3], extra: &[f64]) -> Result<(), TestCaseError> {
     );
     for d in thresholds(&exact, extra) {
         let want = q(d) * q(d) >= exact;
+        prop_assert!(
+            !(want && filters_say_apart(Filter::PointTriangle, [*p, t[0], t[1], t[2]], d)),
+            "the batch filter ends a pair within d = {:e}: {:?} {:?}",
+            d,
+            p,
+            t
+        );
         let res = point_triangle_within(*p, *t, d);
         prop_assert_eq!(res.is_some(), want, "d = {:e} for {:?} {:?}", d, p, t);
         if let Some(r) = res {
@@ -312,6 +319,12 @@ fn check_ee(e: [&P; 4], extra: &[f64]) -> Result<(), TestCaseError> {
     );
     for d in thresholds(&exact, extra) {
         let want = q(d) * q(d) >= exact;
+        prop_assert!(
+            !(want && filters_say_apart(Filter::Segments, [*a0, *a1, *b0, *b1], d)),
+            "the batch filter ends a pair within d = {:e}: {:?}",
+            d,
+            e
+        );
         let res = edge_edge_within(*a0, *a1, *b0, *b1, d);
         prop_assert_eq!(res.is_some(), want, "d = {:e} for {:?}", d, e);
         if let Some(r) = res {
@@ -323,6 +336,39 @@ fn check_ee(e: [&P; 4], extra: &[f64]) -> Result<(), TestCaseError> {
         }
     }
     Ok(())
+}
+
+/// The batch filters in front of the exact tests (`dhcd_kernels::apart`).
+#[derive(Clone, Copy)]
+enum Filter {
+    Segments,
+    PointTriangle,
+}
+
+/// Whether the filter's scalar reference or its kernel on the dispatched backend certifies
+/// the pair farther apart than `d` (the proximity query trusts both).
+fn filters_say_apart(f: Filter, pts: [P; 4], d: f64) -> bool {
+    use dhcd_kernels::apart::{point_triangles_apart_with, segments_apart_with, FourPoints};
+    use dhcd_kernels::pulp::{Simd, WithSimd};
+    use dhcd_kernels::reference::{point_triangle_apart, segment_pair_apart};
+    struct Run(Filter, FourPoints, f64);
+    impl WithSimd for Run {
+        type Output = bool;
+        fn with_simd<S: Simd>(self, simd: S) -> bool {
+            let bits = match self.0 {
+                Filter::Segments => segments_apart_with(simd, &self.1, 1, self.2),
+                Filter::PointTriangle => point_triangles_apart_with(simd, &self.1, 1, self.2),
+            };
+            bits == 1
+        }
+    }
+    let mut batch = FourPoints::default();
+    batch.set(0, pts);
+    let one = match f {
+        Filter::Segments => segment_pair_apart(pts, d),
+        Filter::PointTriangle => point_triangle_apart(pts, d),
+    };
+    one | dhcd_kernels::arch().dispatch(Run(f, batch, d))
 }
 
 // ---------------------------------------------------------------------------------------
@@ -474,6 +520,37 @@ proptest! {
         prop_assume!(finite(&pts));
         let [a0, a1, b0, b1] = pts;
         check_ee([&a0, &a1, &b0, &b1], &[s(1), s(2)])?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+
+    /// The batch filters are not vacuous: random pairs (non-degenerate almost surely) more
+    /// than 1.001 times `d` apart are certified, at scales from 2^-150 to 2^150.
+    #[test]
+    fn batch_filters_certify_separated_pairs(
+        pts in prop::array::uniform4(prop::array::uniform3(-1.0f64..1.0)),
+        lift in 0.0f64..3.0,
+        k in -150i32..150,
+    ) {
+        let s = 2f64.powi(k);
+        let pts = [0, 1, 2, 3].map(|i| {
+            let mut p = pts[i].map(|x| x * s);
+            if i >= 2 {
+                p[2] += lift * s;
+            }
+            p
+        });
+        let [a, b, c, e] = pts;
+        let (ee, _) = ee_oracle(&a, &b, &c, &e);
+        let (pt, _) = pt_oracle(&a, &[b, c, e]);
+        for (f, exact) in [(Filter::Segments, ee), (Filter::PointTriangle, pt)] {
+            let d = sqrt_of(&exact) / 1.001;
+            if d >= 1e-3 * s {
+                prop_assert!(filters_say_apart(f, pts, d), "{:?} at d = {:e}", pts, d);
+            }
+        }
     }
 }
 

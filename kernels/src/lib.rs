@@ -30,6 +30,7 @@
 // iterator forms clippy suggests hide that layout.
 #![allow(clippy::needless_range_loop)]
 
+pub mod apart;
 pub mod lazy;
 pub mod narrow;
 pub mod overlap;

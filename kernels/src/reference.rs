@@ -354,3 +354,118 @@ pub fn bounds_scalar_lanes(p: Soa3, lanes: usize) -> ([f32; 3], [f32; 3]) {
 pub fn bounds_indexed_scalar_lanes(p: Soa3, idx: &[u32], lanes: usize) -> ([f32; 3], [f32; 3]) {
     bounds_ref(indexed(p, idx), lanes)
 }
+
+// ---------------------------------------------------------------------------------------
+// apart
+
+/// The arithmetic of the [`crate::apart`] filters on one pair, in the kernels' operation
+/// order. Their clamps are `min(max(x, 0), 1)`; a NaN there may resolve differently by
+/// backend, which only changes the direction (module doc).
+mod apart_one {
+    use crate::apart::{
+        distance_in_range, DIRECTION_LOW, GAP_ERROR, SCALE_HIGH, SCALE_LOW, SQUARE_MARGIN,
+    };
+
+    pub(super) type P = [f64; 3];
+
+    pub(super) fn sub(x: P, y: P) -> P {
+        [x[0] - y[0], x[1] - y[1], x[2] - y[2]]
+    }
+
+    pub(super) fn dot(x: P, y: P) -> f64 {
+        (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2]
+    }
+
+    // The kernels' order of `max` then `min`: `clamp` differs on NaN.
+    #[allow(clippy::manual_clamp)]
+    pub(super) fn unit(x: f64) -> f64 {
+        x.max(0.0).min(1.0)
+    }
+
+    /// `r - t e`.
+    pub(super) fn along(r: P, t: f64, e: P) -> P {
+        [r[0] - t * e[0], r[1] - t * e[1], r[2] - t * e[2]]
+    }
+
+    /// The certificate: `gap` from the differences `x` exceeds `d |w|` beyond its bound.
+    pub(super) fn certified(gap: f64, x: [P; 3], w: P, d: f64) -> bool {
+        if !distance_in_range(d) {
+            return false;
+        }
+        let mut m = x[0][0].abs();
+        for v in x {
+            for c in v {
+                m = m.max(c.abs());
+            }
+        }
+        let w1 = (w[0].abs() + w[1].abs()) + w[2].abs();
+        let lower = gap - GAP_ERROR * (m * w1);
+        let ww = dot(w, w);
+        lower > 0.0
+            && lower * lower > ((d * d) * ww) * SQUARE_MARGIN
+            && ww >= DIRECTION_LOW
+            && (SCALE_LOW..=SCALE_HIGH).contains(&m)
+    }
+}
+
+/// Whether one segment pair `[a0, a1, b0, b1]` is certainly farther apart than `d` (the
+/// [`crate::apart`] filter on one pair).
+pub fn segment_pair_apart(e: [[f64; 3]; 4], d: f64) -> bool {
+    use apart_one::{along, certified, dot, sub, unit};
+    let [a0, a1, b0, b1] = e;
+    let (r, s, v, u) = (sub(a0, b0), sub(a1, b0), sub(b1, b0), sub(a1, a0));
+    let (uu, vv, uv) = (dot(u, u), dot(v, v), dot(u, v));
+    let (ru, rv) = (dot(r, u), dot(r, v));
+    let den = uu * vv - uv * uv;
+    let p = unit((uv * rv - ru * vv) / den);
+    let q = unit((uv * p + rv) / vv);
+    let p = unit((uv * q - ru) / uu);
+    let w = along([r[0] + p * u[0], r[1] + p * u[1], r[2] + p * u[2]], q, v);
+    let gap = dot(r, w).min(dot(s, w)) - 0f64.max(dot(v, w));
+    certified(gap, [r, s, v], w, d)
+}
+
+/// Whether one point-triangle pair `[p, t0, t1, t2]` is certainly farther apart than `d`.
+pub fn point_triangle_apart(e: [[f64; 3]; 4], d: f64) -> bool {
+    use apart_one::{along, certified, dot, sub, unit};
+    let [p, t0, t1, t2] = e;
+    let (r, e0, e1, f, rf) = (
+        sub(p, t0),
+        sub(t1, t0),
+        sub(t2, t0),
+        sub(t2, t1),
+        sub(p, t1),
+    );
+    let (d00, d01, d11) = (dot(e0, e0), dot(e0, e1), dot(e1, e1));
+    let (d20, d21) = (dot(r, e0), dot(r, e1));
+    let den = d00 * d11 - d01 * d01;
+    let beta = (d11 * d20 - d01 * d21) / den;
+    let gamma = (d00 * d21 - d01 * d20) / den;
+    let inside = beta >= 0.0 && gamma >= 0.0 && beta + gamma <= 1.0;
+    let w_in = along(along(r, beta, e0), gamma, e1);
+    let w0 = along(r, unit(d20 / d00), e0);
+    let w1 = along(r, unit(d21 / d11), e1);
+    let w2 = along(rf, unit(dot(rf, f) / dot(f, f)), f);
+    let (n0, n1, n2) = (dot(w0, w0), dot(w1, w1), dot(w2, w2));
+    let (w01, n01) = if n0 <= n1 { (w0, n0) } else { (w1, n1) };
+    let w_out = if n01 <= n2 { w01 } else { w2 };
+    let w = if inside { w_in } else { w_out };
+    let gap = dot(r, w) - 0f64.max(dot(e0, w)).max(dot(e1, w));
+    certified(gap, [r, e0, e1], w, d)
+}
+
+/// Scalar reference of [`crate::apart::segments_apart_with`].
+pub fn segments_apart_scalar(pairs: &crate::apart::FourPoints, n: usize, d: f64) -> u64 {
+    assert!(n <= crate::apart::MAX_PAIRS, "at most MAX_PAIRS pairs");
+    (0..n).fold(0, |bits, i| {
+        bits | u64::from(segment_pair_apart(pairs.get(i), d)) << i
+    })
+}
+
+/// Scalar reference of [`crate::apart::point_triangles_apart_with`].
+pub fn point_triangles_apart_scalar(pairs: &crate::apart::FourPoints, n: usize, d: f64) -> u64 {
+    assert!(n <= crate::apart::MAX_PAIRS, "at most MAX_PAIRS pairs");
+    (0..n).fold(0, |bits, i| {
+        bits | u64::from(point_triangle_apart(pairs.get(i), d)) << i
+    })
+}

@@ -5,6 +5,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use dhcd_kernels::apart;
 use dhcd_kernels::narrow;
 use dhcd_kernels::overlap::{self, AabbSoa, SphereSoa};
 use dhcd_kernels::pulp::{self, Simd, WithSimd};
@@ -1565,4 +1566,114 @@ fn moving_spheres_meet_whenever_they_do() {
     // NaN never meets.
     let nan = still([f64::NAN, 0.0, 0.0], 1.0);
     assert!(!reference::moving_spheres_meet(&nan, &still([0.0; 3], 1.0)));
+}
+
+// ---------------------------------------------------------------------------------------
+// apart: feature pairs certainly farther than a distance
+
+/// Random pairs of four points in `[-1, 1)^3` (a few of them moved away by up to 3 along
+/// one axis, so that some are apart and some not at every `d` tried), scaled by `scale`.
+fn four_points(rng: &mut Rng, n: usize, scale: f64) -> apart::FourPoints {
+    let mut pairs = apart::FourPoints::default();
+    for i in 0..n {
+        let shift = [0, 1, 2].map(|_| f64::from(rng.f32_in(-3.0, 3.0)));
+        let points = std::array::from_fn(|e| {
+            std::array::from_fn(|k| {
+                let x = f64::from(rng.f32_in(-1.0, 1.0)) + f64::from(rng.f32_in(-1.0, 1.0)) * 1e-9;
+                (if e < 2 { x } else { x + shift[k] }) * scale
+            })
+        });
+        pairs.set(i, points);
+    }
+    pairs
+}
+
+fn check_apart<S: Simd>(simd: S) {
+    let mut rng = Rng::new(41);
+    let mut certified = [0u32; 2];
+    for scale in [1.0, 1e-30, 3e25] {
+        for n in [0, 1, 3, 7, 8, 9, 31, 63, 64] {
+            let pairs = four_points(&mut rng, n, scale);
+            for d in [
+                0.0,
+                0.1 * scale,
+                0.7 * scale,
+                2.0 * scale,
+                1e-300,
+                f64::INFINITY,
+            ] {
+                let s = apart::segments_apart_with(simd, &pairs, n, d);
+                assert_eq!(
+                    s,
+                    reference::segments_apart_scalar(&pairs, n, d),
+                    "n {n} d {d}"
+                );
+                let t = apart::point_triangles_apart_with(simd, &pairs, n, d);
+                assert_eq!(
+                    t,
+                    reference::point_triangles_apart_scalar(&pairs, n, d),
+                    "n {n} d {d}"
+                );
+                assert!(n == 64 || (s | t) >> n == 0, "no bit past n");
+                certified[0] += s.count_ones();
+                certified[1] += t.count_ones();
+            }
+        }
+    }
+    // The data holds pairs certainly apart (the bits are not all zero by accident).
+    assert!(certified.iter().all(|&c| c > 100), "{certified:?}");
+}
+
+#[test]
+fn apart_matches_reference_on_all_backends() {
+    on_all_backends!(check_apart);
+}
+
+#[test]
+fn apart_certifies_far_pairs_and_never_near_ones() {
+    use reference::{point_triangle_apart, segment_pair_apart};
+    // Two unit segments 2 apart along z, crossing in projection.
+    let ee = [
+        [-1.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, -1.0, 2.0],
+        [0.0, 1.0, 2.0],
+    ];
+    assert!(segment_pair_apart(ee, 1.999));
+    assert!(!segment_pair_apart(ee, 2.0));
+    // Parallel segments 1 apart, overlapping along their length.
+    let par = [
+        [0.0, 0.0, 0.0],
+        [4.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [3.0, 1.0, 0.0],
+    ];
+    assert!(segment_pair_apart(par, 0.999));
+    assert!(!segment_pair_apart(par, 1.0));
+    // A point 3 above a triangle's interior; then beyond its edge in its plane; then
+    // beyond a corner.
+    let t = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+    let pt = |p: [f64; 3]| [p, t[0], t[1], t[2]];
+    assert!(point_triangle_apart(pt([1.0, 1.0, 3.0]), 2.999));
+    assert!(!point_triangle_apart(pt([1.0, 1.0, 3.0]), 3.0));
+    assert!(point_triangle_apart(pt([3.0, 3.0, 0.0]), 1.414));
+    assert!(!point_triangle_apart(pt([3.0, 3.0, 0.0]), 1.415));
+    assert!(point_triangle_apart(pt([-3.0, -4.0, 0.0]), 4.999));
+    assert!(!point_triangle_apart(pt([-3.0, -4.0, 0.0]), 5.0));
+    // Touching, degenerate, non-finite and out-of-range input certify nothing.
+    assert!(!point_triangle_apart(pt([2.0, 0.0, 0.0]), 0.0));
+    assert!(!point_triangle_apart(pt([1.0, 1.0, 3.0]), 3e200));
+    assert!(!segment_pair_apart([[0.0; 3]; 4], 0.0));
+    assert!(!segment_pair_apart(
+        [[f64::NAN; 3], [1.0; 3], [5.0; 3], [6.0; 3]],
+        0.1
+    ));
+    assert!(!point_triangle_apart(
+        [[9.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]],
+        f64::NAN
+    ));
+    // Two points (zero-length segments) far apart: some direction still certifies or
+    // nothing does; never a wrong answer.
+    let dots = [[0.0; 3], [0.0; 3], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
+    assert!(!segment_pair_apart(dots, 1.0));
 }
