@@ -432,3 +432,254 @@ fn certified<S: Simd>(
     ok = simd.and_m64s(ok, simd.greater_than_or_equal_f64s(m, c.low));
     simd.and_m64s(ok, simd.less_than_or_equal_f64s(m, c.high))
 }
+
+// ---------------------------------------------------------------------------------------
+// Moving pairs: separation along the centroids' line over a time interval.
+
+/// Up to [`MAX_PAIRS`] moving feature pairs: the four points of each at two poses (CCD's
+/// layout: `[v, t0, t1, t2]` or `[a0, a1, b0, b1]`), as 24 rows: row `12 j + 3 i + k` holds
+/// coordinate `k` of point `i` at pose `j`.
+#[derive(Clone, Debug)]
+pub struct MovingPoints {
+    /// The coordinate rows.
+    pub rows: [[f64; MAX_PAIRS]; 24],
+}
+
+impl Default for MovingPoints {
+    fn default() -> Self {
+        Self {
+            rows: [[0.0; MAX_PAIRS]; 24],
+        }
+    }
+}
+
+impl MovingPoints {
+    /// Stores pair `i` at its two poses.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) {
+        for (j, x) in [x0, x1].into_iter().enumerate() {
+            for (e, p) in x.iter().enumerate() {
+                for k in 0..3 {
+                    self.rows[12 * j + 3 * e + k][i] = p[k];
+                }
+            }
+        }
+    }
+
+    /// Pair `i` at its two poses.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
+        let pose = |j: usize| {
+            std::array::from_fn(|e| std::array::from_fn(|k| self.rows[12 * j + 3 * e + k][i]))
+        };
+        (pose(0), pose(1))
+    }
+}
+
+/// `2^-48`: the relative part of a fixed-axis gap's error bound (per unit of `M |c|_1`).
+pub(crate) const AXIS_REL: f64 = power_of_two(-48);
+/// `2^-1000`: its absolute part.
+pub(crate) const AXIS_ABS: f64 = power_of_two(-1000);
+/// The magnitudes (`M`, and axes' 1-norms) the bound holds for: `[2^-400, 2^400]`.
+pub(crate) const AXIS_LOW: f64 = power_of_two(-400);
+pub(crate) const AXIS_HIGH: f64 = power_of_two(400);
+/// `1 + 2^-46`: raises `|c|` computed from its rounded square (and the products and sums
+/// that follow) above the exact `|c|`.
+pub(crate) const LENGTH_UP: f64 = 1.0 + power_of_two(-46);
+
+/// The bits of the first `n` moving pairs of `pairs` (`n <= MAX_PAIRS`; `vertex_face`: each
+/// is a vertex and a triangle, else two edges) certainly farther than `delta` apart at every
+/// time of `[0, t_end]` (`t_end` in `(0, 1]`; the pose at `t_end` interpolated as
+/// `x0 + t_end (x1 - x0)` when below 1), by separation along the line between the features'
+/// centroids at pose 0. `m` is at least every coordinate's magnitude at both poses.
+///
+/// Along a fixed direction `c` the gap between two linearly moving features is concave in
+/// `t`, so gaps above `delta |c|` at both ends hold over the interval. This is the first
+/// axis of `dhcd`'s CCD cull (`src/ccd/axis.rs`, which derives the error bound): a computed
+/// gap is within `18.1 u M |c|_1 + 2^-1070` of the exact one (`u = 2^-53`), interpolated
+/// poses included; the kernel certifies a gap above `delta (|c| (1 + 2^-46)) + 2^-48 M |c|_1 +
+/// 2^-1000`, whose margins (`2^-48 = 32 u` against `18.1 u`, `2^-46` against about `6 u`)
+/// cover the rounding of the bound itself. Nothing is certified when `m` or `|c|_1` is
+/// outside `[2^-400, 2^400]`, `delta` is not finite and `>= 0`, or `t_end` is outside
+/// `(0, 1]`.
+#[inline(always)]
+pub fn centroids_apart_with<S: Simd>(
+    simd: S,
+    pairs: &MovingPoints,
+    n: usize,
+    vertex_face: bool,
+    delta: f64,
+    m: f64,
+    t_end: f64,
+) -> u64 {
+    assert!(n <= MAX_PAIRS, "at most MAX_PAIRS pairs");
+    let valid = (AXIS_LOW..=AXIS_HIGH).contains(&m)
+        && delta.is_finite()
+        && delta >= 0.0
+        && t_end > 0.0
+        && t_end <= 1.0;
+    if !valid {
+        return 0;
+    }
+    let c = AxisConstants {
+        error: simd.splat_f64s(AXIS_REL * m),
+        abs: simd.splat_f64s(AXIS_ABS),
+        low: simd.splat_f64s(AXIS_LOW),
+        high: simd.splat_f64s(AXIS_HIGH),
+        delta: simd.splat_f64s(delta),
+        length_up: simd.splat_f64s(LENGTH_UP),
+        t: simd.splat_f64s(t_end),
+        third: simd.splat_f64s(1.0 / 3.0),
+        half: simd.splat_f64s(0.5),
+    };
+    let mut bits = 0u64;
+    let mut base = 0;
+    while base < n {
+        let hit = if vertex_face {
+            moving_lanes::<S, true>(simd, &c, pairs, base, t_end < 1.0, delta > 0.0)
+        } else {
+            moving_lanes::<S, false>(simd, &c, pairs, base, t_end < 1.0, delta > 0.0)
+        };
+        let valid = if n - base >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << (n - base)) - 1
+        };
+        bits |= (u64::from(mask_bits_f64(simd, hit)) & valid) << base;
+        base += S::F64_LANES;
+    }
+    bits
+}
+
+/// The splatted constants of one moving batch (`error` is `2^-48 M`).
+struct AxisConstants<V> {
+    error: V,
+    abs: V,
+    low: V,
+    high: V,
+    delta: V,
+    length_up: V,
+    t: V,
+    third: V,
+    half: V,
+}
+
+/// Point `e` of pose `j` of the moving pairs in lanes `base..`.
+#[inline(always)]
+fn moving_point<S: Simd>(pairs: &MovingPoints, j: usize, e: usize, base: usize) -> [S::f64s; 3] {
+    let rows = &pairs.rows[12 * j + 3 * e..12 * j + 3 * e + 3];
+    [
+        S::as_simd_f64s(&rows[0][base..base + S::F64_LANES]).0[0],
+        S::as_simd_f64s(&rows[1][base..base + S::F64_LANES]).0[0],
+        S::as_simd_f64s(&rows[2][base..base + S::F64_LANES]).0[0],
+    ]
+}
+
+/// The gaps along `c` at the points `x`: the second feature (points `split..4`) above the
+/// first, and below it.
+#[inline(always)]
+fn gaps_lanes<S: Simd, const VF: bool>(
+    simd: S,
+    x: &[[S::f64s; 3]; 4],
+    c: &[S::f64s; 3],
+) -> (S::f64s, S::f64s) {
+    let p = [
+        dot3(simd, &x[0], c),
+        dot3(simd, &x[1], c),
+        dot3(simd, &x[2], c),
+        dot3(simd, &x[3], c),
+    ];
+    let (a_lo, a_hi, b_lo, b_hi) = if VF {
+        (
+            p[0],
+            p[0],
+            simd.min_f64s(simd.min_f64s(p[1], p[2]), p[3]),
+            simd.max_f64s(simd.max_f64s(p[1], p[2]), p[3]),
+        )
+    } else {
+        (
+            simd.min_f64s(p[0], p[1]),
+            simd.max_f64s(p[0], p[1]),
+            simd.min_f64s(p[2], p[3]),
+            simd.max_f64s(p[2], p[3]),
+        )
+    };
+    (simd.sub_f64s(b_lo, a_hi), simd.sub_f64s(a_lo, b_hi))
+}
+
+/// The verdicts of the moving pairs in lanes `base..base + F64_LANES` (`VF`: vertex-face).
+#[inline(always)]
+fn moving_lanes<S: Simd, const VF: bool>(
+    simd: S,
+    c: &AxisConstants<S::f64s>,
+    pairs: &MovingPoints,
+    base: usize,
+    interpolate: bool,
+    with_delta: bool,
+) -> S::m64s {
+    let x0 = [
+        moving_point::<S>(pairs, 0, 0, base),
+        moving_point::<S>(pairs, 0, 1, base),
+        moving_point::<S>(pairs, 0, 2, base),
+        moving_point::<S>(pairs, 0, 3, base),
+    ];
+    let mut x1 = [
+        moving_point::<S>(pairs, 1, 0, base),
+        moving_point::<S>(pairs, 1, 1, base),
+        moving_point::<S>(pairs, 1, 2, base),
+        moving_point::<S>(pairs, 1, 3, base),
+    ];
+    if interpolate {
+        // x0 + t (x1 - x0), as the scalar cull interpolates.
+        for (e, p) in x1.iter_mut().enumerate() {
+            for k in 0..3 {
+                p[k] = simd.add_f64s(x0[e][k], simd.mul_f64s(c.t, simd.sub_f64s(p[k], x0[e][k])));
+            }
+        }
+    }
+    // The centroids' line at pose 0 (any direction is a valid axis).
+    let mut axis = [x0[0][0], x0[0][1], x0[0][2]];
+    for k in 0..3 {
+        axis[k] = if VF {
+            simd.sub_f64s(
+                simd.mul_f64s(
+                    simd.add_f64s(simd.add_f64s(x0[1][k], x0[2][k]), x0[3][k]),
+                    c.third,
+                ),
+                x0[0][k],
+            )
+        } else {
+            simd.mul_f64s(
+                simd.sub_f64s(
+                    simd.add_f64s(x0[2][k], x0[3][k]),
+                    simd.add_f64s(x0[0][k], x0[1][k]),
+                ),
+                c.half,
+            )
+        };
+    }
+    let norm1 = simd.add_f64s(
+        simd.add_f64s(simd.abs_f64s(axis[0]), simd.abs_f64s(axis[1])),
+        simd.abs_f64s(axis[2]),
+    );
+    let mut bound = simd.add_f64s(simd.mul_f64s(c.error, norm1), c.abs);
+    if with_delta {
+        let length = simd.mul_f64s(simd.sqrt_f64s(dot3(simd, &axis, &axis)), c.length_up);
+        bound = simd.add_f64s(simd.mul_f64s(c.delta, length), bound);
+    }
+    let (up0, down0) = gaps_lanes::<S, VF>(simd, &x0, &axis);
+    let (up1, down1) = gaps_lanes::<S, VF>(simd, &x1, &axis);
+    let up = simd.and_m64s(
+        simd.greater_than_f64s(up0, bound),
+        simd.greater_than_f64s(up1, bound),
+    );
+    let down = simd.and_m64s(
+        simd.greater_than_f64s(down0, bound),
+        simd.greater_than_f64s(down1, bound),
+    );
+    let in_range = simd.and_m64s(
+        simd.greater_than_or_equal_f64s(norm1, c.low),
+        simd.less_than_or_equal_f64s(norm1, c.high),
+    );
+    simd.and_m64s(in_range, simd.or_m64s(up, down))
+}

@@ -469,3 +469,88 @@ pub fn point_triangles_apart_scalar(pairs: &crate::apart::FourPoints, n: usize, 
         bits | u64::from(point_triangle_apart(pairs.get(i), d)) << i
     })
 }
+
+/// Whether one moving pair (`vertex_face`: `[v, t0, t1, t2]`, else `[a0, a1, b0, b1]`, at
+/// poses `x0` and `x1`) is certainly farther than `delta` apart over `[0, t_end]` along its
+/// centroids' line at pose 0 (the [`crate::apart::centroids_apart_with`] test on one pair).
+pub fn moving_centroids_apart(
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    vertex_face: bool,
+    delta: f64,
+    m: f64,
+    t_end: f64,
+) -> bool {
+    use crate::apart::{AXIS_ABS, AXIS_HIGH, AXIS_LOW, AXIS_REL, LENGTH_UP};
+    let valid = (AXIS_LOW..=AXIS_HIGH).contains(&m)
+        && delta.is_finite()
+        && delta >= 0.0
+        && t_end > 0.0
+        && t_end <= 1.0;
+    if !valid {
+        return false;
+    }
+    let end: [[f64; 3]; 4] = if t_end < 1.0 {
+        std::array::from_fn(|e| std::array::from_fn(|k| x0[e][k] + t_end * (x1[e][k] - x0[e][k])))
+    } else {
+        *x1
+    };
+    let axis: [f64; 3] = std::array::from_fn(|k| {
+        if vertex_face {
+            ((x0[1][k] + x0[2][k]) + x0[3][k]) * (1.0 / 3.0) - x0[0][k]
+        } else {
+            ((x0[2][k] + x0[3][k]) - (x0[0][k] + x0[1][k])) * 0.5
+        }
+    });
+    let dot = |x: [f64; 3]| (x[0] * axis[0] + x[1] * axis[1]) + x[2] * axis[2];
+    let norm1 = (axis[0].abs() + axis[1].abs()) + axis[2].abs();
+    let mut bound = (AXIS_REL * m) * norm1 + AXIS_ABS;
+    if delta > 0.0 {
+        bound += delta * (dot(axis).sqrt() * LENGTH_UP);
+    }
+    let gaps = |x: &[[f64; 3]; 4]| {
+        let p = x.map(dot);
+        let (a_lo, a_hi, b_lo, b_hi) = if vertex_face {
+            (
+                p[0],
+                p[0],
+                p[1].min(p[2]).min(p[3]),
+                p[1].max(p[2]).max(p[3]),
+            )
+        } else {
+            (
+                p[0].min(p[1]),
+                p[0].max(p[1]),
+                p[2].min(p[3]),
+                p[2].max(p[3]),
+            )
+        };
+        (b_lo - a_hi, a_lo - b_hi)
+    };
+    let ((up0, down0), (up1, down1)) = (gaps(x0), gaps(&end));
+    (AXIS_LOW..=AXIS_HIGH).contains(&norm1)
+        && ((up0 > bound && up1 > bound) || (down0 > bound && down1 > bound))
+}
+
+/// Scalar reference of [`crate::apart::centroids_apart_with`].
+pub fn centroids_apart_scalar(
+    pairs: &crate::apart::MovingPoints,
+    n: usize,
+    vertex_face: bool,
+    delta: f64,
+    m: f64,
+    t_end: f64,
+) -> u64 {
+    assert!(n <= crate::apart::MAX_PAIRS, "at most MAX_PAIRS pairs");
+    (0..n).fold(0, |bits, i| {
+        let (x0, x1) = pairs.get(i);
+        bits | u64::from(moving_centroids_apart(
+            &x0,
+            &x1,
+            vertex_face,
+            delta,
+            m,
+            t_end,
+        )) << i
+    })
+}

@@ -1677,3 +1677,43 @@ fn apart_certifies_far_pairs_and_never_near_ones() {
     let dots = [[0.0; 3], [0.0; 3], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
     assert!(!segment_pair_apart(dots, 1.0));
 }
+
+fn check_centroids_apart<S: Simd>(simd: S) {
+    let mut rng = Rng::new(43);
+    let mut certified = 0u32;
+    for scale in [1.0, 1e-30, 3e25] {
+        for n in [0, 1, 5, 8, 13, 64] {
+            let p0 = four_points(&mut rng, n, scale);
+            let p1 = four_points(&mut rng, n, scale);
+            let mut pairs = apart::MovingPoints::default();
+            for i in 0..n {
+                // Half the pairs move a little, half across the box.
+                let (x0, mut x1) = (p0.get(i), p1.get(i));
+                if i % 2 == 0 {
+                    x1 = std::array::from_fn(|e| {
+                        std::array::from_fn(|k| x0[e][k] + 0.01 * x1[e][k])
+                    });
+                }
+                pairs.set(i, &x0, &x1);
+            }
+            let m = 5.0 * scale;
+            for vf in [true, false] {
+                for delta in [0.0, 0.05 * scale, 2.0 * scale] {
+                    for t_end in [1.0, 0.3] {
+                        let got = apart::centroids_apart_with(simd, &pairs, n, vf, delta, m, t_end);
+                        let want =
+                            reference::centroids_apart_scalar(&pairs, n, vf, delta, m, t_end);
+                        assert_eq!(got, want, "n {n} vf {vf} delta {delta} t {t_end}");
+                        certified += got.count_ones();
+                    }
+                }
+            }
+        }
+    }
+    assert!(certified > 100, "{certified}");
+}
+
+#[test]
+fn centroids_apart_matches_reference_on_all_backends() {
+    on_all_backends!(check_centroids_apart);
+}

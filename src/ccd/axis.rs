@@ -18,7 +18,10 @@
 //! `t = 0`, the face normal (vertex-face) or the cross product of the edges (edge-edge) at
 //! `t = 0`, the same two at `t = 1`, then the coordinate axes (the features' boxes at both
 //! ends, sharper than the boxes over the whole step of stage 0). On armadillo-rollers
-//! 326 -> 327 the first axis ends 84% of the 7.0 M candidate pairs, all seven 96%.
+//! 326 -> 327 the first axis ends 84% of the 7.0 M candidate pairs, all seven 96%. The CCD
+//! walk runs the first axis on its candidates 8 at a time first
+//! (`dhcd_kernels::apart::centroids_apart_with`, with this bound and margins for its own
+//! rounding), and this test on the pairs it leaves.
 //!
 //! **Rounding** (`u = 2^-53`, `M` at least the largest coordinate magnitude, `C = sum_k
 //! |c_k|`). The axis is whatever float vector was computed: any direction is a valid axis,
@@ -201,10 +204,34 @@ mod tests {
         x.map(|p| p.map(|c| c * s))
     }
 
+    /// The batch cull on one pair: its scalar reference, and the kernel on the dispatched
+    /// backend (equal; both checked).
+    fn batch_apart(vf: bool, x0: &Points, x1: &Points, d: f64, m: f64, t_end: f64) -> bool {
+        use dhcd_kernels::apart::{centroids_apart_with, MovingPoints};
+        use dhcd_kernels::pulp::{Simd, WithSimd};
+        struct Run<'a>(&'a MovingPoints, bool, f64, f64, f64);
+        impl WithSimd for Run<'_> {
+            type Output = u64;
+            fn with_simd<S: Simd>(self, simd: S) -> u64 {
+                centroids_apart_with(simd, self.0, 1, self.1, self.2, self.3, self.4)
+            }
+        }
+        let mut pairs = MovingPoints::default();
+        pairs.set(0, x0, x1);
+        let one = dhcd_kernels::reference::moving_centroids_apart(x0, x1, vf, d, m, t_end);
+        let batch = dhcd_kernels::arch().dispatch(Run(&pairs, vf, d, m, t_end)) == 1;
+        assert_eq!(
+            one, batch,
+            "kernel and reference disagree: {x0:?} -> {x1:?}"
+        );
+        one
+    }
+
     #[test]
     fn every_pair_called_apart_is_apart_exactly() {
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
         let (mut apart_count, mut between_count, mut total) = (0u32, 0u32, 0u32);
+        let mut batch_count = 0u32;
         for case in 0..4000 {
             let vf = case % 2 == 0;
             let x0: Points = std::array::from_fn(|_| std::array::from_fn(|_| rng.small()));
@@ -237,6 +264,18 @@ mod tests {
             // Over [0, hi] from the pose interpolated (rounded) at a time that is not dyadic,
             // along the centroid axis there.
             let hi = [0.1, 1.0 / 3.0, 0.7][rng.below(3) as usize];
+            // The batch cull of the walk (the centroids' line at t0, the kernel and its
+            // scalar reference), over [0, 1] and over [0, hi].
+            for t_end in [1.0, hi] {
+                if batch_apart(vf, &y0, &y1, d, m, t_end) {
+                    batch_count += 1;
+                    let exact = solve(kind, &x0, &x1, t_end, delta, &|| false).unwrap();
+                    assert_eq!(
+                        exact, None,
+                        "batch: vf {vf} {x0:?} -> {x1:?} delta {delta} until {t_end}"
+                    );
+                }
+            }
             let end = positions_at(&y0, &y1, hi);
             let c = centroid_axis(if vf { 1 } else { 2 }, &end);
             if apart_between(vf, (&y0, &end), &c, d, m) {
@@ -249,6 +288,7 @@ mod tests {
             }
         }
         assert!(between_count > total / 4, "{between_count} of {total}");
+        assert!(batch_count > total / 4, "{batch_count} of {}", 2 * total);
         // Random pairs in one cube are often far apart: most must be culled.
         assert!(apart_count > total / 4, "{apart_count} of {total}");
     }
@@ -284,5 +324,103 @@ mod tests {
             let (y0, y1) = (scaled(&x0, s), scaled(&x1, s));
             assert!(!apart(true, &y0, &y1, 0.0, 5.0 * s));
         }
+    }
+
+    /// The batch cull's certificate against exact arithmetic: along the very axis the kernel
+    /// computes, the exact gaps at both ends exceed `delta |c|` whenever it certifies. Points
+    /// far from the origin (every projection rounds) with the second feature placed within
+    /// a few ulps of touching the first along the axis at t1, so a bound too small would
+    /// certify pairs that touch.
+    #[test]
+    fn batch_certificates_hold_in_exact_arithmetic() {
+        use num_rational::BigRational as Q;
+        use num_traits::{Signed, Zero};
+        let q = |x: f64| Q::from_float(x).expect("finite");
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let (mut certified, mut total) = (0u32, 0u32);
+        for case in 0..20000 {
+            let vf = case % 2 == 0;
+            let offset = [1.0e6, -3.0e5, 7.5e5];
+            let near = |r: &mut Rng| std::array::from_fn(|k| offset[k] + r.small() / 8.0);
+            let x0: Points = std::array::from_fn(|_| near(&mut rng));
+            let mut x1: Points =
+                std::array::from_fn(|i| std::array::from_fn(|k| x0[i][k] + rng.small() / 64.0));
+            // The axis the kernel uses.
+            let c: [f64; 3] = std::array::from_fn(|k| {
+                if vf {
+                    ((x0[1][k] + x0[2][k]) + x0[3][k]) * (1.0 / 3.0) - x0[0][k]
+                } else {
+                    ((x0[2][k] + x0[3][k]) - (x0[0][k] + x0[1][k])) * 0.5
+                }
+            });
+            // At t1, put the first feature's points level with the second feature's lowest
+            // point along c (offset across c by `w = c x e_x`, exactly perpendicular), then
+            // nudge them by a few ulps: gaps of about zero, of either sign, after rounding.
+            let proj = |p: &[f64; 3]| (p[0] * c[0] + p[1] * c[1]) + p[2] * c[2];
+            let split = if vf { 1 } else { 2 };
+            let low = (split..4)
+                .min_by(|&i, &j| proj(&x1[i]).total_cmp(&proj(&x1[j])))
+                .expect("points");
+            let corner = x1[low];
+            let w = [0.0, c[2], -c[1]];
+            for (p, s) in x1.iter_mut().take(split).zip([0.5, -0.25]) {
+                for k in 0..3 {
+                    let mut v = corner[k] + s * w[k];
+                    for _ in 0..rng.below(3) {
+                        v = if rng.below(2) == 0 {
+                            v.next_up()
+                        } else {
+                            v.next_down()
+                        };
+                    }
+                    p[k] = v;
+                }
+            }
+            // With a minimum distance, the same pairs moved down along c by it: gaps of
+            // about `delta |c|`.
+            let delta = [0.0, 0.0, 1e-6][rng.below(3) as usize];
+            let length = ((c[0] * c[0] + c[1] * c[1]) + c[2] * c[2]).sqrt();
+            for p in x1.iter_mut().take(split) {
+                for k in 0..3 {
+                    p[k] -= delta * c[k] / length;
+                }
+            }
+            let m = x0
+                .iter()
+                .chain(&x1)
+                .flatten()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            total += 1;
+            if !batch_apart(vf, &x0, &x1, delta, m, 1.0) {
+                continue;
+            }
+            certified += 1;
+            let cq = c.map(q);
+            let cc = cq.iter().map(|x| x * x).fold(Q::zero(), |a, b| a + b);
+            for x in [&x0, &x1] {
+                let p: Vec<Q> = x
+                    .iter()
+                    .map(|p| {
+                        (0..3)
+                            .map(|k| q(p[k]) * &cq[k])
+                            .fold(Q::zero(), |a, b| a + b)
+                    })
+                    .collect();
+                let (a, b) = p.split_at(split);
+                let lo = |v: &[Q]| v.iter().min().unwrap().clone();
+                let hi = |v: &[Q]| v.iter().max().unwrap().clone();
+                let up = lo(b) - hi(a);
+                let down = lo(a) - hi(b);
+                let gap = if up.is_positive() { up } else { down };
+                let dd = q(delta) * q(delta);
+                assert!(
+                    gap.is_positive() && &gap * &gap > dd * &cc,
+                    "vf {vf}: certified, but an exact gap is {gap} along {c:?}: {x0:?} -> {x1:?}"
+                );
+            }
+        }
+        // Every pair is level along the axis at t1 within rounding: none may be certified
+        // but by a gap above the error bound, and the bound leaves almost none.
+        assert!(certified < total / 100, "{certified} of {total}");
     }
 }

@@ -12,7 +12,11 @@
 //! at t0 and at t1 (the gap along a fixed axis is concave in t under linear motion: two
 //! leaves moving the same way, whose boxes over the step overlap, are apart all step). Each
 //! leaf pair then culls its feature pairs by their own boxes over the step (in `f32`,
-//! rounded outward, grown by the minimum distance) before the exact test of [`crate::ccd`]:
+//! rounded outward, grown by the minimum distance), stages them, and ends 64 at a time those
+//! certainly apart along the line between their centroids at t0 over `[0, t_max]`
+//! ([`dhcd_kernels::apart::centroids_apart_with`], the first axis of [`crate::ccd`]'s cull in
+//! `f64` lanes; not under the step size's per-pair minimum distances), before the exact test
+//! of [`crate::ccd`]:
 //! whether the pair touches in `[0, t_max]` is exact for the `f64` input, and the time of
 //! impact is never later than the true one and at most [`crate::ccd::TOI_TOLERANCE`]
 //! earlier.
@@ -41,7 +45,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{Candidates, FeatureBox, LeafEdges, LeafTriangles};
+use super::features::{CandidateEdge, Candidates, FeatureBox, LeafEdges, LeafTriangles};
 use crate::bv::swept::{f32_down, f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
@@ -53,6 +57,7 @@ use crate::mesh::check_positions_f64;
 use crate::par::Par;
 use crate::tree::RegionTree;
 use crate::walk::{self, Query, Side, Workspace};
+use dhcd_kernels::apart::{centroids_apart_with, MovingPoints, MAX_PAIRS};
 use dhcd_kernels::overlap::BoxRows;
 use listed::ListedCount;
 pub(crate) use listed::{gap_over_listed, Listed, Listing, MAX_LISTED};
@@ -682,6 +687,21 @@ struct ImpactOut {
     edge_edge: Vec<EdgeImpact>,
     /// The feature pairs met, when the walk lists them.
     listed: Listed,
+    /// Scratch of the task, not a result: a leaf pair's candidates on their way to the
+    /// batch cull.
+    staged: Box<Staged>,
+}
+
+/// A leaf pair's candidates staged for the batch cull ([`centroids_apart_with`]), and the
+/// poses of up to [`MAX_PAIRS`] of them.
+#[derive(Default)]
+struct Staged {
+    /// Vertex-triangle pairs (internal indices).
+    vertex_triangles: Vec<(u32, u32)>,
+    /// Edge pairs.
+    edges: Vec<(CandidateEdge, CandidateEdge)>,
+    /// The two poses of each pair of the current chunk.
+    points: MovingPoints,
 }
 
 impl ImpactOut {
@@ -1003,6 +1023,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             face_vertex,
             edge_edge,
             listed: Listed::default(),
+            staged: Box::default(),
         };
         let least = settled.least_toi().unwrap_or(f64::INFINITY);
         settled.vertex_face.retain(|x| ties_with(x.toi, least));
@@ -1209,6 +1230,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
             face_vertex,
             edge_edge,
             listed,
+            staged,
         } = out;
         let listed_before = listed.len();
         let mut lists = self.listing.filter(|_| !self.listed.full()).map(|_| listed);
@@ -1227,6 +1249,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
             b,
             y,
             counters,
+            staged,
             list,
             |v, t, toi| {
                 budget.push(
@@ -1256,6 +1279,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
                 a,
                 x,
                 counters,
+                staged,
                 list,
                 |v, t, toi| {
                     if self_query {
@@ -1281,7 +1305,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
             );
         }
         let list = lists.as_mut().map(|l| &mut l.edge_edge);
-        self.edges_vs_edges(simd, &candidates, x, y, counters, list, edge_edge);
+        self.edges_vs_edges(simd, &candidates, x, y, counters, staged, list, edge_edge);
         if let (Some(l), Some(listing)) = (lists, self.listing) {
             self.listed.add(l, listed_before, listing.most);
         }
@@ -1329,6 +1353,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         st: &Swept<'_, K>,
         y: usize,
         counters: &mut Counters,
+        staged: &mut Staged,
         mut list: Option<&mut Vec<[u32; 2]>>,
         mut emit: impl FnMut(usize, usize, f64),
     ) {
@@ -1343,25 +1368,44 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
             let b = &sv.vertex_boxes[v];
             ([b[0], b[1], b[2]], [b[3], b[4], b[5]])
         };
+        // PERF: the closure only stages the pair; the batch cull runs in the dispatched body
+        // (a closure may be compiled without the backend's target features).
+        let pending = &mut staged.vertex_triangles;
         candidates.vertices_vs_triangles(
             simd,
             sv.tree().vert_run(x),
             vertex_box,
             &tris,
             counters,
-            |v, t| {
-                let (x0, x1) = vertex_face_points(sv, v, st, t);
+            |v, t| pending.push((v as u32, t as u32)),
+        );
+        let mut from = 0;
+        while from < staged.vertex_triangles.len() {
+            let n = (staged.vertex_triangles.len() - from).min(MAX_PAIRS);
+            let chunk = &staged.vertex_triangles[from..from + n];
+            for (i, &(v, t)) in chunk.iter().enumerate() {
+                let (x0, x1) = vertex_face_points(sv, v as usize, st, t as usize);
+                staged.points.set(i, &x0, &x1);
+            }
+            let apart = self.batch_apart(simd, &staged.points, n, true);
+            for (i, &(v, t)) in chunk.iter().enumerate() {
+                let (x0, x1) = staged.points.get(i);
                 if let Some(l) = list.as_deref_mut() {
                     if self.may_reach_gap(true, &x0, &x1) {
-                        l.push([v as u32, t as u32]);
+                        l.push([v, t]);
                     }
+                }
+                if apart & (1 << i) != 0 {
+                    continue;
                 }
                 if let Some(toi) = self.pair_toi(true, &x0, &x1) {
                     self.found(toi);
-                    emit(v, t, toi);
+                    emit(v as usize, t as usize, toi);
                 }
-            },
-        );
+            }
+            from += n;
+        }
+        staged.vertex_triangles.clear();
     }
 
     /// The own edges of leaf `x` of A against those of leaf `y` of B (a leaf with itself:
@@ -1376,33 +1420,68 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         x: usize,
         y: usize,
         counters: &mut Counters,
+        staged: &mut Staged,
         mut list: Option<&mut Vec<[[u32; 2]; 2]>>,
         out: &mut Vec<EdgeImpact>,
     ) {
         let (sa, sb) = (self.a, self.b);
         let (a, b) = (sa.edges(x), sb.edges(y));
         let same_leaf = self.self_query && x == y;
+        // PERF: staged, as in `vertices_vs_triangles`.
+        let pending = &mut staged.edges;
         candidates.edges_vs_edges(simd, &a, &b, same_leaf, counters, |ex, ey| {
-            // `ex` is of A (or, in a self query, of the one mesh), `ey` of B; the exact test
-            // takes the edges in the reported order.
-            let (x0, x1) = edge_edge_points(sa, ex.internal, sb, ey.internal);
-            if let Some(l) = list.as_deref_mut() {
-                if self.may_reach_gap(false, &x0, &x1) {
-                    l.push([ex.internal, ey.internal]);
+            pending.push((ex, ey));
+        });
+        let mut from = 0;
+        while from < staged.edges.len() {
+            let n = (staged.edges.len() - from).min(MAX_PAIRS);
+            let chunk = &staged.edges[from..from + n];
+            for (i, (ex, ey)) in chunk.iter().enumerate() {
+                // `ex` is of A (or, in a self query, of the one mesh), `ey` of B; the exact
+                // test takes the edges in the reported order.
+                let (x0, x1) = edge_edge_points(sa, ex.internal, sb, ey.internal);
+                staged.points.set(i, &x0, &x1);
+            }
+            let apart = self.batch_apart(simd, &staged.points, n, false);
+            for (i, (ex, ey)) in chunk.iter().enumerate() {
+                let (x0, x1) = staged.points.get(i);
+                if let Some(l) = list.as_deref_mut() {
+                    if self.may_reach_gap(false, &x0, &x1) {
+                        l.push([ex.internal, ey.internal]);
+                    }
+                }
+                if apart & (1 << i) != 0 {
+                    continue;
+                }
+                if let Some(toi) = self.pair_toi(false, &x0, &x1) {
+                    self.found(toi);
+                    self.budget.push(
+                        out,
+                        EdgeImpact {
+                            a: ex.ids,
+                            b: ey.ids,
+                            toi,
+                        },
+                    );
                 }
             }
-            if let Some(toi) = self.pair_toi(false, &x0, &x1) {
-                self.found(toi);
-                self.budget.push(
-                    out,
-                    EdgeImpact {
-                        a: ex.ids,
-                        b: ey.ids,
-                        toi,
-                    },
-                );
-            }
-        });
+            from += n;
+        }
+        staged.edges.clear();
+    }
+
+    /// The staged pairs (the first `n` of `points`) certainly farther than the minimum
+    /// distance apart over `[0, t_max]`, `t_max` the query's now (in earliest mode the best
+    /// time so far plus the slack; it only decreases, so the pairs are apart up to any later
+    /// `t_max` too): the exact test would find no contact in them. None under the step
+    /// size's per-pair minimum distances.
+    #[inline(always)]
+    fn batch_apart<S: Simd>(&self, simd: S, points: &MovingPoints, n: usize, vf: bool) -> u64 {
+        if self.gap.is_some() {
+            return 0;
+        }
+        let (delta, t_end) = (self.options.min_distance, self.options_now().t_max);
+        centroids_apart_with(simd, points, n, vf, delta, self.magnitude, t_end)
     }
 }
 
