@@ -45,7 +45,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{CandidateEdge, Candidates, FeatureBox, LeafEdges, LeafTriangles};
+use super::features::{parts, CandidateEdge, Candidates, FeatureBox, LeafEdges, LeafTriangles};
 use crate::bv::swept::{f32_down, f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
@@ -1370,42 +1370,39 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         };
         // PERF: the closure only stages the pair; the batch cull runs in the dispatched body
         // (a closure may be compiled without the backend's target features).
-        let pending = &mut staged.vertex_triangles;
-        candidates.vertices_vs_triangles(
-            simd,
-            sv.tree().vert_run(x),
-            vertex_box,
-            &tris,
-            counters,
-            |v, t| pending.push((v as u32, t as u32)),
-        );
-        let mut from = 0;
-        while from < staged.vertex_triangles.len() {
-            let n = (staged.vertex_triangles.len() - from).min(MAX_PAIRS);
-            let chunk = &staged.vertex_triangles[from..from + n];
-            for (i, &(v, t)) in chunk.iter().enumerate() {
-                let (x0, x1) = vertex_face_points(sv, v as usize, st, t as usize);
-                staged.points.set(i, &x0, &x1);
-            }
-            let apart = self.batch_apart(simd, &staged.points, n, true);
-            for (i, &(v, t)) in chunk.iter().enumerate() {
-                let (x0, x1) = staged.points.get(i);
-                if let Some(l) = list.as_deref_mut() {
-                    if self.may_reach_gap(true, &x0, &x1) {
-                        l.push([v, t]);
+        for part in parts(sv.tree().vert_run(x), tris.len) {
+            let pending = &mut staged.vertex_triangles;
+            candidates.vertices_vs_triangles(simd, part, vertex_box, &tris, counters, |v, t| {
+                pending.push((v as u32, t as u32))
+            });
+            let mut from = 0;
+            while from < staged.vertex_triangles.len() {
+                let n = (staged.vertex_triangles.len() - from).min(MAX_PAIRS);
+                let chunk = &staged.vertex_triangles[from..from + n];
+                for (i, &(v, t)) in chunk.iter().enumerate() {
+                    let (x0, x1) = vertex_face_points(sv, v as usize, st, t as usize);
+                    staged.points.set(i, &x0, &x1);
+                }
+                let apart = self.batch_apart(simd, &staged.points, n, true);
+                for (i, &(v, t)) in chunk.iter().enumerate() {
+                    let (x0, x1) = staged.points.get(i);
+                    if let Some(l) = list.as_deref_mut() {
+                        if self.may_reach_gap(true, &x0, &x1) {
+                            l.push([v, t]);
+                        }
+                    }
+                    if apart & (1 << i) != 0 {
+                        continue;
+                    }
+                    if let Some(toi) = self.pair_toi(true, &x0, &x1) {
+                        self.found(toi);
+                        emit(v as usize, t as usize, toi);
                     }
                 }
-                if apart & (1 << i) != 0 {
-                    continue;
-                }
-                if let Some(toi) = self.pair_toi(true, &x0, &x1) {
-                    self.found(toi);
-                    emit(v as usize, t as usize, toi);
-                }
+                from += n;
             }
-            from += n;
+            staged.vertex_triangles.clear();
         }
-        staged.vertex_triangles.clear();
     }
 
     /// The own edges of leaf `x` of A against those of leaf `y` of B (a leaf with itself:
@@ -1428,46 +1425,48 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         let (a, b) = (sa.edges(x), sb.edges(y));
         let same_leaf = self.self_query && x == y;
         // PERF: staged, as in `vertices_vs_triangles`.
-        let pending = &mut staged.edges;
-        candidates.edges_vs_edges(simd, &a, &b, same_leaf, counters, |ex, ey| {
-            pending.push((ex, ey));
-        });
-        let mut from = 0;
-        while from < staged.edges.len() {
-            let n = (staged.edges.len() - from).min(MAX_PAIRS);
-            let chunk = &staged.edges[from..from + n];
-            for (i, (ex, ey)) in chunk.iter().enumerate() {
-                // `ex` is of A (or, in a self query, of the one mesh), `ey` of B; the exact
-                // test takes the edges in the reported order.
-                let (x0, x1) = edge_edge_points(sa, ex.internal, sb, ey.internal);
-                staged.points.set(i, &x0, &x1);
-            }
-            let apart = self.batch_apart(simd, &staged.points, n, false);
-            for (i, (ex, ey)) in chunk.iter().enumerate() {
-                let (x0, x1) = staged.points.get(i);
-                if let Some(l) = list.as_deref_mut() {
-                    if self.may_reach_gap(false, &x0, &x1) {
-                        l.push([ex.internal, ey.internal]);
+        for part in parts(0..a.edges.len(), b.edges.len()) {
+            let pending = &mut staged.edges;
+            candidates.edges_vs_edges(simd, &a, part, &b, same_leaf, counters, |ex, ey| {
+                pending.push((ex, ey));
+            });
+            let mut from = 0;
+            while from < staged.edges.len() {
+                let n = (staged.edges.len() - from).min(MAX_PAIRS);
+                let chunk = &staged.edges[from..from + n];
+                for (i, (ex, ey)) in chunk.iter().enumerate() {
+                    // `ex` is of A (or, in a self query, of the one mesh), `ey` of B; the exact
+                    // test takes the edges in the reported order.
+                    let (x0, x1) = edge_edge_points(sa, ex.internal, sb, ey.internal);
+                    staged.points.set(i, &x0, &x1);
+                }
+                let apart = self.batch_apart(simd, &staged.points, n, false);
+                for (i, (ex, ey)) in chunk.iter().enumerate() {
+                    let (x0, x1) = staged.points.get(i);
+                    if let Some(l) = list.as_deref_mut() {
+                        if self.may_reach_gap(false, &x0, &x1) {
+                            l.push([ex.internal, ey.internal]);
+                        }
+                    }
+                    if apart & (1 << i) != 0 {
+                        continue;
+                    }
+                    if let Some(toi) = self.pair_toi(false, &x0, &x1) {
+                        self.found(toi);
+                        self.budget.push(
+                            out,
+                            EdgeImpact {
+                                a: ex.ids,
+                                b: ey.ids,
+                                toi,
+                            },
+                        );
                     }
                 }
-                if apart & (1 << i) != 0 {
-                    continue;
-                }
-                if let Some(toi) = self.pair_toi(false, &x0, &x1) {
-                    self.found(toi);
-                    self.budget.push(
-                        out,
-                        EdgeImpact {
-                            a: ex.ids,
-                            b: ey.ids,
-                            toi,
-                        },
-                    );
-                }
+                from += n;
             }
-            from += n;
+            staged.edges.clear();
         }
-        staged.edges.clear();
     }
 
     /// The staged pairs (the first `n` of `points`) certainly farther than the minimum

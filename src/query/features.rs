@@ -22,6 +22,22 @@ use dhcd_kernels::overlap::{boxes_meet_from, BoxRows, MAX_BOX_ROW};
 
 pub(crate) type FeatureBox = ([f32; 3], [f32; 3]);
 
+/// The most candidates of one kind the queries stage at once for their batch filters
+/// (`dhcd_kernels::apart`): a leaf pair whose features could give more (vertices times
+/// triangles, edges times edges) is enumerated in parts of the first leaf's features
+/// ([`parts`]), so the scratch stays bounded however large the leaves (a fixed-depth tree's
+/// leaves may hold thousands of triangles). Pairs of default leaves (64 triangles) are one
+/// part.
+pub(crate) const MAX_STAGED: usize = 1 << 16;
+
+/// `range` in consecutive parts, each of at most `MAX_STAGED / per` items (at least one): the
+/// parts of a leaf's features whose candidates, at most `per` each, can be staged together.
+pub(crate) fn parts(range: Range<usize>, per: usize) -> impl Iterator<Item = Range<usize>> {
+    let step = (MAX_STAGED / per.max(1)).max(1);
+    let end = range.end;
+    range.step_by(step).map(move |s| s..(s + step).min(end))
+}
+
 /// The union of the first `n` boxes of `rows` (empty: `+inf..-inf`).
 // PERF: vector min / max on the dispatched backend; a fold of `f32::min` stayed scalar (4-6%
 // of a proximity query). Boxes hold no NaN, so the vector min is `f32::min`.
@@ -199,16 +215,18 @@ impl Candidates<'_> {
         }
     }
 
-    /// The own edges `a` of one leaf against `b` of another (`same_leaf`: the same leaf of
-    /// a self query, each unordered pair once): `decide(x, y)` for every pair whose grown
-    /// boxes meet, but edges sharing a vertex in a self query; each counted in
+    /// The own edges `a[within]` of one leaf against `b` of another (`same_leaf`: the same
+    /// leaf of a self query, each unordered pair once): `decide(x, y)` for every pair whose
+    /// grown boxes meet, but edges sharing a vertex in a self query; each counted in
     /// `prim_tests`. `x` is `a`'s edge and `y` `b`'s, but in a self query the edge with the
     /// smaller original indices comes first (both sides are then one mesh).
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn edges_vs_edges<S: Simd>(
         &self,
         simd: S,
         a: &LeafEdges<'_>,
+        within: Range<usize>,
         b: &LeafEdges<'_>,
         same_leaf: bool,
         counters: &mut Counters,
@@ -217,8 +235,8 @@ impl Candidates<'_> {
         let (ea, eb) = (a.edges, b.edges);
         let (ra, rb) = (&a.rows, &b.rows);
         let near = grown(&union_of(simd, rb, eb.len()), self.margin);
-        for base_a in (0..ea.len()).step_by(MAX_BOX_ROW) {
-            let mut near_bits = meeting(simd, &near, ra, base_a, ea.len());
+        for base_a in within.clone().step_by(MAX_BOX_ROW) {
+            let mut near_bits = meeting(simd, &near, ra, base_a, within.end);
             while near_bits != 0 {
                 let i = base_a + near_bits.trailing_zeros() as usize;
                 near_bits &= near_bits - 1;

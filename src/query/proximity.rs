@@ -18,7 +18,7 @@ use pulp::Simd;
 
 use dhcd_kernels::apart::{point_triangles_apart_with, segments_apart_with, FourPoints, MAX_PAIRS};
 
-use super::features::{points_box, CandidateEdge, Candidates, LeafEdges, LeafTriangles};
+use super::features::{parts, points_box, CandidateEdge, Candidates, LeafEdges, LeafTriangles};
 use super::{LeafAction, NodeTest, Posed, PosedQuery, Within};
 use crate::bv::BoundingVolume;
 use crate::control::Budget;
@@ -420,47 +420,45 @@ impl Features<'_, '_> {
             corners: tt.triangles(),
         };
         let (p, rounded) = (lv.h.points(), lv.h.is_rounded());
-        let vertex_box = |v: usize| points_box([p.get(v)], rounded);
         // PERF: the closure only stages the pair; the filter runs in the dispatched body
         // (see `edges_vs_edges`).
-        let staged = &mut batch.vertex_triangles;
-        candidates.vertices_vs_triangles(
-            simd,
-            tv.vert_run(lv.node),
-            vertex_box,
-            &tris,
-            counters,
-            |v, t| staged.push((v as u32, t as u32)),
-        );
-        let at = |c: u32| lt.h.position_f64(c as usize);
-        let mut from = 0;
-        while from < batch.vertex_triangles.len() {
-            let n = (batch.vertex_triangles.len() - from).min(MAX_PAIRS);
-            for i in 0..n {
-                let (v, t) = batch.vertex_triangles[from + i];
-                let [c0, c1, c2] = tris.corners[t as usize];
-                let pv = lv.h.position_f64(v as usize);
-                batch.points.set(i, [pv, at(c0), at(c1), at(c2)]);
-            }
-            let apart = point_triangles_apart_with(simd, &batch.points, n, self.d);
-            for (i, &(v, t)) in batch.vertex_triangles[from..from + n].iter().enumerate() {
-                if apart & (1 << i) != 0 {
-                    continue;
+        for part in parts(tv.vert_run(lv.node), tris.len) {
+            let vertex_box = |v: usize| points_box([p.get(v)], rounded);
+            let staged = &mut batch.vertex_triangles;
+            candidates.vertices_vs_triangles(simd, part, vertex_box, &tris, counters, |v, t| {
+                staged.push((v as u32, t as u32))
+            });
+            let at = |c: u32| lt.h.position_f64(c as usize);
+            let mut from = 0;
+            while from < batch.vertex_triangles.len() {
+                let n = (batch.vertex_triangles.len() - from).min(MAX_PAIRS);
+                for i in 0..n {
+                    let (v, t) = batch.vertex_triangles[from + i];
+                    let [c0, c1, c2] = tris.corners[t as usize];
+                    let pv = lv.h.position_f64(v as usize);
+                    batch.points.set(i, [pv, at(c0), at(c1), at(c2)]);
                 }
-                let [pv, t0, t1, t2] = batch.points.get(i);
-                if let Some((d2, kind)) = distance::point_triangle_within(pv, [t0, t1, t2], self.d)
-                {
-                    emit(
-                        tv.vert_order()[v as usize],
-                        tt.tri_order()[t as usize],
-                        d2,
-                        kind,
-                    );
+                let apart = point_triangles_apart_with(simd, &batch.points, n, self.d);
+                for (i, &(v, t)) in batch.vertex_triangles[from..from + n].iter().enumerate() {
+                    if apart & (1 << i) != 0 {
+                        continue;
+                    }
+                    let [pv, t0, t1, t2] = batch.points.get(i);
+                    if let Some((d2, kind)) =
+                        distance::point_triangle_within(pv, [t0, t1, t2], self.d)
+                    {
+                        emit(
+                            tv.vert_order()[v as usize],
+                            tt.tri_order()[t as usize],
+                            d2,
+                            kind,
+                        );
+                    }
                 }
+                from += n;
             }
-            from += n;
+            batch.vertex_triangles.clear();
         }
-        batch.vertex_triangles.clear();
     }
 
     /// The own edges of leaf `la` against those of `lb` (a leaf with itself: each unordered
@@ -482,46 +480,48 @@ impl Features<'_, '_> {
         // PERF: the closure only stages the pair; the filter runs here, in the dispatched
         // body (a closure may be compiled without the backend's target features, and then
         // every SIMD operation is a call).
-        candidates.edges_vs_edges(simd, &a, &b, same_leaf, counters, |x, y| {
-            batch.edges.push((x, y));
-        });
-        let (pa, pb) = (
-            |v: u32| la.h.position_f64(v as usize),
-            |v: u32| lb.h.position_f64(v as usize),
-        );
-        let mut from = 0;
-        while from < batch.edges.len() {
-            let n = (batch.edges.len() - from).min(MAX_PAIRS);
-            for i in 0..n {
-                // `x` is of `la` (or, in a self query, of the one mesh), `y` of `lb`; the
-                // exact test takes the endpoints in the reported order, so its type names
-                // them so.
-                // PERF: one load per endpoint, not `map` over the edges: copies of the
-                // points through the stack stalled on store forwarding.
-                let (x, y) = batch.edges[from + i];
-                let ([x0, x1], [y0, y1]) = (x.internal, y.internal);
-                batch.points.set(i, [pa(x0), pa(x1), pb(y0), pb(y1)]);
-            }
-            let apart = segments_apart_with(simd, &batch.points, n, self.d);
-            for (i, &(x, y)) in batch.edges[from..from + n].iter().enumerate() {
-                if apart & (1 << i) != 0 {
-                    continue;
+        for part in parts(0..a.edges.len(), b.edges.len()) {
+            candidates.edges_vs_edges(simd, &a, part, &b, same_leaf, counters, |x, y| {
+                batch.edges.push((x, y));
+            });
+            let (pa, pb) = (
+                |v: u32| la.h.position_f64(v as usize),
+                |v: u32| lb.h.position_f64(v as usize),
+            );
+            let mut from = 0;
+            while from < batch.edges.len() {
+                let n = (batch.edges.len() - from).min(MAX_PAIRS);
+                for i in 0..n {
+                    // `x` is of `la` (or, in a self query, of the one mesh), `y` of `lb`; the
+                    // exact test takes the endpoints in the reported order, so its type names
+                    // them so.
+                    // PERF: one load per endpoint, not `map` over the edges: copies of the
+                    // points through the stack stalled on store forwarding.
+                    let (x, y) = batch.edges[from + i];
+                    let ([x0, x1], [y0, y1]) = (x.internal, y.internal);
+                    batch.points.set(i, [pa(x0), pa(x1), pb(y0), pb(y1)]);
                 }
-                let [a0, a1, b0, b1] = batch.points.get(i);
-                if let Some((d2, kind)) = distance::edge_edge_within(a0, a1, b0, b1, self.d) {
-                    self.budget.push(
-                        out,
-                        EdgePair {
-                            a: x.ids,
-                            b: y.ids,
-                            distance_sq: d2,
-                            kind,
-                        },
-                    );
+                let apart = segments_apart_with(simd, &batch.points, n, self.d);
+                for (i, &(x, y)) in batch.edges[from..from + n].iter().enumerate() {
+                    if apart & (1 << i) != 0 {
+                        continue;
+                    }
+                    let [a0, a1, b0, b1] = batch.points.get(i);
+                    if let Some((d2, kind)) = distance::edge_edge_within(a0, a1, b0, b1, self.d) {
+                        self.budget.push(
+                            out,
+                            EdgePair {
+                                a: x.ids,
+                                b: y.ids,
+                                distance_sq: d2,
+                                kind,
+                            },
+                        );
+                    }
                 }
+                from += n;
             }
-            from += n;
+            batch.edges.clear();
         }
-        batch.edges.clear();
     }
 }
