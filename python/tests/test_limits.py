@@ -85,7 +85,10 @@ def test_results_over_the_limit_raise_and_the_limit_can_be_lifted():
 
 
 def interrupt_after(seconds):
-    """Sends SIGINT to this process after `seconds`, from another thread."""
+    """Sends SIGINT to this process after `seconds`, from another thread. Python's own
+    handler is installed first: a process started in the background by a non-interactive
+    shell inherits SIGINT ignored, and Python then installs none (no KeyboardInterrupt)."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
     def send():
         time.sleep(seconds)
