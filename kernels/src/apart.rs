@@ -49,6 +49,7 @@
 use pulp::Simd;
 
 use crate::lanes::mask_bits_f64;
+use crate::narrow::low_bits;
 
 /// The largest batch: one bit of the result per pair.
 pub const MAX_PAIRS: usize = 64;
@@ -170,12 +171,7 @@ fn apart_with<S: Simd, P: Pairs>(simd: S, pairs: &FourPoints, n: usize, d: f64) 
     let mut base = 0;
     while base < n {
         let hit = P::lanes(simd, &c, pairs, base);
-        let valid = if n - base >= 64 {
-            u64::MAX
-        } else {
-            (1u64 << (n - base)) - 1
-        };
-        bits |= (u64::from(mask_bits_f64(simd, hit)) & valid) << base;
+        bits |= (u64::from(mask_bits_f64(simd, hit)) & low_bits(n - base)) << base;
         base += S::F64_LANES;
     }
     bits
@@ -198,6 +194,17 @@ struct Constants<V> {
 fn row<S: Simd>(pairs: &FourPoints, k: usize, base: usize) -> S::f64s {
     let (head, _) = S::as_simd_f64s(&pairs.rows[k][base..base + S::F64_LANES]);
     head[0]
+}
+
+/// The four points of the pairs in lanes `base..`.
+#[inline(always)]
+fn points<S: Simd>(pairs: &FourPoints, base: usize) -> [[S::f64s; 3]; 4] {
+    [
+        point::<S>(pairs, 0, base),
+        point::<S>(pairs, 1, base),
+        point::<S>(pairs, 2, base),
+        point::<S>(pairs, 3, base),
+    ]
 }
 
 /// Point `e` (0..4) of the pairs in lanes `base..`.
@@ -243,12 +250,7 @@ fn segments_apart_lanes<S: Simd>(
     pairs: &FourPoints,
     base: usize,
 ) -> S::m64s {
-    let (a0, a1, b0, b1) = (
-        point::<S>(pairs, 0, base),
-        point::<S>(pairs, 1, base),
-        point::<S>(pairs, 2, base),
-        point::<S>(pairs, 3, base),
-    );
+    let [a0, a1, b0, b1] = points::<S>(pairs, base);
     // The certified part reads r, s, v (module doc); u only steers the direction.
     let r = sub3(simd, &a0, &b0);
     let s = sub3(simd, &a1, &b0);
@@ -300,12 +302,7 @@ fn point_triangles_apart_lanes<S: Simd>(
     pairs: &FourPoints,
     base: usize,
 ) -> S::m64s {
-    let (p, t0, t1, t2) = (
-        point::<S>(pairs, 0, base),
-        point::<S>(pairs, 1, base),
-        point::<S>(pairs, 2, base),
-        point::<S>(pairs, 3, base),
-    );
+    let [p, t0, t1, t2] = points::<S>(pairs, base);
     // The certified part reads r, e0, e1 (module doc); f only steers the direction.
     let r = sub3(simd, &p, &t0);
     let e0 = sub3(simd, &t1, &t0);
@@ -487,6 +484,17 @@ pub(crate) const AXIS_HIGH: f64 = power_of_two(400);
 /// that follow) above the exact `|c|`.
 pub(crate) const LENGTH_UP: f64 = 1.0 + power_of_two(-46);
 
+/// Whether the moving filter can certify anything for these inputs (the ranges of
+/// [`centroids_apart_with`]).
+#[inline(always)]
+pub(crate) fn moving_in_range(delta: f64, m: f64, t_end: f64) -> bool {
+    (AXIS_LOW..=AXIS_HIGH).contains(&m)
+        && delta.is_finite()
+        && delta >= 0.0
+        && t_end > 0.0
+        && t_end <= 1.0
+}
+
 /// The bits of the first `n` moving pairs of `pairs` (`n <= MAX_PAIRS`; `vertex_face`: each
 /// is a vertex and a triangle, else two edges) certainly farther than `delta` apart at every
 /// time of `[0, t_end]` (`t_end` in `(0, 1]`; the pose at `t_end` interpolated as
@@ -513,12 +521,7 @@ pub fn centroids_apart_with<S: Simd>(
     t_end: f64,
 ) -> u64 {
     assert!(n <= MAX_PAIRS, "at most MAX_PAIRS pairs");
-    let valid = (AXIS_LOW..=AXIS_HIGH).contains(&m)
-        && delta.is_finite()
-        && delta >= 0.0
-        && t_end > 0.0
-        && t_end <= 1.0;
-    if !valid {
+    if !moving_in_range(delta, m, t_end) {
         return 0;
     }
     let c = AxisConstants {
@@ -540,12 +543,7 @@ pub fn centroids_apart_with<S: Simd>(
         } else {
             moving_lanes::<S, false>(simd, &c, pairs, base, t_end < 1.0, delta > 0.0)
         };
-        let valid = if n - base >= 64 {
-            u64::MAX
-        } else {
-            (1u64 << (n - base)) - 1
-        };
-        bits |= (u64::from(mask_bits_f64(simd, hit)) & valid) << base;
+        bits |= (u64::from(mask_bits_f64(simd, hit)) & low_bits(n - base)) << base;
         base += S::F64_LANES;
     }
     bits

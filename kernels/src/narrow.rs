@@ -649,7 +649,7 @@ pub(crate) fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[Row]) {
 
 /// The low `n` bits set (`n <= 64`).
 #[inline(always)]
-fn low_bits(n: usize) -> u64 {
+pub(crate) fn low_bits(n: usize) -> u64 {
     if n >= 64 {
         u64::MAX
     } else {

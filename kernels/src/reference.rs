@@ -482,12 +482,7 @@ pub fn moving_centroids_apart(
     t_end: f64,
 ) -> bool {
     use crate::apart::{AXIS_ABS, AXIS_HIGH, AXIS_LOW, AXIS_REL, LENGTH_UP};
-    let valid = (AXIS_LOW..=AXIS_HIGH).contains(&m)
-        && delta.is_finite()
-        && delta >= 0.0
-        && t_end > 0.0
-        && t_end <= 1.0;
-    if !valid {
+    if !crate::apart::moving_in_range(delta, m, t_end) {
         return false;
     }
     let end: [[f64; 3]; 4] = if t_end < 1.0 {
