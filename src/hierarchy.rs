@@ -44,9 +44,9 @@ pub struct Hierarchy<K: BoundingVolume> {
     refit: Refit,
     /// Triangle corners and boxes in the current pose, refreshed lazily per leaf.
     tris: TriCache,
-    /// The boxes of each leaf's own edges in the current pose, refreshed lazily per leaf;
-    /// allocated by the first query on features (proximity).
-    edges: std::sync::OnceLock<EdgeCache>,
+    /// The boxes of each leaf's own edges and vertices in the current pose, refreshed lazily
+    /// per leaf; allocated by the first query on features (proximity).
+    features: std::sync::OnceLock<FeatureCache>,
     /// The positions it was built with (caller's order, as `f64`): the rest pose the
     /// contact set's mollifier thresholds are measured in.
     rest: Arc<[[f64; 3]]>,
@@ -62,21 +62,23 @@ pub(crate) struct TriCache {
     tiles: LazyTiles,
 }
 
-/// The boxes of every leaf's own edges (`tree/edges.rs`) in the current pose, refreshed
-/// lazily one leaf at a time: a leaf meets several leaves in a query on features. One group
-/// per leaf rank: six rows (min x, y, z, max x, y, z) of its own edges.
+/// The boxes of every leaf's own edges (`tree/edges.rs`) and own vertices (its vertex run) in
+/// the current pose, refreshed lazily one leaf at a time: a leaf meets several leaves in a
+/// query on features. One group per leaf rank: six rows (min x, y, z, max x, y, z) of its own
+/// edges, six of its own vertices, then the box of its edges' boxes (six entries).
 #[derive(Clone, Debug)]
-struct EdgeCache {
+struct FeatureCache {
     tiles: LazyTiles,
 }
 
-impl EdgeCache {
+impl FeatureCache {
     fn new(tree: &RegionTree) -> Self {
         let table = tree.leaf_edges();
         let mut start = 0;
-        let groups = (0..tree.leaf_count())
-            .map(|r| {
-                let n = 6 * table.of_rank(r).len();
+        // `leaves()` is in rank order.
+        let groups = (tree.leaves().enumerate())
+            .map(|(r, leaf)| {
+                let n = 6 * (table.of_rank(r).len() + tree.vert_run(leaf).len()) + 6;
                 start += n;
                 start - n..start
             })
@@ -85,6 +87,16 @@ impl EdgeCache {
             tiles: LazyTiles::new(start, groups),
         }
     }
+}
+
+/// The cached boxes of one leaf's own edges and vertices ([`Hierarchy::leaf_feature_boxes`]).
+pub(crate) struct LeafFeatureBoxes<'a> {
+    /// Its own edges' boxes (`tree/edges.rs` order).
+    pub(crate) edges: BoxRows<'a>,
+    /// The box of its own edges' boxes.
+    pub(crate) edge_bounds: ([f32; 3], [f32; 3]),
+    /// Its own vertices' boxes (its vertex run's order).
+    pub(crate) vertices: BoxRows<'a>,
 }
 
 /// The cached triangles of one leaf: the tile of its padded slots (its `len` triangles
@@ -200,7 +212,7 @@ impl<K: BoundingVolume> Hierarchy<K> {
         Ok(Self {
             rest,
             tris: TriCache::new(&tree),
-            edges: std::sync::OnceLock::new(),
+            features: std::sync::OnceLock::new(),
             tree,
             points,
             exact,
@@ -281,8 +293,8 @@ impl<K: BoundingVolume> Hierarchy<K> {
     pub(crate) fn invalidate(&mut self) {
         K::invalidate(&mut self.nodes);
         self.tris.tiles.invalidate();
-        if let Some(edges) = self.edges.get_mut() {
-            edges.tiles.invalidate();
+        if let Some(features) = self.features.get_mut() {
+            features.tiles.invalidate();
         }
     }
 
@@ -337,31 +349,59 @@ impl<K: BoundingVolume> Hierarchy<K> {
         self.tris.leaf(simd, &self.tree, &self.points, leaf)
     }
 
-    /// The closed boxes of leaf `leaf`'s own edges in the current pose (rounded outward for
-    /// an `f64` hierarchy), as six rows, computed first if stale.
+    /// The closed boxes of leaf `leaf`'s own edges and own vertices in the current pose
+    /// (rounded outward for an `f64` hierarchy), as six rows each, computed first if stale.
     #[inline]
-    pub(crate) fn leaf_edge_boxes(&self, leaf: usize) -> BoxRows<'_> {
-        let cache = self.edges.get_or_init(|| EdgeCache::new(&self.tree));
+    pub(crate) fn leaf_feature_boxes(&self, leaf: usize) -> LeafFeatureBoxes<'_> {
+        let cache = self.features.get_or_init(|| FeatureCache::new(&self.tree));
         let r = self.tree.leaf_rank(leaf).expect("a leaf");
         let edges = self.tree.leaf_edges().of_rank(r);
-        let n = edges.len();
+        let vertices = self.tree.vert_run(leaf);
+        let (ne, nv) = (edges.len(), vertices.len());
         let p = &self.points;
-        let (tile, _) = cache.tiles.get_or_fill(r, |rows| {
+        let rounded = p.is_rounded();
+        let outward = |lo: f32, hi: f32| {
+            if rounded {
+                (lo.next_down(), hi.next_up())
+            } else {
+                (lo, hi)
+            }
+        };
+        let (tile, _) = cache.tiles.get_or_fill(r, |tile| {
+            let (edge_rows, rest) = tile.split_at_mut(6 * ne);
+            let (vertex_rows, bounds) = rest.split_at_mut(6 * nv);
+            let (mut least, mut most) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
             for (i, &[u, v]) in edges.iter().enumerate() {
                 let (a, b) = (p.get(u as usize), p.get(v as usize));
                 for k in 0..3 {
-                    let (lo, hi) = (a[k].min(b[k]), a[k].max(b[k]));
-                    let (lo, hi) = if p.is_rounded() {
-                        (lo.next_down(), hi.next_up())
-                    } else {
-                        (lo, hi)
-                    };
-                    rows[k * n + i] = lo;
-                    rows[(3 + k) * n + i] = hi;
+                    let (lo, hi) = outward(a[k].min(b[k]), a[k].max(b[k]));
+                    edge_rows[k * ne + i] = lo;
+                    edge_rows[(3 + k) * ne + i] = hi;
+                    least[k] = least[k].min(lo);
+                    most[k] = most[k].max(hi);
+                }
+            }
+            bounds[..3].copy_from_slice(&least);
+            bounds[3..].copy_from_slice(&most);
+            for (i, v) in vertices.clone().enumerate() {
+                let a = p.get(v);
+                for k in 0..3 {
+                    let (lo, hi) = outward(a[k], a[k]);
+                    vertex_rows[k * nv + i] = lo;
+                    vertex_rows[(3 + k) * nv + i] = hi;
                 }
             }
         });
-        std::array::from_fn(|f| &tile[f * n..(f + 1) * n])
+        let (edge_rows, rest) = tile.split_at(6 * ne);
+        let (vertex_rows, bounds) = rest.split_at(6 * nv);
+        LeafFeatureBoxes {
+            edges: std::array::from_fn(|f| &edge_rows[f * ne..(f + 1) * ne]),
+            edge_bounds: (
+                [bounds[0], bounds[1], bounds[2]],
+                [bounds[3], bounds[4], bounds[5]],
+            ),
+            vertices: std::array::from_fn(|f| &vertex_rows[f * nv..(f + 1) * nv]),
+        }
     }
 
     /// Checks that every fitted node's volume encloses every vertex of its region in the

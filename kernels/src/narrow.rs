@@ -216,6 +216,12 @@ impl<'a> TriSoa<'a> {
         }
     }
 
+    /// The box given by [`TriSoa::with_bounds`] (a group's union box), if any.
+    #[inline(always)]
+    pub fn bounds(&self) -> Option<Bounds> {
+        self.bounds
+    }
+
     /// Coordinate `k` of corner `c`.
     #[inline(always)]
     pub fn corner(&self, c: usize, k: usize) -> &'a [f32] {

@@ -45,7 +45,9 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use pulp::Simd;
 
-use super::features::{parts, CandidateEdge, Candidates, FeatureBox, LeafEdges, LeafTriangles};
+use super::features::{
+    bounds_of, parts, CandidateEdge, Candidates, FeatureBox, LeafEdges, LeafTriangles, LeafVertices,
+};
 use crate::bv::swept::{f32_down, f32_up, Step};
 use crate::bv::BoundingVolume;
 use crate::ccd::{self, CcdOptions, TOI_TOLERANCE};
@@ -287,13 +289,16 @@ pub(crate) struct Swept<'h, K: BoundingVolume> {
     /// ([`ccd::pair_until`]).
     magnitude: f64,
     bounds: K::Swept,
-    /// Each vertex's box over the culling positions ([`vertex_boxes`]): `[lo xyz, hi xyz]`.
-    vertex_boxes: Vec<[f32; 6]>,
+    /// Each vertex's box over the culling positions ([`vertex_boxes`]), as six rows.
+    vertex_rows: [Vec<f32>; 6],
     tri_rows: [Vec<f32>; 6],
     edge_rows: [Vec<f32>; 6],
     /// Per node (filled for leaves): the box of its triangles' corners and its own vertices,
     /// at t0 and at t1.
     leaf_ends: Vec<[FeatureBox; 2]>,
+    /// Per node (filled for leaves): the box of its triangles' boxes and that of its own
+    /// edges' boxes, over the culling positions.
+    leaf_bounds: Vec<[FeatureBox; 2]>,
 }
 
 /// A bound on how far a position at a time `by` of `steps`, computed in `f64` as `x0 + by
@@ -452,7 +457,9 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         let tri_rows = box_rows(tree.triangles().iter().copied(), &boxes);
         let edge_rows = box_rows(tree.leaf_edges().all().iter().copied(), &boxes);
         let triangles = tree.triangles();
+        let vertex_rows = std::array::from_fn(|f| boxes.iter().map(|b| b[f]).collect());
         let mut ends = Vec::with_capacity(tree.node_count());
+        let mut leaf_bounds = Vec::with_capacity(tree.node_count());
         for n in 0..tree.node_count() {
             // An empty box stays `+inf..-inf`.
             let mut lo = [[f32::INFINITY; 3]; 2];
@@ -471,6 +478,17 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
                 }
             }
             ends.push([0, 1].map(|e| (lo[e], hi[e])));
+            let of = |rows: &[Vec<f32>; 6], r: std::ops::Range<usize>| {
+                let rows: BoxRows<'_> = std::array::from_fn(|f| &rows[f][r.clone()]);
+                bounds_of(&rows, r.len())
+            };
+            leaf_bounds.push(match tree.leaf_rank(n) {
+                Some(rank) => [
+                    of(&tri_rows, tree.tri_range(n)),
+                    of(&edge_rows, tree.leaf_edges().range_of_rank(rank)),
+                ],
+                None => [([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]); 2],
+            });
         }
         Self {
             h,
@@ -480,10 +498,11 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
             horizon: 1.0,
             horizon_error: 0.0,
             magnitude,
-            vertex_boxes: boxes,
+            vertex_rows,
             tri_rows,
             edge_rows,
             leaf_ends: ends,
+            leaf_bounds,
         }
     }
 
@@ -511,7 +530,17 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         LeafEdges {
             edges: edges.of_rank(rank),
             rows: std::array::from_fn(|f| &self.edge_rows[f][r.clone()]),
+            bounds: self.leaf_bounds[leaf][1],
             order: tree.vert_order(),
+        }
+    }
+
+    /// Leaf `leaf`'s own vertices and their boxes over the step, as candidates.
+    fn vertices(&self, leaf: usize) -> LeafVertices<'_> {
+        let r = self.tree().vert_run(leaf);
+        LeafVertices {
+            rows: std::array::from_fn(|f| &self.vertex_rows[f][r.clone()]),
+            first: r.start,
         }
     }
 }
@@ -1361,18 +1390,16 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         let tris = LeafTriangles {
             len: rows[0].len(),
             rows,
+            bounds: st.leaf_bounds[y][0],
             first: st.tree().tri_range(y).start,
             corners: st.tree().triangles(),
         };
-        let vertex_box = |v: usize| {
-            let b = &sv.vertex_boxes[v];
-            ([b[0], b[1], b[2]], [b[3], b[4], b[5]])
-        };
+        let vertices = sv.vertices(x);
         // PERF: the closure only stages the pair; the batch cull runs in the dispatched body
         // (a closure may be compiled without the backend's target features).
-        for part in parts(sv.tree().vert_run(x), tris.len) {
+        for part in parts(0..vertices.rows[0].len(), tris.len) {
             let pending = &mut staged.vertex_triangles;
-            candidates.vertices_vs_triangles(simd, part, vertex_box, &tris, counters, |v, t| {
+            candidates.vertices_vs_triangles(simd, &vertices, part, &tris, counters, |v, t| {
                 pending.push((v as u32, t as u32))
             });
             let mut from = 0;

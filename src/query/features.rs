@@ -7,10 +7,12 @@
 //! triangle), so a vertex-triangle pair is met only in the leaf pair (vertex's leaf,
 //! triangle's leaf) and an edge pair only in the pair of their leaves, however many
 //! triangles share the features. Inside a leaf pair, features are culled first by the other
-//! leaf's union box grown by the query's margin, then pair by pair by their boxes grown by it
+//! leaf's bounds (a box holding all its boxes, kept with the leaf's boxes rather than computed
+//! per leaf pair) grown by the query's margin, then pair by pair by their boxes grown by it
 //! ([`Candidates`]); in a self query, pairs sharing a vertex are skipped. Boxes are `f32`,
 //! closed, rounded outward from the positions; a leaf's boxes are six rows (`lo xyz`, `hi
-//! xyz`) tested 64 at a time by [`boxes_meet_from`].
+//! xyz`) tested 64 at a time by [`boxes_meet_from`], the vertices' and edges' against the
+//! other leaf's bounds as well as each one's against the other leaf's boxes.
 
 use std::ops::Range;
 
@@ -38,66 +40,11 @@ pub(crate) fn parts(range: Range<usize>, per: usize) -> impl Iterator<Item = Ran
     range.step_by(step).map(move |s| s..(s + step).min(end))
 }
 
-/// The union of the first `n` boxes of `rows` (empty: `+inf..-inf`).
-// PERF: vector min / max on the dispatched backend; a fold of `f32::min` stayed scalar (4-6%
-// of a proximity query). Boxes hold no NaN, so the vector min is `f32::min`.
-#[inline(always)]
-fn union_of<S: Simd>(simd: S, rows: &BoxRows, n: usize) -> FeatureBox {
-    // No closures: one may be compiled without the backend's target features.
-    let lo = [
-        row_min(simd, &rows[0][..n]),
-        row_min(simd, &rows[1][..n]),
-        row_min(simd, &rows[2][..n]),
-    ];
-    let hi = [
-        row_max(simd, &rows[3][..n]),
-        row_max(simd, &rows[4][..n]),
-        row_max(simd, &rows[5][..n]),
-    ];
-    (lo, hi)
-}
-
-/// The least of `row` (`+inf` if empty).
-#[inline(always)]
-fn row_min<S: Simd>(simd: S, row: &[f32]) -> f32 {
-    let (head, tail) = S::as_simd_f32s(row);
-    let mut m = simd.splat_f32s(f32::INFINITY);
-    for &x in head {
-        m = simd.min_f32s(m, x);
-    }
-    let mut least = simd.reduce_min_f32s(m);
-    for &x in tail {
-        least = least.min(x);
-    }
-    least
-}
-
-/// The greatest of `row` (`-inf` if empty).
-#[inline(always)]
-fn row_max<S: Simd>(simd: S, row: &[f32]) -> f32 {
-    let (head, tail) = S::as_simd_f32s(row);
-    let mut m = simd.splat_f32s(f32::NEG_INFINITY);
-    for &x in head {
-        m = simd.max_f32s(m, x);
-    }
-    let mut most = simd.reduce_max_f32s(m);
-    for &x in tail {
-        most = most.max(x);
-    }
-    most
-}
-
 /// The bits of boxes `base..base + 64` of the first `n` of `rows` that meet `probe` (bit
 /// `j` for box `base + j`).
 #[inline(always)]
 fn meeting<S: Simd>(simd: S, probe: &FeatureBox, rows: &BoxRows, base: usize, n: usize) -> u64 {
     boxes_meet_from(simd, probe.0, probe.1, rows, base, n)
-}
-
-/// Whether two closed boxes meet.
-#[inline(always)]
-fn meet(a: &FeatureBox, b: &FeatureBox) -> bool {
-    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
 }
 
 /// `b` grown by `m` along every axis, rounded outward.
@@ -107,22 +54,6 @@ fn grown(b: &FeatureBox, m: f32) -> FeatureBox {
         b.0.map(|x| (x - m).next_down()),
         b.1.map(|x| (x + m).next_up()),
     )
-}
-
-/// The closed box of points `p` (`f32` values of the hierarchy's positions), widened by an
-/// ulp when they are roundings of `f64` positions, so it holds the exact points too.
-#[inline(always)]
-pub(crate) fn points_box<const N: usize>(p: [[f32; 3]; N], rounded: bool) -> FeatureBox {
-    let mut b = (p[0], p[0]);
-    for q in &p[1..] {
-        b.0 = std::array::from_fn(|k| b.0[k].min(q[k]));
-        b.1 = std::array::from_fn(|k| b.1[k].max(q[k]));
-    }
-    if rounded {
-        (b.0.map(f32::next_down), b.1.map(f32::next_up))
-    } else {
-        b
-    }
 }
 
 /// An edge (internal vertex indices) as its original indices, smaller first, and its
@@ -137,21 +68,42 @@ fn ordered_edge(order: &[u32], [s, t]: [u32; 2]) -> ([u32; 2], [u32; 2]) {
     }
 }
 
-/// A leaf's triangles as candidates: their boxes (the first `len` of six rows), the internal
-/// index of the first, and every triangle's corners (internal indices).
+/// A leaf's triangles as candidates: their boxes (the first `len` of six rows) and a box
+/// holding them all (`bounds`), the internal index of the first, and every triangle's corners
+/// (internal indices).
 pub(crate) struct LeafTriangles<'a> {
     pub(crate) rows: BoxRows<'a>,
     pub(crate) len: usize,
+    pub(crate) bounds: FeatureBox,
     pub(crate) first: usize,
     pub(crate) corners: &'a [[u32; 3]],
 }
 
-/// A leaf's own edges as candidates (internal vertex indices) with their boxes, and the
-/// internal-to-original vertex order of their mesh.
+/// A leaf's own vertices as candidates: their boxes (six rows, one entry per vertex of its
+/// run) and the internal index of the first.
+pub(crate) struct LeafVertices<'a> {
+    pub(crate) rows: BoxRows<'a>,
+    pub(crate) first: usize,
+}
+
+/// A leaf's own edges as candidates (internal vertex indices) with their boxes and a box
+/// holding them all (`bounds`), and the internal-to-original vertex order of their mesh.
 pub(crate) struct LeafEdges<'a> {
     pub(crate) edges: &'a [[u32; 2]],
     pub(crate) rows: BoxRows<'a>,
+    pub(crate) bounds: FeatureBox,
     pub(crate) order: &'a [u32],
+}
+
+/// The box of `rows`' first `n` boxes (empty: `+inf..-inf`): the bounds a leaf keeps with
+/// its boxes.
+pub(crate) fn bounds_of(rows: &BoxRows, n: usize) -> FeatureBox {
+    let least = |row: &[f32]| row[..n].iter().fold(f32::INFINITY, |m, &x| m.min(x));
+    let most = |row: &[f32]| row[..n].iter().fold(f32::NEG_INFINITY, |m, &x| m.max(x));
+    (
+        [least(rows[0]), least(rows[1]), least(rows[2])],
+        [most(rows[3]), most(rows[4]), most(rows[5])],
+    )
 }
 
 /// An edge of a candidate pair: its original vertex indices, smaller first, and its
@@ -173,9 +125,9 @@ pub(crate) struct Candidates<'c> {
 }
 
 impl Candidates<'_> {
-    /// The vertices `vertices` (internal, of one leaf; `vertex_box(v)` their boxes) against
-    /// the triangles `tris` of another (or the same) leaf: `decide(v, t)` (internal indices)
-    /// for every pair whose grown boxes meet, but a triangle containing the vertex in a self
+    /// The vertices `vertices.first + i` for `i` in `within` (of one leaf) against the
+    /// triangles `tris` of another (or the same) leaf: `decide(v, t)` (internal indices) for
+    /// every pair whose grown boxes meet, but a triangle containing the vertex in a self
     /// query; each counted in `prim_tests`.
     // PERF: mask loops, not closures around the box tests: a closure may be compiled without
     // the dispatched target features (the kernel then calls every intrinsic).
@@ -183,33 +135,39 @@ impl Candidates<'_> {
     pub(crate) fn vertices_vs_triangles<S: Simd>(
         &self,
         simd: S,
-        vertices: Range<usize>,
-        vertex_box: impl Fn(usize) -> FeatureBox,
+        vertices: &LeafVertices<'_>,
+        within: Range<usize>,
         tris: &LeafTriangles<'_>,
         counters: &mut Counters,
         mut decide: impl FnMut(usize, usize),
     ) {
-        let (rows, n) = (&tris.rows, tris.len);
-        let near = grown(&union_of(simd, rows, n), self.margin);
-        for v in vertices {
-            let vbox = vertex_box(v);
-            if !meet(&vbox, &near) {
-                continue;
-            }
-            let probe = grown(&vbox, self.margin);
-            for base in (0..n).step_by(MAX_BOX_ROW) {
-                if (self.stopped)() {
-                    return;
-                }
-                let mut bits = meeting(simd, &probe, rows, base, n);
-                while bits != 0 {
-                    let t = tris.first + base + bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    if self.self_query && tris.corners[t].contains(&(v as u32)) {
-                        continue;
+        let (rv, rows, n) = (&vertices.rows, &tris.rows, tris.len);
+        let near = grown(&tris.bounds, self.margin);
+        for base_v in within.clone().step_by(MAX_BOX_ROW) {
+            let mut near_bits = meeting(simd, &near, rv, base_v, within.end);
+            while near_bits != 0 {
+                let i = base_v + near_bits.trailing_zeros() as usize;
+                near_bits &= near_bits - 1;
+                let v = vertices.first + i;
+                let vbox = (
+                    [rv[0][i], rv[1][i], rv[2][i]],
+                    [rv[3][i], rv[4][i], rv[5][i]],
+                );
+                let probe = grown(&vbox, self.margin);
+                for base in (0..n).step_by(MAX_BOX_ROW) {
+                    if (self.stopped)() {
+                        return;
                     }
-                    counters.prim_tests += 1;
-                    decide(v, t);
+                    let mut bits = meeting(simd, &probe, rows, base, n);
+                    while bits != 0 {
+                        let t = tris.first + base + bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        if self.self_query && tris.corners[t].contains(&(v as u32)) {
+                            continue;
+                        }
+                        counters.prim_tests += 1;
+                        decide(v, t);
+                    }
                 }
             }
         }
@@ -234,7 +192,7 @@ impl Candidates<'_> {
     ) {
         let (ea, eb) = (a.edges, b.edges);
         let (ra, rb) = (&a.rows, &b.rows);
-        let near = grown(&union_of(simd, rb, eb.len()), self.margin);
+        let near = grown(&b.bounds, self.margin);
         for base_a in within.clone().step_by(MAX_BOX_ROW) {
             let mut near_bits = meeting(simd, &near, ra, base_a, within.end);
             while near_bits != 0 {

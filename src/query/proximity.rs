@@ -18,7 +18,7 @@ use pulp::Simd;
 
 use dhcd_kernels::apart::{point_triangles_apart_with, segments_apart_with, FourPoints, MAX_PAIRS};
 
-use super::features::{parts, points_box, CandidateEdge, Candidates, LeafEdges, LeafTriangles};
+use super::features::{parts, CandidateEdge, Candidates, LeafEdges, LeafTriangles, LeafVertices};
 use super::{LeafAction, NodeTest, Posed, PosedQuery, Within};
 use crate::bv::BoundingVolume;
 use crate::control::Budget;
@@ -258,12 +258,22 @@ impl<'h, K: BoundingVolume> Leaf<'h, K> {
     /// The leaf's own edges as candidates.
     fn edges(&self) -> LeafEdges<'h> {
         let tree = self.h.tree();
+        let boxes = self.h.leaf_feature_boxes(self.node);
         LeafEdges {
             edges: tree
                 .leaf_edges()
                 .of_rank(tree.leaf_rank(self.node).expect("a leaf")),
-            rows: self.h.leaf_edge_boxes(self.node),
+            rows: boxes.edges,
+            bounds: boxes.edge_bounds,
             order: tree.vert_order(),
+        }
+    }
+
+    /// The leaf's own vertices as candidates.
+    fn vertices(&self) -> LeafVertices<'h> {
+        LeafVertices {
+            rows: self.h.leaf_feature_boxes(self.node).vertices,
+            first: self.h.tree().vert_run(self.node).start,
         }
     }
 }
@@ -416,16 +426,16 @@ impl Features<'_, '_> {
                 soa.hi(2),
             ],
             len: leaf_tris.len,
+            bounds: soa.bounds().expect("a cached leaf's triangles have bounds"),
             first: tt.tri_range(lt.node).start,
             corners: tt.triangles(),
         };
-        let (p, rounded) = (lv.h.points(), lv.h.is_rounded());
+        let vertices = lv.vertices();
         // PERF: the closure only stages the pair; the filter runs in the dispatched body
         // (see `edges_vs_edges`).
-        for part in parts(tv.vert_run(lv.node), tris.len) {
-            let vertex_box = |v: usize| points_box([p.get(v)], rounded);
+        for part in parts(0..tv.vert_run(lv.node).len(), tris.len) {
             let staged = &mut batch.vertex_triangles;
-            candidates.vertices_vs_triangles(simd, part, vertex_box, &tris, counters, |v, t| {
+            candidates.vertices_vs_triangles(simd, &vertices, part, &tris, counters, |v, t| {
                 staged.push((v as u32, t as u32))
             });
             let at = |c: u32| lt.h.position_f64(c as usize);
