@@ -1173,6 +1173,19 @@ fn edge_edge_points<K: BoundingVolume>(
     )
 }
 
+/// The staged pairs `0..n` of a chunk whose points are read after the batch cull (`apart`:
+/// the pairs it ended): all of them when the walk lists (the gap rule sees every candidate),
+/// else those it left.
+#[inline(always)]
+fn pairs_to_read(apart: u64, n: usize, listing: bool) -> u64 {
+    let all = if n >= 64 { u64::MAX } else { (1u64 << n) - 1 };
+    if listing {
+        all
+    } else {
+        all & !apart
+    }
+}
+
 /// A pair's own options: the query's, or with the step-size rule its minimum distance from
 /// its distance at t0 (`None`: it cannot reach it before `t_max`).
 #[inline(always)]
@@ -1411,7 +1424,11 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                     staged.points.set(i, &x0, &x1);
                 }
                 let apart = self.batch_apart(simd, &staged.points, n, true);
-                for (i, &(v, t)) in chunk.iter().enumerate() {
+                let mut undecided = pairs_to_read(apart, n, list.is_some());
+                while undecided != 0 {
+                    let i = undecided.trailing_zeros() as usize;
+                    undecided &= undecided - 1;
+                    let (v, t) = chunk[i];
                     let (x0, x1) = staged.points.get(i);
                     if let Some(l) = list.as_deref_mut() {
                         if self.may_reach_gap(true, &x0, &x1) {
@@ -1468,7 +1485,11 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                     staged.points.set(i, &x0, &x1);
                 }
                 let apart = self.batch_apart(simd, &staged.points, n, false);
-                for (i, (ex, ey)) in chunk.iter().enumerate() {
+                let mut undecided = pairs_to_read(apart, n, list.is_some());
+                while undecided != 0 {
+                    let i = undecided.trailing_zeros() as usize;
+                    undecided &= undecided - 1;
+                    let (ex, ey) = &chunk[i];
                     let (x0, x1) = staged.points.get(i);
                     if let Some(l) = list.as_deref_mut() {
                         if self.may_reach_gap(false, &x0, &x1) {
