@@ -54,13 +54,17 @@ use crate::narrow::low_bits;
 /// The largest batch: one bit of the result per pair.
 pub const MAX_PAIRS: usize = 64;
 
+/// Twelve rows of [`MAX_PAIRS`] coordinates: row `3 i + k` holds coordinate `k` of point `i`
+/// of each pair.
+pub type PointRows = [[f64; MAX_PAIRS]; 12];
+
 /// Up to [`MAX_PAIRS`] feature pairs of four points each as twelve rows of coordinates: rows
 /// `3 i + k` hold coordinate `k` of point `i`. Segment pairs are `[a0, a1, b0, b1]`,
 /// point-triangle pairs `[p, t0, t1, t2]`.
 #[derive(Clone, Debug)]
 pub struct FourPoints {
     /// The coordinate rows.
-    pub rows: [[f64; MAX_PAIRS]; 12],
+    pub rows: PointRows,
 }
 
 impl Default for FourPoints {
@@ -127,7 +131,7 @@ pub fn point_triangles_apart_with<S: Simd>(simd: S, pairs: &FourPoints, n: usize
 // PERF: a trait, not a closure or `fn` pointer: those may be compiled without the backend's
 // target features (every SIMD operation then a call).
 trait Pairs {
-    fn lanes<S: Simd>(simd: S, c: &Constants<S::f64s>, pairs: &FourPoints, base: usize) -> S::m64s;
+    fn lanes<S: Simd>(simd: S, c: &Constants<S::f64s>, pairs: &PointRows, base: usize) -> S::m64s;
 }
 
 /// Segment pairs `[a0, a1, b0, b1]`.
@@ -135,7 +139,7 @@ struct Segments;
 
 impl Pairs for Segments {
     #[inline(always)]
-    fn lanes<S: Simd>(simd: S, c: &Constants<S::f64s>, pairs: &FourPoints, base: usize) -> S::m64s {
+    fn lanes<S: Simd>(simd: S, c: &Constants<S::f64s>, pairs: &PointRows, base: usize) -> S::m64s {
         segments_apart_lanes(simd, c, pairs, base)
     }
 }
@@ -145,7 +149,7 @@ struct PointTriangles;
 
 impl Pairs for PointTriangles {
     #[inline(always)]
-    fn lanes<S: Simd>(simd: S, c: &Constants<S::f64s>, pairs: &FourPoints, base: usize) -> S::m64s {
+    fn lanes<S: Simd>(simd: S, c: &Constants<S::f64s>, pairs: &PointRows, base: usize) -> S::m64s {
         point_triangles_apart_lanes(simd, c, pairs, base)
     }
 }
@@ -157,27 +161,19 @@ fn apart_with<S: Simd, P: Pairs>(simd: S, pairs: &FourPoints, n: usize, d: f64) 
     if !distance_in_range(d) {
         return 0;
     }
-    let c = Constants {
-        zero: simd.splat_f64s(0.0),
-        one: simd.splat_f64s(1.0),
-        dd: simd.splat_f64s(d * d),
-        gap_error: simd.splat_f64s(GAP_ERROR),
-        margin: simd.splat_f64s(SQUARE_MARGIN),
-        low: simd.splat_f64s(SCALE_LOW),
-        high: simd.splat_f64s(SCALE_HIGH),
-        direction_low: simd.splat_f64s(DIRECTION_LOW),
-    };
+    let c = Constants::new(simd, d * d);
     let mut bits = 0u64;
     let mut base = 0;
     while base < n {
-        let hit = P::lanes(simd, &c, pairs, base);
+        let hit = P::lanes(simd, &c, &pairs.rows, base);
         bits |= (u64::from(mask_bits_f64(simd, hit)) & low_bits(n - base)) << base;
         base += S::F64_LANES;
     }
     bits
 }
 
-/// The splatted constants of one batch.
+/// The splatted constants of one batch (`dd`: the distance's square, per lane).
+#[derive(Clone, Copy)]
 struct Constants<V> {
     zero: V,
     one: V,
@@ -189,16 +185,32 @@ struct Constants<V> {
     direction_low: V,
 }
 
+impl<V: Copy> Constants<V> {
+    #[inline(always)]
+    fn new<S: Simd<f64s = V>>(simd: S, dd: f64) -> Self {
+        Constants {
+            zero: simd.splat_f64s(0.0),
+            one: simd.splat_f64s(1.0),
+            dd: simd.splat_f64s(dd),
+            gap_error: simd.splat_f64s(GAP_ERROR),
+            margin: simd.splat_f64s(SQUARE_MARGIN),
+            low: simd.splat_f64s(SCALE_LOW),
+            high: simd.splat_f64s(SCALE_HIGH),
+            direction_low: simd.splat_f64s(DIRECTION_LOW),
+        }
+    }
+}
+
 /// Lanes `base..base + F64_LANES` of row `k`.
 #[inline(always)]
-fn row<S: Simd>(pairs: &FourPoints, k: usize, base: usize) -> S::f64s {
-    let (head, _) = S::as_simd_f64s(&pairs.rows[k][base..base + S::F64_LANES]);
+fn row<S: Simd>(pairs: &PointRows, k: usize, base: usize) -> S::f64s {
+    let (head, _) = S::as_simd_f64s(&pairs[k][base..base + S::F64_LANES]);
     head[0]
 }
 
 /// The four points of the pairs in lanes `base..`.
 #[inline(always)]
-fn points<S: Simd>(pairs: &FourPoints, base: usize) -> [[S::f64s; 3]; 4] {
+fn points<S: Simd>(pairs: &PointRows, base: usize) -> [[S::f64s; 3]; 4] {
     [
         point::<S>(pairs, 0, base),
         point::<S>(pairs, 1, base),
@@ -209,7 +221,7 @@ fn points<S: Simd>(pairs: &FourPoints, base: usize) -> [[S::f64s; 3]; 4] {
 
 /// Point `e` (0..4) of the pairs in lanes `base..`.
 #[inline(always)]
-fn point<S: Simd>(pairs: &FourPoints, e: usize, base: usize) -> [S::f64s; 3] {
+fn point<S: Simd>(pairs: &PointRows, e: usize, base: usize) -> [S::f64s; 3] {
     [
         row::<S>(pairs, 3 * e, base),
         row::<S>(pairs, 3 * e + 1, base),
@@ -247,7 +259,7 @@ fn unit<S: Simd>(simd: S, c: &Constants<S::f64s>, x: S::f64s) -> S::f64s {
 fn segments_apart_lanes<S: Simd>(
     simd: S,
     c: &Constants<S::f64s>,
-    pairs: &FourPoints,
+    pairs: &PointRows,
     base: usize,
 ) -> S::m64s {
     let [a0, a1, b0, b1] = points::<S>(pairs, base);
@@ -299,7 +311,7 @@ fn segments_apart_lanes<S: Simd>(
 fn point_triangles_apart_lanes<S: Simd>(
     simd: S,
     c: &Constants<S::f64s>,
-    pairs: &FourPoints,
+    pairs: &PointRows,
     base: usize,
 ) -> S::m64s {
     let [p, t0, t1, t2] = points::<S>(pairs, base);
@@ -680,4 +692,141 @@ fn moving_lanes<S: Simd, const VF: bool>(
         simd.less_than_or_equal_f64s(norm1, c.high),
     );
     simd.and_m64s(in_range, simd.or_m64s(up, down))
+}
+
+// ---------------------------------------------------------------------------------------
+// Moving pairs: apart at pose 0 by more than their relative motion can close.
+
+/// `2^-46`: the absolute part of the motion bound, per unit of `M`.
+pub(crate) const MOTION_ABS: f64 = power_of_two(-46);
+
+/// The bits of the first `n` moving pairs of `pairs` (`n <= MAX_PAIRS`; `vertex_face`: each
+/// is a vertex and a triangle, else two edges) certainly farther than `delta` apart at every
+/// time of `[0, t_end]` (`t_end` in `(0, 1]`): at pose 0 they are farther apart than `delta`
+/// plus the most their relative motion can close by `t_end`. `m` is at least every
+/// coordinate's magnitude at both poses.
+///
+/// **The motion bound.** Translating both features by a common motion changes no distance.
+/// Take the motion of the pair's first point `o` (the vertex, or `a0`): relative to it,
+/// point `i` moves by `t D_i` at time `t`, `D_i = (x1_i - x1_o) - (x0_i - x0_o)`, and every
+/// point of a feature, a convex combination of its corners, by at most `t` times the largest
+/// `|D_i|` of its corners. So the distance at `t` is at least the distance at pose 0 minus
+/// `t A`, `A = max_i |D_i|` over the triangle's corners (vertex-face), or `|D_a1| + max(|D_b0|,
+/// |D_b1|)` (edge-edge). This is the separation-at-`t0` bound of additive CCD (Li et al.
+/// 2021) used as a cull: it ends the neighbours of a sheet that slides or bends a little,
+/// which no fixed axis separates over the step.
+///
+/// **Rounding** (`u = 2^-53`). Each `D_i` component is two differences of coordinates and
+/// their difference: within `8 u M` of the exact one, so `|D_i|` is within `14 u M` of the
+/// norm of the computed vector; its computed norm (three squares, two sums, a square root)
+/// is within `2.6 u` of that norm, plus `2^-535` for squares that underflow. So `A <= s (1 +
+/// 3.7 u) + 28 u M + 2^-534`, `s` the computed sum or maximum. The kernel takes `A' = s (1 +
+/// 2^-46) + 2^-46 M` (each rounding at most `u`: `A' >= s (1 + 125 u) + 127 u M`, and `M >=
+/// 2^-400` puts `99 u M` far above `2^-534`), `d = (delta + (A' t_end)(1 + 2^-46))(1 + 2^-46)`
+/// (at least `delta + A t_end`), and certifies the pair when the static certificate of the
+/// module doc proves it farther than `d` at pose 0. A `d` outside `[2^-200, 2^200]` certifies
+/// nothing; nor do the ranges of [`centroids_apart_with`] (`m` in `[2^-400, 2^400]`, `delta`
+/// finite and `>= 0`, `t_end` in `(0, 1]`). An `A' t_end` that underflows loses at most
+/// `2^-1074`, covered by the margin on a `d >= 2^-200`.
+#[inline(always)]
+pub fn apart_beyond_motion_with<S: Simd>(
+    simd: S,
+    pairs: &MovingPoints,
+    n: usize,
+    vertex_face: bool,
+    delta: f64,
+    m: f64,
+    t_end: f64,
+) -> u64 {
+    assert!(n <= MAX_PAIRS, "at most MAX_PAIRS pairs");
+    if !moving_in_range(delta, m, t_end) {
+        return 0;
+    }
+    let start: &PointRows = pairs.rows[..12].try_into().expect("twelve rows of pose 0");
+    let c = Constants::new(simd, 0.0);
+    let motion = MotionConstants {
+        up: simd.splat_f64s(LENGTH_UP),
+        slack: simd.splat_f64s(MOTION_ABS * m),
+        t: simd.splat_f64s(t_end),
+        delta: simd.splat_f64s(delta),
+    };
+    let mut bits = 0u64;
+    let mut base = 0;
+    while base < n {
+        let d = if vertex_face {
+            motion_distance_lanes::<S, true>(simd, &motion, pairs, base)
+        } else {
+            motion_distance_lanes::<S, false>(simd, &motion, pairs, base)
+        };
+        let c = Constants {
+            dd: simd.mul_f64s(d, d),
+            ..c
+        };
+        let apart = if vertex_face {
+            point_triangles_apart_lanes(simd, &c, start, base)
+        } else {
+            segments_apart_lanes(simd, &c, start, base)
+        };
+        let in_range = simd.and_m64s(
+            simd.greater_than_or_equal_f64s(d, c.low),
+            simd.less_than_or_equal_f64s(d, c.high),
+        );
+        let hit = simd.and_m64s(apart, in_range);
+        bits |= (u64::from(mask_bits_f64(simd, hit)) & low_bits(n - base)) << base;
+        base += S::F64_LANES;
+    }
+    bits
+}
+
+/// The splatted constants of the motion bound: `1 + 2^-46`, `2^-46 M`, `t_end`, `delta`.
+struct MotionConstants<V> {
+    up: V,
+    slack: V,
+    t: V,
+    delta: V,
+}
+
+/// The distance `d` of [`apart_beyond_motion_with`] for the moving pairs in lanes
+/// `base..base + F64_LANES` (`VF`: vertex-face).
+#[inline(always)]
+fn motion_distance_lanes<S: Simd, const VF: bool>(
+    simd: S,
+    c: &MotionConstants<S::f64s>,
+    pairs: &MovingPoints,
+    base: usize,
+) -> S::f64s {
+    let o = [
+        moving_point::<S>(pairs, 0, 0, base),
+        moving_point::<S>(pairs, 1, 0, base),
+    ];
+    let (n1, n2, n3) = (
+        relative_motion(simd, pairs, &o, 1, base),
+        relative_motion(simd, pairs, &o, 2, base),
+        relative_motion(simd, pairs, &o, 3, base),
+    );
+    let s = if VF {
+        simd.max_f64s(simd.max_f64s(n1, n2), n3)
+    } else {
+        simd.add_f64s(n1, simd.max_f64s(n2, n3))
+    };
+    let a = simd.add_f64s(simd.mul_f64s(s, c.up), c.slack);
+    let a_t = simd.mul_f64s(simd.mul_f64s(a, c.t), c.up);
+    simd.mul_f64s(simd.add_f64s(c.delta, a_t), c.up)
+}
+
+/// `|D_e|`: how far point `e` moves relative to the pair's first point `o` (`o[j]` at pose
+/// `j`), `D_e = (x1_e - x1_o) - (x0_e - x0_o)`, in lanes `base..`.
+// PERF: a function, not a closure: a closure may be compiled without the target features.
+#[inline(always)]
+fn relative_motion<S: Simd>(
+    simd: S,
+    pairs: &MovingPoints,
+    o: &[[S::f64s; 3]; 2],
+    e: usize,
+    base: usize,
+) -> S::f64s {
+    let x0 = moving_point::<S>(pairs, 0, e, base);
+    let x1 = moving_point::<S>(pairs, 1, e, base);
+    let d = sub3(simd, &sub3(simd, &x1, &o[1]), &sub3(simd, &x0, &o[0]));
+    simd.sqrt_f64s(dot3(simd, &d, &d))
 }

@@ -549,3 +549,62 @@ pub fn centroids_apart_scalar(
         )) << i
     })
 }
+
+/// Whether one moving pair (`vertex_face`: `[v, t0, t1, t2]`, else `[a0, a1, b0, b1]`, at
+/// poses `x0` and `x1`) is certainly farther than `delta` apart over `[0, t_end]`: farther at
+/// pose 0 than `delta` plus the most its relative motion closes by `t_end` (the
+/// [`crate::apart::apart_beyond_motion_with`] test on one pair, in its operation order).
+pub fn moving_apart_beyond_motion(
+    x0: &[[f64; 3]; 4],
+    x1: &[[f64; 3]; 4],
+    vertex_face: bool,
+    delta: f64,
+    m: f64,
+    t_end: f64,
+) -> bool {
+    use crate::apart::{LENGTH_UP, MOTION_ABS, SCALE_HIGH, SCALE_LOW};
+    if !crate::apart::moving_in_range(delta, m, t_end) {
+        return false;
+    }
+    let relative = |e: usize| {
+        let d: [f64; 3] = std::array::from_fn(|k| (x1[e][k] - x1[0][k]) - (x0[e][k] - x0[0][k]));
+        ((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]).sqrt()
+    };
+    let (n1, n2, n3) = (relative(1), relative(2), relative(3));
+    let s = if vertex_face {
+        n1.max(n2).max(n3)
+    } else {
+        n1 + n2.max(n3)
+    };
+    let a = s * LENGTH_UP + MOTION_ABS * m;
+    let d = (delta + (a * t_end) * LENGTH_UP) * LENGTH_UP;
+    (SCALE_LOW..=SCALE_HIGH).contains(&d)
+        && if vertex_face {
+            point_triangle_apart(*x0, d)
+        } else {
+            segment_pair_apart(*x0, d)
+        }
+}
+
+/// Scalar reference of [`crate::apart::apart_beyond_motion_with`].
+pub fn apart_beyond_motion_scalar(
+    pairs: &crate::apart::MovingPoints,
+    n: usize,
+    vertex_face: bool,
+    delta: f64,
+    m: f64,
+    t_end: f64,
+) -> u64 {
+    assert!(n <= crate::apart::MAX_PAIRS, "at most MAX_PAIRS pairs");
+    (0..n).fold(0, |bits, i| {
+        let (x0, x1) = pairs.get(i);
+        bits | u64::from(moving_apart_beyond_motion(
+            &x0,
+            &x1,
+            vertex_face,
+            delta,
+            m,
+            t_end,
+        )) << i
+    })
+}

@@ -1717,3 +1717,97 @@ fn check_centroids_apart<S: Simd>(simd: S) {
 fn centroids_apart_matches_reference_on_all_backends() {
     on_all_backends!(check_centroids_apart);
 }
+
+fn check_apart_beyond_motion<S: Simd>(simd: S) {
+    let mut rng = Rng::new(47);
+    let mut certified = 0u32;
+    for scale in [1.0, 1e-30, 3e25] {
+        for n in [0, 1, 5, 8, 13, 64] {
+            let p0 = four_points(&mut rng, n, scale);
+            let p1 = four_points(&mut rng, n, scale);
+            let mut pairs = apart::MovingPoints::default();
+            for i in 0..n {
+                // Most pairs move a little (a translation and a small part of another pose),
+                // some across the box.
+                let (x0, mut x1) = (p0.get(i), p1.get(i));
+                if i % 4 != 0 {
+                    let shift = x1[0];
+                    x1 = std::array::from_fn(|e| {
+                        std::array::from_fn(|k| x0[e][k] + shift[k] + 0.01 * x1[e][k])
+                    });
+                }
+                pairs.set(i, &x0, &x1);
+            }
+            let m = 15.0 * scale;
+            for vf in [true, false] {
+                for delta in [0.0, 0.05 * scale, 2.0 * scale] {
+                    for t_end in [1.0, 0.3, 1e-300] {
+                        let got =
+                            apart::apart_beyond_motion_with(simd, &pairs, n, vf, delta, m, t_end);
+                        let want =
+                            reference::apart_beyond_motion_scalar(&pairs, n, vf, delta, m, t_end);
+                        assert_eq!(got, want, "n {n} vf {vf} delta {delta} t {t_end}");
+                        certified += got.count_ones();
+                    }
+                }
+            }
+        }
+    }
+    assert!(certified > 100, "{certified}");
+}
+
+#[test]
+fn apart_beyond_motion_matches_reference_on_all_backends() {
+    on_all_backends!(check_apart_beyond_motion);
+}
+
+/// The motion bound on hand-made moves: a vertex falling onto a face is apart only over the
+/// part of the step before it can arrive; features translating together stay apart by their
+/// distance at pose 0, and no further.
+#[test]
+fn apart_beyond_motion_on_hand_cases() {
+    use reference::moving_apart_beyond_motion as apart;
+    let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let falling = (
+        [[0.25, 0.25, 1.0], tri[0], tri[1], tri[2]],
+        [[0.25, 0.25, 0.0], tri[0], tri[1], tri[2]],
+    );
+    let m = 1.0;
+    // It reaches the face at t = 1: never apart over the whole step, with or without delta.
+    assert!(!apart(&falling.0, &falling.1, true, 0.0, m, 1.0));
+    assert!(!apart(&falling.0, &falling.1, true, 0.1, m, 1.0));
+    // Over [0, 0.9] it stays 0.1 above: apart for a delta below that, not at it.
+    assert!(apart(&falling.0, &falling.1, true, 0.0, m, 0.9));
+    assert!(apart(&falling.0, &falling.1, true, 0.099, m, 0.9));
+    assert!(!apart(&falling.0, &falling.1, true, 0.1, m, 0.9));
+    // A sheet's neighbours translating together: 0.5 apart in the plane all step.
+    let shift = [0.3, -0.2, 0.0];
+    let moved = |x: [[f64; 3]; 4]| x.map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]]);
+    let beside = [[1.5, 0.0, 0.0], tri[0], tri[1], tri[2]];
+    assert!(apart(&beside, &moved(beside), true, 0.0, 2.0, 1.0));
+    assert!(apart(&beside, &moved(beside), true, 0.499, 2.0, 1.0));
+    assert!(!apart(&beside, &moved(beside), true, 0.5, 2.0, 1.0));
+    // Two edges 0.5 apart, one turning towards the other by 0.4 at its far end (the bound
+    // is |D_a1| = 0.4): apart at delta 0.05 (0.5 > 0.45), not at 0.2 (0.5 < 0.6).
+    let edges0 = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 0.5, 0.0],
+        [1.0, 0.5, 0.0],
+    ];
+    let mut edges1 = edges0;
+    edges1[1][1] = 0.4;
+    assert!(apart(&edges0, &edges1, false, 0.05, 1.0, 1.0));
+    assert!(!apart(&edges0, &edges1, false, 0.2, 1.0, 1.0));
+    // Out of range: nothing certified.
+    assert!(!apart(&beside, &moved(beside), true, 0.0, 2.0, 0.0));
+    assert!(!apart(&beside, &moved(beside), true, -1.0, 2.0, 1.0));
+    assert!(!apart(
+        &beside,
+        &moved(beside),
+        true,
+        0.0,
+        2f64.powi(500),
+        1.0
+    ));
+}

@@ -204,22 +204,39 @@ mod tests {
         x.map(|p| p.map(|c| c * s))
     }
 
-    /// The batch cull on one pair: its scalar reference, and the kernel on the dispatched
-    /// backend (equal; both checked).
-    fn batch_apart(vf: bool, x0: &Points, x1: &Points, d: f64, m: f64, t_end: f64) -> bool {
-        use dhcd_kernels::apart::{centroids_apart_with, MovingPoints};
+    /// A batch cull of the walk on one pair: its scalar reference, and the kernel on the
+    /// dispatched backend (equal; both checked). `MOTION`: the motion bound
+    /// (`apart_beyond_motion_with`), else the centroids' line (`centroids_apart_with`).
+    fn batch_apart<const MOTION: bool>(
+        vf: bool,
+        x0: &Points,
+        x1: &Points,
+        d: f64,
+        m: f64,
+        t_end: f64,
+    ) -> bool {
+        use dhcd_kernels::apart::{apart_beyond_motion_with, centroids_apart_with, MovingPoints};
         use dhcd_kernels::pulp::{Simd, WithSimd};
-        struct Run<'a>(&'a MovingPoints, bool, f64, f64, f64);
-        impl WithSimd for Run<'_> {
+        use dhcd_kernels::reference::{moving_apart_beyond_motion, moving_centroids_apart};
+        struct Run<'a, const MOTION: bool>(&'a MovingPoints, bool, f64, f64, f64);
+        impl<const MOTION: bool> WithSimd for Run<'_, MOTION> {
             type Output = u64;
             fn with_simd<S: Simd>(self, simd: S) -> u64 {
-                centroids_apart_with(simd, self.0, 1, self.1, self.2, self.3, self.4)
+                if MOTION {
+                    apart_beyond_motion_with(simd, self.0, 1, self.1, self.2, self.3, self.4)
+                } else {
+                    centroids_apart_with(simd, self.0, 1, self.1, self.2, self.3, self.4)
+                }
             }
         }
         let mut pairs = MovingPoints::default();
         pairs.set(0, x0, x1);
-        let one = dhcd_kernels::reference::moving_centroids_apart(x0, x1, vf, d, m, t_end);
-        let batch = dhcd_kernels::arch().dispatch(Run(&pairs, vf, d, m, t_end)) == 1;
+        let one = if MOTION {
+            moving_apart_beyond_motion(x0, x1, vf, d, m, t_end)
+        } else {
+            moving_centroids_apart(x0, x1, vf, d, m, t_end)
+        };
+        let batch = dhcd_kernels::arch().dispatch(Run::<MOTION>(&pairs, vf, d, m, t_end)) == 1;
         assert_eq!(
             one, batch,
             "kernel and reference disagree: {x0:?} -> {x1:?}"
@@ -231,7 +248,7 @@ mod tests {
     fn every_pair_called_apart_is_apart_exactly() {
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
         let (mut apart_count, mut between_count, mut total) = (0u32, 0u32, 0u32);
-        let mut batch_count = 0u32;
+        let (mut batch_count, mut motion_count) = (0u32, 0u32);
         for case in 0..4000 {
             let vf = case % 2 == 0;
             let x0: Points = std::array::from_fn(|_| std::array::from_fn(|_| rng.small()));
@@ -267,12 +284,20 @@ mod tests {
             // The batch cull of the walk (the centroids' line at t0, the kernel and its
             // scalar reference), over [0, 1] and over [0, hi].
             for t_end in [1.0, hi] {
-                if batch_apart(vf, &y0, &y1, d, m, t_end) {
+                if batch_apart::<false>(vf, &y0, &y1, d, m, t_end) {
                     batch_count += 1;
                     let exact = solve(kind, &x0, &x1, t_end, delta, &|| false).unwrap();
                     assert_eq!(
                         exact, None,
                         "batch: vf {vf} {x0:?} -> {x1:?} delta {delta} until {t_end}"
+                    );
+                }
+                if batch_apart::<true>(vf, &y0, &y1, d, m, t_end) {
+                    motion_count += 1;
+                    let exact = solve(kind, &x0, &x1, t_end, delta, &|| false).unwrap();
+                    assert_eq!(
+                        exact, None,
+                        "motion: vf {vf} {x0:?} -> {x1:?} delta {delta} until {t_end}"
                     );
                 }
             }
@@ -289,6 +314,7 @@ mod tests {
         }
         assert!(between_count > total / 4, "{between_count} of {total}");
         assert!(batch_count > total / 4, "{batch_count} of {}", 2 * total);
+        assert!(motion_count > total / 8, "{motion_count} of {}", 2 * total);
         // Random pairs in one cube are often far apart: most must be culled.
         assert!(apart_count > total / 4, "{apart_count} of {total}");
     }
@@ -391,7 +417,7 @@ mod tests {
                 .flatten()
                 .fold(0.0f64, |m, x| m.max(x.abs()));
             total += 1;
-            if !batch_apart(vf, &x0, &x1, delta, m, 1.0) {
+            if !batch_apart::<false>(vf, &x0, &x1, delta, m, 1.0) {
                 continue;
             }
             certified += 1;
