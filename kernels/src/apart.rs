@@ -701,10 +701,12 @@ fn moving_lanes<S: Simd, const VF: bool>(
 pub(crate) const MOTION_ABS: f64 = power_of_two(-46);
 
 /// The bits of the first `n` moving pairs of `pairs` (`n <= MAX_PAIRS`; `vertex_face`: each
-/// is a vertex and a triangle, else two edges) certainly farther than `delta` apart at every
-/// time of `[0, t_end]` (`t_end` in `(0, 1]`): at pose 0 they are farther apart than `delta`
-/// plus the most their relative motion can close by `t_end`. `m` is at least every
-/// coordinate's magnitude at both poses.
+/// is a vertex and a triangle, else two edges) farther apart at pose 0 than `delta` plus
+/// `closing` times the most their relative motion can close by `t_end` (`t_end` in `(0, 1]`,
+/// `closing >= 1`). With `closing = 1` such a pair stays farther than `delta` apart at every
+/// time of `[0, t_end]`; with `closing = 1 / s` it cannot come within the step-size rule's
+/// gap `delta + (1 - s)(d0 - delta)` by `t_end` (`d0 - A t > gap` iff `d0 > delta + A t / s`).
+/// `m` is at least every coordinate's magnitude at both poses.
 ///
 /// **The motion bound.** Translating both features by a common motion changes no distance.
 /// Take the motion of the pair's first point `o` (the vertex, or `a0`): relative to it,
@@ -722,24 +724,27 @@ pub(crate) const MOTION_ABS: f64 = power_of_two(-46);
 /// is within `2.6 u` of that norm, plus `2^-535` for squares that underflow. So `A <= s (1 +
 /// 3.7 u) + 28 u M + 2^-534`, `s` the computed sum or maximum. The kernel takes `A' = s (1 +
 /// 2^-46) + 2^-46 M` (each rounding at most `u`: `A' >= s (1 + 125 u) + 127 u M`, and `M >=
-/// 2^-400` puts `99 u M` far above `2^-534`), `d = (delta + (A' t_end)(1 + 2^-46))(1 + 2^-46)`
-/// (at least `delta + A t_end`), and certifies the pair when the static certificate of the
-/// module doc proves it farther than `d` at pose 0. A `d` outside `[2^-200, 2^200]` certifies
-/// nothing; nor do the ranges of [`centroids_apart_with`] (`m` in `[2^-400, 2^400]`, `delta`
-/// finite and `>= 0`, `t_end` in `(0, 1]`). An `A' t_end` that underflows loses at most
-/// `2^-1074`, covered by the margin on a `d >= 2^-200`.
+/// 2^-400` puts `99 u M` far above `2^-534`), `d = (delta + ((A' t_end) closing)(1 +
+/// 2^-46))(1 + 2^-46)` (at least `delta + A t_end closing`: five roundings against the
+/// margins), and certifies the pair when the static certificate of the module doc proves it
+/// farther than `d` at pose 0. A `d` outside `[2^-200, 2^200]` certifies nothing; nor do the
+/// ranges of [`centroids_apart_with`] (`m` in `[2^-400, 2^400]`, `delta` finite and `>= 0`,
+/// `t_end` in `(0, 1]`), nor a `closing` not finite or below 1. A product that underflows
+/// loses at most `2^-1074`, covered by the margin on a `d >= 2^-200`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub fn apart_beyond_motion_with<S: Simd>(
     simd: S,
     pairs: &MovingPoints,
     n: usize,
     vertex_face: bool,
     delta: f64,
+    closing: f64,
     m: f64,
     t_end: f64,
 ) -> u64 {
     assert!(n <= MAX_PAIRS, "at most MAX_PAIRS pairs");
-    if !moving_in_range(delta, m, t_end) {
+    if !motion_in_range(delta, closing, m, t_end) {
         return 0;
     }
     let start: &PointRows = pairs.rows[..12].try_into().expect("twelve rows of pose 0");
@@ -748,6 +753,7 @@ pub fn apart_beyond_motion_with<S: Simd>(
         up: simd.splat_f64s(LENGTH_UP),
         slack: simd.splat_f64s(MOTION_ABS * m),
         t: simd.splat_f64s(t_end),
+        closing: simd.splat_f64s(closing),
         delta: simd.splat_f64s(delta),
     };
     let mut bits = 0u64;
@@ -778,12 +784,21 @@ pub fn apart_beyond_motion_with<S: Simd>(
     bits
 }
 
-/// The splatted constants of the motion bound: `1 + 2^-46`, `2^-46 M`, `t_end`, `delta`.
+/// The splatted constants of the motion bound: `1 + 2^-46`, `2^-46 M`, `t_end`, `closing`,
+/// `delta`.
 struct MotionConstants<V> {
     up: V,
     slack: V,
     t: V,
+    closing: V,
     delta: V,
+}
+
+/// Whether the motion filter can certify anything for these inputs (the ranges of
+/// [`apart_beyond_motion_with`]).
+#[inline(always)]
+pub(crate) fn motion_in_range(delta: f64, closing: f64, m: f64, t_end: f64) -> bool {
+    moving_in_range(delta, m, t_end) && closing.is_finite() && closing >= 1.0
 }
 
 /// The distance `d` of [`apart_beyond_motion_with`] for the moving pairs in lanes
@@ -810,7 +825,7 @@ fn motion_distance_lanes<S: Simd, const VF: bool>(
         simd.add_f64s(n1, simd.max_f64s(n2, n3))
     };
     let a = simd.add_f64s(simd.mul_f64s(s, c.up), c.slack);
-    let a_t = simd.mul_f64s(simd.mul_f64s(a, c.t), c.up);
+    let a_t = simd.mul_f64s(simd.mul_f64s(simd.mul_f64s(a, c.t), c.closing), c.up);
     simd.mul_f64s(simd.add_f64s(c.delta, a_t), c.up)
 }
 

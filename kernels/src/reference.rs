@@ -551,19 +551,20 @@ pub fn centroids_apart_scalar(
 }
 
 /// Whether one moving pair (`vertex_face`: `[v, t0, t1, t2]`, else `[a0, a1, b0, b1]`, at
-/// poses `x0` and `x1`) is certainly farther than `delta` apart over `[0, t_end]`: farther at
-/// pose 0 than `delta` plus the most its relative motion closes by `t_end` (the
-/// [`crate::apart::apart_beyond_motion_with`] test on one pair, in its operation order).
+/// poses `x0` and `x1`) is farther apart at pose 0 than `delta` plus `closing` times the most
+/// its relative motion closes by `t_end` (the [`crate::apart::apart_beyond_motion_with`] test
+/// on one pair, in its operation order).
 pub fn moving_apart_beyond_motion(
     x0: &[[f64; 3]; 4],
     x1: &[[f64; 3]; 4],
     vertex_face: bool,
     delta: f64,
+    closing: f64,
     m: f64,
     t_end: f64,
 ) -> bool {
     use crate::apart::{LENGTH_UP, MOTION_ABS, SCALE_HIGH, SCALE_LOW};
-    if !crate::apart::moving_in_range(delta, m, t_end) {
+    if !crate::apart::motion_in_range(delta, closing, m, t_end) {
         return false;
     }
     let relative = |e: usize| {
@@ -577,7 +578,7 @@ pub fn moving_apart_beyond_motion(
         n1 + n2.max(n3)
     };
     let a = s * LENGTH_UP + MOTION_ABS * m;
-    let d = (delta + (a * t_end) * LENGTH_UP) * LENGTH_UP;
+    let d = (delta + ((a * t_end) * closing) * LENGTH_UP) * LENGTH_UP;
     (SCALE_LOW..=SCALE_HIGH).contains(&d)
         && if vertex_face {
             point_triangle_apart(*x0, d)
@@ -592,6 +593,7 @@ pub fn apart_beyond_motion_scalar(
     n: usize,
     vertex_face: bool,
     delta: f64,
+    closing: f64,
     m: f64,
     t_end: f64,
 ) -> u64 {
@@ -603,6 +605,7 @@ pub fn apart_beyond_motion_scalar(
             &x1,
             vertex_face,
             delta,
+            closing,
             m,
             t_end,
         )) << i

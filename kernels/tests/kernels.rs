@@ -1741,11 +1741,13 @@ fn check_apart_beyond_motion<S: Simd>(simd: S) {
             let m = 15.0 * scale;
             for vf in [true, false] {
                 for delta in [0.0, 0.05 * scale, 2.0 * scale] {
-                    for t_end in [1.0, 0.3, 1e-300] {
-                        let got =
-                            apart::apart_beyond_motion_with(simd, &pairs, n, vf, delta, m, t_end);
-                        let want =
-                            reference::apart_beyond_motion_scalar(&pairs, n, vf, delta, m, t_end);
+                    for (t_end, closing) in [(1.0, 1.0), (0.3, 1.0), (1e-300, 1.0), (1.0, 1.25)] {
+                        let got = apart::apart_beyond_motion_with(
+                            simd, &pairs, n, vf, delta, closing, m, t_end,
+                        );
+                        let want = reference::apart_beyond_motion_scalar(
+                            &pairs, n, vf, delta, closing, m, t_end,
+                        );
                         assert_eq!(got, want, "n {n} vf {vf} delta {delta} t {t_end}");
                         certified += got.count_ones();
                     }
@@ -1766,7 +1768,12 @@ fn apart_beyond_motion_matches_reference_on_all_backends() {
 /// distance at pose 0, and no further.
 #[test]
 fn apart_beyond_motion_on_hand_cases() {
-    use reference::moving_apart_beyond_motion as apart;
+    let apart = |x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], vf, delta, m, t_end| {
+        reference::moving_apart_beyond_motion(x0, x1, vf, delta, 1.0, m, t_end)
+    };
+    let closing = |x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4], c| {
+        reference::moving_apart_beyond_motion(x0, x1, true, 0.0, c, 1.0, 1.0)
+    };
     let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     let falling = (
         [[0.25, 0.25, 1.0], tri[0], tri[1], tri[2]],
@@ -1799,6 +1806,14 @@ fn apart_beyond_motion_on_hand_cases() {
     edges1[1][1] = 0.4;
     assert!(apart(&edges0, &edges1, false, 0.05, 1.0, 1.0));
     assert!(!apart(&edges0, &edges1, false, 0.2, 1.0, 1.0));
+    // A vertex 1 above a face, moving 0.5 towards it: apart with the motion counted twice
+    // less a little (1 > 0.999), not counted twice (1 = 1) or with a closing below 1.
+    let mut half = falling.1;
+    half[0][2] = 0.5;
+    assert!(closing(&falling.0, &half, 1.998));
+    assert!(!closing(&falling.0, &half, 2.0));
+    assert!(!closing(&falling.0, &falling.0, 0.5));
+    assert!(!closing(&falling.0, &falling.0, f64::INFINITY));
     // Out of range: nothing certified.
     assert!(!apart(&beside, &moved(beside), true, 0.0, 2.0, 0.0));
     assert!(!apart(&beside, &moved(beside), true, -1.0, 2.0, 1.0));

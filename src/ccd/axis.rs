@@ -223,7 +223,7 @@ mod tests {
             type Output = u64;
             fn with_simd<S: Simd>(self, simd: S) -> u64 {
                 if MOTION {
-                    apart_beyond_motion_with(simd, self.0, 1, self.1, self.2, self.3, self.4)
+                    apart_beyond_motion_with(simd, self.0, 1, self.1, self.2, 1.0, self.3, self.4)
                 } else {
                     centroids_apart_with(simd, self.0, 1, self.1, self.2, self.3, self.4)
                 }
@@ -232,7 +232,7 @@ mod tests {
         let mut pairs = MovingPoints::default();
         pairs.set(0, x0, x1);
         let one = if MOTION {
-            moving_apart_beyond_motion(x0, x1, vf, d, m, t_end)
+            moving_apart_beyond_motion(x0, x1, vf, d, 1.0, m, t_end)
         } else {
             moving_centroids_apart(x0, x1, vf, d, m, t_end)
         };

@@ -670,6 +670,29 @@ impl Gap {
         }
     }
 
+    /// The minimum distance and closing factor with which the motion cull
+    /// ([`apart_beyond_motion_with`]) ends exactly the pairs that cannot come within their
+    /// kept gap (as [`Gap::at_gap`] computes it) by `t_max`; `None` for a rule it cannot
+    /// serve (`rescaling` not in `(2^-40, 1]`).
+    ///
+    /// The cull proves `d0 > delta' + closing A t` for the relative motion `A` over `[0,
+    /// t]`, so the distance at `t` is at least `d0 - A t`. The kept gap is the rule's `g =
+    /// dmin + (1 - s)(d0 - dmin)` computed from a rounded `d0` and raised by `16 EPSILON`:
+    /// at most `g + 20 EPSILON d0` (`g <= d0` whenever `d0 >= dmin`, and a pair with `d0 <
+    /// dmin` is never certified). With `closing >= 1 / (s - 64 EPSILON)` and `delta' >= s dmin
+    /// closing`, `d0 > delta' + closing A t` gives `(s - 64 EPSILON) d0 > s dmin + A t`, so
+    /// `d0 - A t > g + 64 EPSILON d0`, above the kept gap.
+    pub(crate) fn motion_cull(&self) -> Option<(f64, f64)> {
+        let s = self.rescaling;
+        if !(s > 2f64.powi(-40) && s <= 1.0) {
+            return None;
+        }
+        // Rounded so that each is at least its exact value.
+        let closing = (1.0 / (s - 64.0 * f64::EPSILON).next_down()).next_up();
+        let delta = ((self.min_distance * s) * closing) * (1.0 + 2f64.powi(-50));
+        (delta.is_finite() && closing.is_finite()).then_some((delta, closing))
+    }
+
     /// Whether the pair can reach its gap before `t_max` (see [`Gap::options`]): `false`
     /// when `d0 > dmin + A / s`, decided exactly on the positions at t0.
     #[inline]
@@ -1573,7 +1596,8 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     /// time so far plus the slack; it only decreases, so the pairs are apart up to any later
     /// `t_max` too): the exact test would find no contact in them. Along the centroids' line
     /// first; the pairs it leaves by their distance at t0 against their relative motion,
-    /// when `motion` says that pays. None under the step size's per-pair minimum distances.
+    /// when `motion` says that pays. Under the step size's per-pair gaps, the pairs that
+    /// cannot come within theirs ([`Gap::motion_cull`]).
     #[inline(always)]
     fn batch_apart<S: Simd>(
         &self,
@@ -1583,21 +1607,25 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         vf: bool,
         motion: &mut MotionCull,
     ) -> u64 {
-        if self.gap.is_some() {
-            return 0;
-        }
-        let (delta, t_end, m) = (
-            self.options.min_distance,
-            self.options_now().t_max,
-            self.magnitude,
-        );
-        let along_axis = centroids_apart_with(simd, points, n, vf, delta, m, t_end);
+        let (t_end, m) = (self.options_now().t_max, self.magnitude);
+        let (along_axis, delta, closing) = match &self.gap {
+            // Each pair keeps its own gap: the motion cull alone, at the rule's closing.
+            Some(gap) => match gap.motion_cull() {
+                Some((delta, closing)) => (0, delta, closing),
+                None => return 0,
+            },
+            None => {
+                let delta = self.options.min_distance;
+                let along = centroids_apart_with(simd, points, n, vf, delta, m, t_end);
+                (along, delta, 1.0)
+            }
+        };
         let left = pairs_to_read(along_axis, n, false);
         let seen = left.count_ones();
         if seen == 0 || !motion.runs(seen) {
             return along_axis;
         }
-        let ended = apart_beyond_motion_with(simd, points, n, vf, delta, m, t_end) & left;
+        let ended = apart_beyond_motion_with(simd, points, n, vf, delta, closing, m, t_end) & left;
         motion.record(seen, ended.count_ones());
         along_axis | ended
     }
@@ -1606,6 +1634,92 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Under the step size's rule, every pair the motion cull ends (at [`Gap::motion_cull`]'s
+    /// distance and closing) stays outside the gap it would be kept at: the exact test at
+    /// that gap finds no contact up to the horizon. Motions on a coarse grid, so pairs that
+    /// reach their gap exactly are frequent; and the cull ends a fair share (not vacuous).
+    #[test]
+    fn the_motion_cull_keeps_every_pair_outside_its_gap() {
+        use dhcd_kernels::reference::moving_apart_beyond_motion;
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut grid = |steps: u64, size: f64| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 33) % (2 * steps + 1)) as f64 * size - steps as f64 * size
+        };
+        let (mut ended, mut total) = (0u32, 0u32);
+        for case in 0..6000 {
+            let vf = case % 2 == 0;
+            let x0: [[f64; 3]; 4] =
+                std::array::from_fn(|_| std::array::from_fn(|_| grid(8, 0.125)));
+            let x1: [[f64; 3]; 4] =
+                std::array::from_fn(|i| std::array::from_fn(|k| x0[i][k] + grid(4, 1.0 / 32.0)));
+            let gap = Gap {
+                min_distance: [0.0, 1.0 / 64.0, 0.125][case % 3],
+                rescaling: [0.8, 0.5, 1.0, 0.3][(case / 3) % 4],
+            };
+            let t_max = [1.0, 0.5, 0.2][(case / 12) % 3];
+            let m = x0
+                .iter()
+                .chain(&x1)
+                .flatten()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            let (delta, closing) = gap.motion_cull().expect("a rule the cull serves");
+            total += 1;
+            if !moving_apart_beyond_motion(&x0, &x1, vf, delta, closing, m, t_max) {
+                continue;
+            }
+            ended += 1;
+            let o = CcdOptions::new(t_max, 0.0).unwrap();
+            let at_gap = gap.at_gap(vf, &x0, o);
+            let exact = if vf {
+                crate::ccd::vertex_face_exact(&x0, &x1, &at_gap)
+            } else {
+                crate::ccd::edge_edge_exact(&x0, &x1, &at_gap)
+            };
+            assert_eq!(
+                exact, None,
+                "vf {vf} {x0:?} -> {x1:?} {gap:?} until {t_max}"
+            );
+        }
+        assert!(ended > total / 4, "{ended} of {total}");
+    }
+
+    /// A vertex 1 above a face closing in by `1 - g` reaches the rule's gap `g` exactly at
+    /// the end of the step: not ended; a little less motion, or a shorter horizon, is.
+    #[test]
+    fn the_motion_cull_keeps_a_pair_that_reaches_its_gap() {
+        use dhcd_kernels::reference::moving_apart_beyond_motion;
+        let tri = [[-1.0, -1.0, 0.0], [2.0, -1.0, 0.0], [-1.0, 2.0, 0.0]];
+        let gap = Gap {
+            min_distance: 0.0,
+            rescaling: 0.75,
+        };
+        let (delta, closing) = gap.motion_cull().unwrap();
+        let x0 = [[0.0, 0.0, 1.0], tri[0], tri[1], tri[2]];
+        // Gap 0.25: down by 0.75 reaches it at t = 1.
+        let x1 = [[0.0, 0.0, 0.25], tri[0], tri[1], tri[2]];
+        assert!(!moving_apart_beyond_motion(
+            &x0, &x1, true, delta, closing, 2.0, 1.0
+        ));
+        assert!(moving_apart_beyond_motion(
+            &x0, &x1, true, delta, closing, 2.0, 0.99
+        ));
+        let short = [[0.0, 0.0, 0.2501], tri[0], tri[1], tri[2]];
+        assert!(moving_apart_beyond_motion(
+            &x0, &short, true, delta, closing, 2.0, 1.0
+        ));
+        // Rules the cull cannot serve.
+        for rescaling in [0.0, 1.5, f64::NAN] {
+            let g = Gap {
+                min_distance: 0.0,
+                rescaling,
+            };
+            assert_eq!(g.motion_cull(), None);
+        }
+    }
 
     fn boxed(lo: [f32; 3], hi: [f32; 3]) -> FeatureBox {
         (lo, hi)
