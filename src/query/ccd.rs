@@ -749,7 +749,7 @@ struct ImpactOut {
     staged: Box<Staged>,
 }
 
-/// A leaf pair's candidates staged for the batch cull ([`SweptQuery::batch_apart`]), and the
+/// A leaf pair's candidates staged for the batch cull ([`SweptQuery::batch_cull`]), and the
 /// poses of up to [`MAX_PAIRS`] of them.
 #[derive(Default)]
 struct Staged {
@@ -759,8 +759,9 @@ struct Staged {
     edges: Vec<(CandidateEdge, CandidateEdge)>,
     /// The two poses of each pair of the current chunk.
     points: MovingPoints,
-    /// Whether the motion cull is paying on this task's pairs.
-    motion: MotionCull,
+    /// Whether the motion cull is paying on this task's pairs: for the impact test, and
+    /// for a listing walk's list.
+    motion: [MotionCull; 2],
 }
 
 /// When the motion cull ([`apart_beyond_motion_with`]) runs. It pays where it ends many of
@@ -1247,16 +1248,33 @@ fn edge_edge_points<K: BoundingVolume>(
     )
 }
 
-/// The staged pairs `0..n` of a chunk whose points are read after the batch cull (`apart`:
-/// the pairs it ended): all of them when the walk lists (the gap rule sees every candidate),
-/// else those it left.
+/// The bits of pairs `0..n` of a chunk (`n <= 64`).
 #[inline(always)]
-fn pairs_to_read(apart: u64, n: usize, listing: bool) -> u64 {
-    let all = if n >= 64 { u64::MAX } else { (1u64 << n) - 1 };
-    if listing {
-        all
+fn first_bits(n: usize) -> u64 {
+    if n >= 64 {
+        u64::MAX
     } else {
-        all & !apart
+        (1u64 << n) - 1
+    }
+}
+
+/// What the batch cull decided of a chunk's staged pairs ([`SweptQuery::batch_cull`]).
+struct Culled {
+    /// Certainly farther than their minimum distance apart over `[0, t_max]`: no contact.
+    apart: u64,
+    /// In a listing walk: certainly unable to come within their gap by the walk's horizon,
+    /// so not listed.
+    unreachable: u64,
+}
+
+impl Culled {
+    /// The pairs of `0..n` whose points are read: those left to the impact test, and in a
+    /// walk that `lists`, those left to the listing's test.
+    #[inline(always)]
+    fn to_read(&self, n: usize, lists: bool) -> u64 {
+        let all = first_bits(n);
+        let to_list = if lists { all & !self.unreachable } else { 0 };
+        (all & !self.apart) | to_list
     }
 }
 
@@ -1497,19 +1515,27 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                     let (x0, x1) = vertex_face_points(sv, v as usize, st, t as usize);
                     staged.points.set(i, &x0, &x1);
                 }
-                let apart = self.batch_apart(simd, &staged.points, n, true, &mut staged.motion);
-                let mut undecided = pairs_to_read(apart, n, list.is_some());
+                let culled = self.batch_cull(
+                    simd,
+                    &staged.points,
+                    n,
+                    true,
+                    list.is_some(),
+                    &mut staged.motion,
+                );
+                let mut undecided = culled.to_read(n, list.is_some());
                 while undecided != 0 {
                     let i = undecided.trailing_zeros() as usize;
                     undecided &= undecided - 1;
                     let (v, t) = chunk[i];
                     let (x0, x1) = staged.points.get(i);
                     if let Some(l) = list.as_deref_mut() {
-                        if self.may_reach_gap(true, &x0, &x1) {
+                        if culled.unreachable & (1 << i) == 0 && self.may_reach_gap(true, &x0, &x1)
+                        {
                             l.push([v, t]);
                         }
                     }
-                    if apart & (1 << i) != 0 {
+                    if culled.apart & (1 << i) != 0 {
                         continue;
                     }
                     if let Some(toi) = self.pair_toi(true, &x0, &x1) {
@@ -1558,19 +1584,27 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                     let (x0, x1) = edge_edge_points(sa, ex.internal, sb, ey.internal);
                     staged.points.set(i, &x0, &x1);
                 }
-                let apart = self.batch_apart(simd, &staged.points, n, false, &mut staged.motion);
-                let mut undecided = pairs_to_read(apart, n, list.is_some());
+                let culled = self.batch_cull(
+                    simd,
+                    &staged.points,
+                    n,
+                    false,
+                    list.is_some(),
+                    &mut staged.motion,
+                );
+                let mut undecided = culled.to_read(n, list.is_some());
                 while undecided != 0 {
                     let i = undecided.trailing_zeros() as usize;
                     undecided &= undecided - 1;
                     let (ex, ey) = &chunk[i];
                     let (x0, x1) = staged.points.get(i);
                     if let Some(l) = list.as_deref_mut() {
-                        if self.may_reach_gap(false, &x0, &x1) {
+                        if culled.unreachable & (1 << i) == 0 && self.may_reach_gap(false, &x0, &x1)
+                        {
                             l.push([ex.internal, ey.internal]);
                         }
                     }
-                    if apart & (1 << i) != 0 {
+                    if culled.apart & (1 << i) != 0 {
                         continue;
                     }
                     if let Some(toi) = self.pair_toi(false, &x0, &x1) {
@@ -1591,43 +1625,81 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         }
     }
 
-    /// The staged pairs (the first `n` of `points`) certainly farther than the minimum
-    /// distance apart over `[0, t_max]`, `t_max` the query's now (in earliest mode the best
-    /// time so far plus the slack; it only decreases, so the pairs are apart up to any later
-    /// `t_max` too): the exact test would find no contact in them. Along the centroids' line
-    /// first; the pairs it leaves by their distance at t0 against their relative motion,
-    /// when `motion` says that pays. Under the step size's per-pair gaps, the pairs that
-    /// cannot come within theirs ([`Gap::motion_cull`]).
+    /// The batch cull of the staged pairs (the first `n` of `points`): those certainly
+    /// farther than the minimum distance apart over `[0, t_max]`, `t_max` the query's now (in
+    /// earliest mode the best time so far plus the slack; it only decreases, so the pairs are
+    /// apart up to any later `t_max` too), whose exact test would find no contact. Along the
+    /// centroids' line first; the pairs it leaves by their distance at t0 against their
+    /// relative motion, when that pays. Under the step size's per-pair gaps, the pairs that
+    /// cannot come within theirs ([`Gap::motion_cull`]). A walk that `lists` also ends, for
+    /// its list, the pairs that cannot come within their gap by its horizon.
     #[inline(always)]
-    fn batch_apart<S: Simd>(
+    fn batch_cull<S: Simd>(
         &self,
         simd: S,
         points: &MovingPoints,
         n: usize,
         vf: bool,
+        lists: bool,
+        [motion, motion_listing]: &mut [MotionCull; 2],
+    ) -> Culled {
+        let all = first_bits(n);
+        let t_end = self.options_now().t_max;
+        // PERF: `if let`, not closures around the kernel: a closure may be compiled without
+        // the backend's target features (every vector operation a call: 2.3x slower).
+        if let Some(gap) = &self.gap {
+            let mut apart = 0;
+            if let Some((delta, closing)) = gap.motion_cull() {
+                let horizon = (delta, closing, t_end);
+                apart = self.motion_cull(simd, points, (n, vf, all), horizon, motion);
+            }
+            return Culled {
+                apart,
+                unreachable: 0,
+            };
+        }
+        let delta = self.options.min_distance;
+        let along = centroids_apart_with(simd, points, n, vf, delta, self.magnitude, t_end);
+        let ended = self.motion_cull(
+            simd,
+            points,
+            (n, vf, all & !along),
+            (delta, 1.0, t_end),
+            motion,
+        );
+        let mut unreachable = 0;
+        if let Some(listing) = self.listing.filter(|_| lists) {
+            if let Some((d, closing)) = listing.gap.motion_cull() {
+                let horizon = (d, closing, self.horizon);
+                unreachable = self.motion_cull(simd, points, (n, vf, all), horizon, motion_listing);
+            }
+        }
+        Culled {
+            apart: along | ended,
+            unreachable,
+        }
+    }
+
+    /// The motion cull ([`apart_beyond_motion_with`]) on the pairs `among` of the first `n`
+    /// staged (`vf`: vertex-face) at minimum distance `delta`, closing factor `closing` and
+    /// horizon `t_end`, when `motion` says it pays (else none).
+    #[inline(always)]
+    fn motion_cull<S: Simd>(
+        &self,
+        simd: S,
+        points: &MovingPoints,
+        (n, vf, among): (usize, bool, u64),
+        (delta, closing, t_end): (f64, f64, f64),
         motion: &mut MotionCull,
     ) -> u64 {
-        let (t_end, m) = (self.options_now().t_max, self.magnitude);
-        let (along_axis, delta, closing) = match &self.gap {
-            // Each pair keeps its own gap: the motion cull alone, at the rule's closing.
-            Some(gap) => match gap.motion_cull() {
-                Some((delta, closing)) => (0, delta, closing),
-                None => return 0,
-            },
-            None => {
-                let delta = self.options.min_distance;
-                let along = centroids_apart_with(simd, points, n, vf, delta, m, t_end);
-                (along, delta, 1.0)
-            }
-        };
-        let left = pairs_to_read(along_axis, n, false);
-        let seen = left.count_ones();
+        let seen = among.count_ones();
         if seen == 0 || !motion.runs(seen) {
-            return along_axis;
+            return 0;
         }
-        let ended = apart_beyond_motion_with(simd, points, n, vf, delta, closing, m, t_end) & left;
+        let m = self.magnitude;
+        let ended = apart_beyond_motion_with(simd, points, n, vf, delta, closing, m, t_end) & among;
         motion.record(seen, ended.count_ones());
-        along_axis | ended
+        ended
     }
 }
 
