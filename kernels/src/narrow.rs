@@ -653,9 +653,9 @@ pub(crate) fn check(a: &TriSoa, na: usize, b: &TriSoa, nb: usize, out: &[Row]) {
     );
 }
 
-/// The low `n` bits set (`n <= 64`).
+/// The low `n` bits set (`n <= 64`): the mask of a batch's first `n` entries.
 #[inline(always)]
-pub(crate) fn low_bits(n: usize) -> u64 {
+pub fn low_bits(n: usize) -> u64 {
     if n >= 64 {
         u64::MAX
     } else {

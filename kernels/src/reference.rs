@@ -536,17 +536,22 @@ pub fn centroids_apart_scalar(
     m: f64,
     t_end: f64,
 ) -> u64 {
+    moving_bits(pairs, n, |x0, x1| {
+        moving_centroids_apart(x0, x1, vertex_face, delta, m, t_end)
+    })
+}
+
+/// The bits of the first `n` moving pairs of `pairs` (`n <= MAX_PAIRS`) that `test` passes
+/// (bit `i` for pair `i`): the batch of a one-pair moving test.
+fn moving_bits(
+    pairs: &crate::apart::MovingPoints,
+    n: usize,
+    test: impl Fn(&[[f64; 3]; 4], &[[f64; 3]; 4]) -> bool,
+) -> u64 {
     assert!(n <= crate::apart::MAX_PAIRS, "at most MAX_PAIRS pairs");
     (0..n).fold(0, |bits, i| {
         let (x0, x1) = pairs.get(i);
-        bits | u64::from(moving_centroids_apart(
-            &x0,
-            &x1,
-            vertex_face,
-            delta,
-            m,
-            t_end,
-        )) << i
+        bits | u64::from(test(&x0, &x1)) << i
     })
 }
 
@@ -597,17 +602,7 @@ pub fn apart_beyond_motion_scalar(
     m: f64,
     t_end: f64,
 ) -> u64 {
-    assert!(n <= crate::apart::MAX_PAIRS, "at most MAX_PAIRS pairs");
-    (0..n).fold(0, |bits, i| {
-        let (x0, x1) = pairs.get(i);
-        bits | u64::from(moving_apart_beyond_motion(
-            &x0,
-            &x1,
-            vertex_face,
-            delta,
-            closing,
-            m,
-            t_end,
-        )) << i
+    moving_bits(pairs, n, |x0, x1| {
+        moving_apart_beyond_motion(x0, x1, vertex_face, delta, closing, m, t_end)
     })
 }

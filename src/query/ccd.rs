@@ -65,6 +65,7 @@ use crate::walk::{self, Query, Side, Workspace};
 use dhcd_kernels::apart::{
     apart_beyond_motion_with, centroids_apart_with, MovingPoints, MAX_PAIRS,
 };
+use dhcd_kernels::narrow::low_bits;
 use dhcd_kernels::overlap::BoxRows;
 use listed::ListedCount;
 pub(crate) use listed::{gap_over_listed, Listed, Listing, MAX_LISTED};
@@ -1248,16 +1249,6 @@ fn edge_edge_points<K: BoundingVolume>(
     )
 }
 
-/// The bits of pairs `0..n` of a chunk (`n <= 64`).
-#[inline(always)]
-fn first_bits(n: usize) -> u64 {
-    if n >= 64 {
-        u64::MAX
-    } else {
-        (1u64 << n) - 1
-    }
-}
-
 /// What the batch cull decided of a chunk's staged pairs ([`SweptQuery::batch_cull`]).
 struct Culled {
     /// Certainly farther than their minimum distance apart over `[0, t_max]`: no contact.
@@ -1272,7 +1263,7 @@ impl Culled {
     /// walk that `lists`, those left to the listing's test.
     #[inline(always)]
     fn to_read(&self, n: usize, lists: bool) -> u64 {
-        let all = first_bits(n);
+        let all = low_bits(n);
         let to_list = if lists { all & !self.unreachable } else { 0 };
         (all & !self.apart) | to_list
     }
@@ -1643,7 +1634,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         lists: bool,
         [motion, motion_listing]: &mut [MotionCull; 2],
     ) -> Culled {
-        let all = first_bits(n);
+        let all = low_bits(n);
         let t_end = self.options_now().t_max;
         // PERF: `if let`, not closures around the kernel: a closure may be compiled without
         // the backend's target features (every vector operation a call: 2.3x slower).
