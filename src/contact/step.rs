@@ -42,7 +42,7 @@
 //! as on most simulation steps), the gap walk would meet nearly the pairs of the first
 //! impact's last pass again. That pass then culls at the gap walk's distance for its own
 //! horizon (at least the one for `T`: the distance grows with the time) and lists the pairs
-//! that may reach their gap by that horizon; the gap rule is tested on the list and no
+//! its batch cull leaves as able to reach their gap by that horizon; the gap rule is tested on the list and no
 //! second walk runs ([`crate::query::ccd`]'s `listed`). A list past [`MAX_LISTED`] pairs is
 //! dropped for the walk.
 

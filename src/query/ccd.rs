@@ -576,9 +576,9 @@ struct SweptQuery<'s, 'h, K: BoundingVolume> {
     restart_below: Option<f64>,
     /// The walk stopped for that.
     abandoned: AtomicBool,
-    /// The walk lists the feature pairs it meets that may reach their gap under the
-    /// listing's rule by the walk's horizon ([`run_passes`]), up to the listing's `most`
-    /// (counted in `listed`).
+    /// The walk lists the feature pairs it meets that the batch cull does not prove unable
+    /// to reach their gap under the listing's rule by the walk's horizon ([`run_passes`]),
+    /// up to the listing's `most` (counted in `listed`).
     listing: Option<&'s Listing<'s>>,
     listed: ListedCount,
     /// Earliest mode: the least time of impact found so far, by this walk or any other
@@ -885,7 +885,7 @@ pub(crate) fn run<K: BoundingVolume>(
 }
 
 /// [`run`], and with `listing` the feature pairs met by its last pass that may reach their
-/// gap by the pass's horizon, when that pass's bounds were fitted short of the whole step
+/// gap by the pass's horizon (a superset: see [`listed`]), when that pass's bounds were fitted short of the whole step
 /// (see [`listed`]): each such pass culls at the listing's distance for its horizon at
 /// least. `None` when no such pass ran or it met more pairs than the listing's `most`.
 #[allow(clippy::too_many_arguments)]
@@ -1046,13 +1046,6 @@ pub(crate) fn ties_with(toi: f64, least: f64) -> bool {
 }
 
 impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
-    /// A listing walk's rule: the pair may reach its gap by the walk's horizon.
-    #[inline(always)]
-    fn may_reach_gap(&self, vertex_face: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> bool {
-        self.listing
-            .is_some_and(|l| l.gap.may_reach(vertex_face, x0, x1, self.horizon))
-    }
-
     fn side(&self, side: Side) -> &Swept<'_, K> {
         match side {
             Side::A => self.a,
@@ -1466,7 +1459,7 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
 impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     /// The own vertices of leaf `x` of `sv` against the triangles of leaf `y` of `st`:
     /// `emit(vertex, triangle, toi)` (internal indices) for each pair that collides, and
-    /// into `list` each that may reach its gap when the walk lists.
+    /// into `list` each the batch cull leaves for it when the walk lists.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn vertices_vs_triangles<S: Simd>(
@@ -1521,8 +1514,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                     let (v, t) = chunk[i];
                     let (x0, x1) = staged.points.get(i);
                     if let Some(l) = list.as_deref_mut() {
-                        if culled.unreachable & (1 << i) == 0 && self.may_reach_gap(true, &x0, &x1)
-                        {
+                        if culled.unreachable & (1 << i) == 0 {
                             l.push([v, t]);
                         }
                     }
@@ -1542,7 +1534,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
 
     /// The own edges of leaf `x` of A against those of leaf `y` of B (a leaf with itself:
     /// each unordered pair once): each pair that collides into `out`, and into `list` each
-    /// that may reach its gap when the walk lists.
+    /// the batch cull leaves for it when the walk lists.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn edges_vs_edges<S: Simd>(
@@ -1590,8 +1582,7 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
                     let (ex, ey) = &chunk[i];
                     let (x0, x1) = staged.points.get(i);
                     if let Some(l) = list.as_deref_mut() {
-                        if culled.unreachable & (1 << i) == 0 && self.may_reach_gap(false, &x0, &x1)
-                        {
+                        if culled.unreachable & (1 << i) == 0 {
                             l.push([ex.internal, ey.internal]);
                         }
                     }

@@ -12,17 +12,27 @@
 //! larger culling distance costs the first walk little where `H` is small, which is where
 //! a pass lists (bounds fitted short of the whole step, [`super::run_passes`]).
 //!
+//! The list is a superset: every pair the pass meets except those its batch cull proves
+//! unable to come within their gap by `H` ([`Gap::motion_cull`], in `f64` lanes). No exact
+//! reach test runs in the walk (on pairs touching at t0 it is the slow exact path, and it
+//! was most of a step where every vertex touches); the list's test culls each 64 pairs
+//! again at the best time so far, then tests the rest exactly at their gap, as the gap walk
+//! would.
+//!
 //! The list is bounded ([`Listing::most`], [`MAX_LISTED`] for the step size); past it the
-//! list is dropped and the caller walks again. Results are the gap walk's: the same pairs tested under the same rule with the
-//! same shared bound, settled the same way ([`SweptQuery::settle_earliest`]).
+//! list is dropped and the caller walks again. Results are the gap walk's: the same pairs
+//! tested under the same rule with the same shared bound, settled the same way
+//! ([`SweptQuery::settle_earliest`]).
 
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
+use pulp::{Simd, WithSimd};
+
 use super::{
     edge_edge_points, vertex_face_points, CcdQuery, EdgeImpact, FaceImpact, Gap, ImpactOut,
-    Impacts, Swept, SweptQuery, VertexImpact,
+    Impacts, MotionCull, Swept, SweptQuery, VertexImpact, MAX_PAIRS,
 };
 use crate::bv::BoundingVolume;
 use crate::control::Budget;
@@ -64,9 +74,9 @@ impl Listed {
     }
 }
 
-/// What a walk lists: the pairs that may reach their gap under `gap` by the walk's horizon,
-/// among those its bounds meet culled at `cull_for(horizon)` at least; at most `most` of
-/// them, or none.
+/// What a walk lists: among the pairs its bounds meet culled at `cull_for(horizon)` at
+/// least, those its batch cull does not prove unable to reach their gap under `gap` by the
+/// walk's horizon; at most `most` of them, or none.
 pub(crate) struct Listing<'a> {
     pub(crate) cull_for: &'a (dyn Fn(f64) -> f64 + Sync),
     pub(crate) gap: Gap,
@@ -126,18 +136,30 @@ pub(crate) fn gap_over_listed<K: BoundingVolume>(
     // The pair tests see the horizon the gap walk's bounds would have reached.
     let q = SweptQuery { horizon: by, ..q };
     let mut out = ImpactOut::default();
-    q.merge(
-        &mut out,
-        q.each_listed(&listed.vertex_face, par, SweptQuery::vertex_face),
+    let vertex_face = q.each_listed(
+        &listed.vertex_face,
+        true,
+        par,
+        SweptQuery::vertex_face_poses,
+        SweptQuery::vertex_face,
     );
-    q.merge(
-        &mut out,
-        q.each_listed(&listed.face_vertex, par, SweptQuery::face_vertex),
+    q.merge(&mut out, vertex_face);
+    let face_vertex = q.each_listed(
+        &listed.face_vertex,
+        true,
+        par,
+        SweptQuery::face_vertex_poses,
+        SweptQuery::face_vertex,
     );
-    q.merge(
-        &mut out,
-        q.each_listed(&listed.edge_edge, par, SweptQuery::edge_edge),
+    q.merge(&mut out, face_vertex);
+    let edge_edge = q.each_listed(
+        &listed.edge_edge,
+        false,
+        par,
+        SweptQuery::edge_edge_poses,
+        SweptQuery::edge_edge,
     );
+    q.merge(&mut out, edge_edge);
     budget.finish()?;
     q.settle_earliest(&mut out);
     budget.finish()?;
@@ -149,25 +171,25 @@ pub(crate) fn gap_over_listed<K: BoundingVolume>(
 }
 
 impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
-    /// `test` on each of `pairs` into one output, in tasks of [`LISTED_PER_TASK`] pairs
-    /// when `par` is parallel (outputs merged in task order).
+    /// The gap rule on each of `pairs` (`vf`: vertex-triangle pairs) into one output, in
+    /// tasks of [`LISTED_PER_TASK`] pairs when `par` is parallel (outputs merged in task
+    /// order): `points` reads a pair's two poses, `report` records its impact.
     fn each_listed<T: Sync>(
         &self,
         pairs: &[T],
+        vf: bool,
         par: Par,
-        test: impl Fn(&Self, &T, &mut ImpactOut) + Sync,
+        points: impl Fn(&Self, &T) -> ([[f64; 3]; 4], [[f64; 3]; 4]) + Sync,
+        report: impl Fn(&Self, &T, f64, &mut ImpactOut) + Sync,
     ) -> ImpactOut {
         let run = |chunk: &[T]| {
-            let mut out = ImpactOut::default();
-            for (i, p) in chunk.iter().enumerate() {
-                if i % crate::control::POLL_EVERY as usize == 0 && self.budget.stopped() {
-                    break;
-                }
-                let before = out.len();
-                test(self, p, &mut out);
-                self.budget.add(out.len() - before);
-            }
-            out
+            dhcd_kernels::arch().dispatch(ListedOp {
+                q: self,
+                pairs: chunk,
+                vf,
+                points: &points,
+                report: &report,
+            })
         };
         if !par.is_parallel() || pairs.len() <= LISTED_PER_TASK {
             return run(pairs);
@@ -184,10 +206,9 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
     }
 
     /// The time a listed pair reaches its gap: its exact test at the gap, with the options
-    /// of the moment. The list holds only pairs that may reach their gap by the listing
-    /// walk's horizon ([`Gap::may_reach`], an exact distance test that is costly for pairs
-    /// touching at t0); it is not tested again for the shorter time of the moment, as the
-    /// test at the gap decides those pairs anyway.
+    /// of the moment. No exact reach test ([`Gap::may_reach`]) runs before it: that is a
+    /// distance test, slow on pairs touching at t0, and the test at the gap decides the same
+    /// pairs (the batch cull before it ends most that cannot reach their gap by then).
     #[inline(always)]
     fn listed_toi(&self, vertex_face: bool, x0: &[[f64; 3]; 4], x1: &[[f64; 3]; 4]) -> Option<f64> {
         let gap = self.gap.as_ref().expect("a gap rule");
@@ -195,51 +216,109 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         self.pair_toi_with(vertex_face, x0, x1, &o)
     }
 
-    /// A listed vertex of `a` against a triangle of `b`.
+    /// A listed vertex of `a` and triangle of `b`: its poses.
     #[inline(always)]
-    fn vertex_face(&self, &[v, t]: &[u32; 2], out: &mut ImpactOut) {
-        let (v, t) = (v as usize, t as usize);
-        let (x0, x1) = vertex_face_points(self.a, v, self.b, t);
-        if let Some(toi) = self.listed_toi(true, &x0, &x1) {
-            self.found(toi);
-            let impact = VertexImpact {
-                vertex: self.a.tree().vert_order()[v],
-                triangle: self.b.tree().tri_order()[t],
-                toi,
-            };
-            self.budget.push(&mut out.vertex_face, impact);
-        }
+    fn vertex_face_poses(&self, &[v, t]: &[u32; 2]) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
+        vertex_face_points(self.a, v as usize, self.b, t as usize)
     }
 
-    /// A listed vertex of `b` against a triangle of `a` (pair queries).
+    /// A listed vertex of `b` and triangle of `a` (pair queries): its poses.
     #[inline(always)]
-    fn face_vertex(&self, &[v, t]: &[u32; 2], out: &mut ImpactOut) {
-        let (v, t) = (v as usize, t as usize);
-        let (x0, x1) = vertex_face_points(self.b, v, self.a, t);
-        if let Some(toi) = self.listed_toi(true, &x0, &x1) {
-            self.found(toi);
-            let impact = FaceImpact {
-                triangle: self.a.tree().tri_order()[t],
-                vertex: self.b.tree().vert_order()[v],
-                toi,
-            };
-            self.budget.push(&mut out.face_vertex, impact);
-        }
+    fn face_vertex_poses(&self, &[v, t]: &[u32; 2]) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
+        vertex_face_points(self.b, v as usize, self.a, t as usize)
     }
 
-    /// A listed edge of `a` against an edge of `b`.
+    /// A listed edge of `a` and edge of `b`: its poses.
     #[inline(always)]
-    fn edge_edge(&self, &[ea, eb]: &[[u32; 2]; 2], out: &mut ImpactOut) {
-        let (x0, x1) = edge_edge_points(self.a, ea, self.b, eb);
-        if let Some(toi) = self.listed_toi(false, &x0, &x1) {
-            self.found(toi);
-            let ids = |s: &Swept<'_, K>, e: [u32; 2]| e.map(|v| s.tree().vert_order()[v as usize]);
-            let impact = EdgeImpact {
-                a: ids(self.a, ea),
-                b: ids(self.b, eb),
-                toi,
-            };
-            self.budget.push(&mut out.edge_edge, impact);
+    fn edge_edge_poses(&self, &[ea, eb]: &[[u32; 2]; 2]) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
+        edge_edge_points(self.a, ea, self.b, eb)
+    }
+
+    /// A listed vertex of `a` against a triangle of `b` reaches its gap at `toi`.
+    #[inline(always)]
+    fn vertex_face(&self, &[v, t]: &[u32; 2], toi: f64, out: &mut ImpactOut) {
+        let impact = VertexImpact {
+            vertex: self.a.tree().vert_order()[v as usize],
+            triangle: self.b.tree().tri_order()[t as usize],
+            toi,
+        };
+        self.budget.push(&mut out.vertex_face, impact);
+    }
+
+    /// A listed vertex of `b` against a triangle of `a` (pair queries) reaches its gap at
+    /// `toi`.
+    #[inline(always)]
+    fn face_vertex(&self, &[v, t]: &[u32; 2], toi: f64, out: &mut ImpactOut) {
+        let impact = FaceImpact {
+            triangle: self.a.tree().tri_order()[t as usize],
+            vertex: self.b.tree().vert_order()[v as usize],
+            toi,
+        };
+        self.budget.push(&mut out.face_vertex, impact);
+    }
+
+    /// A listed edge of `a` against an edge of `b` reaches its gap at `toi`.
+    #[inline(always)]
+    fn edge_edge(&self, &[ea, eb]: &[[u32; 2]; 2], toi: f64, out: &mut ImpactOut) {
+        let ids = |s: &Swept<'_, K>, e: [u32; 2]| e.map(|v| s.tree().vert_order()[v as usize]);
+        let impact = EdgeImpact {
+            a: ids(self.a, ea),
+            b: ids(self.b, eb),
+            toi,
+        };
+        self.budget.push(&mut out.edge_edge, impact);
+    }
+}
+
+/// The gap rule on one task's listed pairs, on the dispatched backend: 64 at a time, the
+/// batch cull of the gap walk ([`SweptQuery::batch_cull`]: the pairs that cannot come
+/// within their gap by the best time so far) before the exact test at the gap: the listing
+/// pass culled at its own horizon, which the best time may be far below.
+struct ListedOp<'q, 's, 'h, K: BoundingVolume, T, P, R> {
+    q: &'q SweptQuery<'s, 'h, K>,
+    pairs: &'q [T],
+    vf: bool,
+    points: &'q P,
+    report: &'q R,
+}
+
+impl<'s, 'h, K, T, P, R> WithSimd for ListedOp<'_, 's, 'h, K, T, P, R>
+where
+    K: BoundingVolume,
+    P: Fn(&SweptQuery<'s, 'h, K>, &T) -> ([[f64; 3]; 4], [[f64; 3]; 4]),
+    R: Fn(&SweptQuery<'s, 'h, K>, &T, f64, &mut ImpactOut),
+{
+    type Output = ImpactOut;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) -> ImpactOut {
+        let q = self.q;
+        let mut out = ImpactOut::default();
+        let mut motion = [MotionCull::default(), MotionCull::default()];
+        for chunk in self.pairs.chunks(MAX_PAIRS) {
+            if q.budget.stopped() {
+                break;
+            }
+            let n = chunk.len();
+            for (i, pair) in chunk.iter().enumerate() {
+                let (x0, x1) = (self.points)(q, pair);
+                out.staged.points.set(i, &x0, &x1);
+            }
+            // PERF: the kernel in this dispatched body, not in a closure (see `batch_cull`).
+            let culled = q.batch_cull(simd, &out.staged.points, n, self.vf, false, &mut motion);
+            let mut undecided = culled.to_read(n, false);
+            while undecided != 0 {
+                let i = undecided.trailing_zeros() as usize;
+                undecided &= undecided - 1;
+                let (x0, x1) = out.staged.points.get(i);
+                if let Some(toi) = q.listed_toi(self.vf, &x0, &x1) {
+                    q.found(toi);
+                    let before = out.len();
+                    (self.report)(q, &chunk[i], toi, &mut out);
+                    q.budget.add(out.len() - before);
+                }
+            }
         }
+        out
     }
 }
