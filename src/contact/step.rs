@@ -42,9 +42,11 @@
 //! as on most simulation steps), the gap walk would meet nearly the pairs of the first
 //! impact's last pass again. That pass then culls at the gap walk's distance for its own
 //! horizon (at least the one for `T`: the distance grows with the time) and lists the pairs
-//! its batch cull leaves as able to reach their gap by that horizon; the gap rule is tested on the list and no
-//! second walk runs ([`crate::query::ccd`]'s `listed`). A list past [`MAX_LISTED`] pairs is
-//! dropped for the walk.
+//! its batch cull leaves as able to reach their gap by that horizon; the gap rule is tested
+//! on the list and no second walk runs ([`crate::query::ccd`]'s `listed`). A pass over the
+//! whole step lists the same way when the relative motion is small against the edges
+//! ([`WHOLE_STEP_LISTING`]): a sheet sliding or bending a little, with no impact, then costs
+//! one walk. A list past [`MAX_LISTED`] pairs is dropped for the walk.
 
 use std::sync::atomic::AtomicU64;
 
@@ -199,6 +201,7 @@ fn step_between<K: BoundingVolume>(
         cull_for: &cull_for,
         gap: Gap::of(options),
         most: most_listed,
+        whole_step: lists_whole_step(a, b, self_query, motions, options),
     };
     let (best, first_work, listed) =
         first_impact(a, b, self_query, options, Some(&listing), &budget, ws, par)?;
@@ -220,6 +223,40 @@ fn step_between<K: BoundingVolume>(
         step: step_at(limiting.toi),
         limiting,
     })
+}
+
+/// The most the gap walk's culling distance over the whole step may exceed the minimum
+/// distance, as a fraction of the mean edge length at t0, for the first impact's passes over
+/// the whole step to list ([`lists_whole_step`]).
+const WHOLE_STEP_LISTING: f64 = 1.0 / 16.0;
+
+/// Whether the first impact's passes over the whole step list their pairs for the gap
+/// rule (see [`crate::query::ccd`]'s `listed`): when the gap walk's culling distance over
+/// the whole step exceeds the minimum distance by at most [`WHOLE_STEP_LISTING`] times the
+/// mean edge length at t0. The first walk then meets nearly the candidates it meets anyway (a distance
+/// well below the spacing of the features adds few), and a step whose first impact is late
+/// or none runs one walk, not two. Where the relative motion is large against the
+/// features (layers closing in, bodies meeting), the larger distance costs the first walk
+/// more than the second walk it saves, and a pass over the whole step does not list.
+fn lists_whole_step<K: BoundingVolume>(
+    a: &Swept<'_, K>,
+    b: &Swept<'_, K>,
+    self_query: bool,
+    motions: &[Motion<'_>],
+    options: &StepOptions,
+) -> bool {
+    let sides: &[&Swept<'_, K>] = if self_query { &[a] } else { &[a, b] };
+    let (mut sum, mut edges) = (0.0f64, 0usize);
+    for (s, m) in sides.iter().zip(motions) {
+        for &[u, v] in &s.tree().tables().edges {
+            let (p, q) = (m.x0[u as usize], m.x0[v as usize]);
+            sum += ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+        }
+        edges += s.tree().tables().edges.len();
+    }
+    let mean_edge = if edges == 0 { 0.0 } else { sum / edges as f64 };
+    let extra = cull_distance(options, motions, false, 1.0) - options.min_distance;
+    extra <= WHOLE_STEP_LISTING * mean_edge
 }
 
 /// The earliest impact at the minimum distance (plain CCD, cheap: culled at that
@@ -400,7 +437,12 @@ mod tests {
                 let control = crate::control::Control::default();
                 let budget = Budget::new(&control);
                 let cull_for = |horizon: f64| cull_distance(o, &[motion], false, horizon);
-                let listing = Listing { cull_for: &cull_for, gap: Gap::of(o), most: MAX_LISTED };
+                let listing = Listing {
+                    cull_for: &cull_for,
+                    gap: Gap::of(o),
+                    most: MAX_LISTED,
+                    whole_step: false,
+                };
                 let mut ws = Workspace::default();
                 let (best, _, listed) =
                     first_impact(&s, &s, true, o, Some(&listing), &budget, &mut ws, Par::Seq)
@@ -427,6 +469,82 @@ mod tests {
                         // The walk's node tests are counted, the list's only its pairs.
                         assert!(w.counters.bv_tests > l.counters.bv_tests, "{at}");
                     }
+                }
+            }
+        });
+    }
+
+    /// The same folded sheet, its far layer closing from 2e-3 to 6e-4 above the near one
+    /// (the same jitter at both ends): nothing touches, but pairs reach their gap late in
+    /// the step. The relative motion is small against the edges, so the first impact's pass
+    /// over the whole step lists; the step from that list is the second walk's, with the
+    /// same limiting pairs, for every method, rule and thread count.
+    #[test]
+    fn a_pass_over_the_whole_step_lists_when_the_motion_is_small() {
+        use crate::shapes::{fold_x, grid, jitter};
+        use crate::{Hierarchy, Mesh, Options};
+        let rest = grid(12, 12, 0.1, [0.0; 3]);
+        let far: Vec<bool> = rest.positions().iter().map(|p| p[0] > 0.6).collect();
+        let jittered = jitter(&fold_x(rest.positions(), 0.6), [1e-3, 1e-3, 2e-4], 1);
+        let layered = |lift: f32| -> Vec<[f64; 3]> {
+            let at = jittered.iter().zip(&far);
+            at.map(|(p, &f)| [p[0], p[1], p[2] + if f { lift } else { 0.0 }])
+                .map(|p| p.map(f64::from))
+                .collect()
+        };
+        let (x0, x1) = (layered(2e-3), layered(6e-4));
+        let m = Mesh::new_f64(x0.clone(), rest.triangles().to_vec()).unwrap();
+        let motion = Motion::new(&x0, &x1);
+        let rules = [
+            StepOptions::default(),
+            StepOptions {
+                min_distance: 1e-4,
+                rescaling: 0.8,
+            },
+            StepOptions {
+                min_distance: 0.0,
+                rescaling: 0.5,
+            },
+        ];
+        crate::for_each_method!(K => {
+            let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
+            let s = Swept::new(&h, motion).unwrap();
+            for o in &rules {
+                let at = format!("{:?} {o:?}", K::METHOD);
+                assert!(lists_whole_step(&s, &s, true, &[motion], o), "{at}");
+                let control = crate::control::Control::default();
+                let budget = Budget::new(&control);
+                let cull_for = |horizon: f64| cull_distance(o, &[motion], false, horizon);
+                let listing = Listing {
+                    cull_for: &cull_for,
+                    gap: Gap::of(o),
+                    most: MAX_LISTED,
+                    whole_step: true,
+                };
+                let mut ws = Workspace::default();
+                let (best, _, listed) =
+                    first_impact(&s, &s, true, o, Some(&listing), &budget, &mut ws, Par::Seq)
+                        .unwrap();
+                let first = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
+                assert_eq!(first, f64::INFINITY, "{at}: nothing touches");
+                let listed = listed.expect("the pass over the whole step lists").len();
+                assert!(listed > 3, "{at}: {listed} pairs listed");
+                for par in [Par::Seq, Par::Rayon(2)] {
+                    let mut step = |most: usize| {
+                        let motions = [motion];
+                        step_between(&s, &s, true, &motions, o, most, &mut ws, par).unwrap()
+                    };
+                    let from_list = step(MAX_LISTED);
+                    let walked = step(0);
+                    let at = format!("{at} {par:?}");
+                    assert!(from_list.step < 1.0, "{at}: some pair reaches its gap");
+                    assert_eq!(from_list.step, walked.step, "{at}");
+                    let (l, w) = (&from_list.limiting, &walked.limiting);
+                    assert!(!l.vertex_face.is_empty() || !l.edge_edge.is_empty(), "{at}");
+                    assert_eq!(l.vertex_face, w.vertex_face, "{at}");
+                    assert_eq!(l.edge_edge, w.edge_edge, "{at}");
+                    assert_eq!(l.toi, w.toi, "{at}");
+                    assert!(w.counters.bv_tests > l.counters.bv_tests, "{at}");
                 }
             }
         });

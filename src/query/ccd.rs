@@ -512,7 +512,7 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         }
     }
 
-    fn tree(&self) -> &'h RegionTree {
+    pub(crate) fn tree(&self) -> &'h RegionTree {
         self.h.tree()
     }
 
@@ -885,9 +885,11 @@ pub(crate) fn run<K: BoundingVolume>(
 }
 
 /// [`run`], and with `listing` the feature pairs met by its last pass that may reach their
-/// gap by the pass's horizon (a superset: see [`listed`]), when that pass's bounds were fitted short of the whole step
-/// (see [`listed`]): each such pass culls at the listing's distance for its horizon at
-/// least. `None` when no such pass ran or it met more pairs than the listing's `most`.
+/// gap by the pass's horizon (a superset, see [`listed`]), when that pass's bounds were
+/// fitted short of the whole step or the listing asks for whole-step passes too
+/// ([`Listing::whole_step`]): each such pass culls at the listing's distance for its
+/// horizon at least. `None` when no such pass ran or it met more pairs than the listing's
+/// `most`.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn run_passes<K: BoundingVolume>(
     a: &Swept<'_, K>,
@@ -914,8 +916,8 @@ pub(crate) fn run_passes<K: BoundingVolume>(
         };
         let restart_below = (best.is_some() && restarts < MAX_RESTARTS)
             .then(|| sa.horizon().min(sb.horizon()) / RESTART_FACTOR);
-        // Only a pass fitted short of the step lists (see `listed`).
-        let listing = listing.filter(|_| sa.horizon().min(sb.horizon()) < 1.0);
+        // A pass over the whole step lists only when the listing says so (see `listed`).
+        let listing = listing.filter(|l| l.whole_step || sa.horizon().min(sb.horizon()) < 1.0);
         let q = SweptQuery::new(
             sa,
             sb,

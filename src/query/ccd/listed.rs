@@ -10,7 +10,9 @@
 //! gap rule is then tested on that list ([`gap_over_listed`]), pair by pair on its exact
 //! motion as in the walk, instead of a second walk over nearly the same candidates; the
 //! larger culling distance costs the first walk little where `H` is small, which is where
-//! a pass lists (bounds fitted short of the whole step, [`super::run_passes`]).
+//! a pass lists (bounds fitted short of the whole step, [`super::run_passes`]), or where
+//! `c(1)` itself is small ([`Listing::whole_step`]: a step with no early impact then runs
+//! one walk, not two).
 //!
 //! The list is a superset: every pair the pass meets except those its batch cull proves
 //! unable to come within their gap by `H` ([`Gap::motion_cull`], in `f64` lanes). No exact
@@ -81,6 +83,8 @@ pub(crate) struct Listing<'a> {
     pub(crate) cull_for: &'a (dyn Fn(f64) -> f64 + Sync),
     pub(crate) gap: Gap,
     pub(crate) most: usize,
+    /// Passes over the whole step list too, not only those fitted short of it.
+    pub(crate) whole_step: bool,
 }
 
 /// The pairs a walk's tasks have listed, against [`Listing::most`].
