@@ -731,9 +731,18 @@ impl Gap {
         }
         let relative = relative_sq.sqrt() + 8.0 * f64::EPSILON * longest_sq.sqrt();
         // Within [0, t_max] (in earliest mode the best time so far) a vertex moves `t_max`
-        // of its displacement. Rounded up (each operation above is within a few ulps).
-        let reach =
-            (self.min_distance + relative * t_max / self.rescaling) * (1.0 + 16.0 * f64::EPSILON);
+        // of its displacement. The pair is kept at the rounded-up gap of `at_gap` (at most
+        // `g + 20 EPSILON d0`, see `motion_cull`), which it reaches only if `(s - 20
+        // EPSILON) d0 <= s dmin + A t`: divided by `s - 64 EPSILON`, as the motion cull's
+        // closing factor, so that no pair the exact test at that gap would find is refused
+        // (the walk and the list then find the same pairs). Rounded up (each operation
+        // above is within a few ulps).
+        let s = self.rescaling - 64.0 * f64::EPSILON;
+        if s <= 0.0 {
+            return true;
+        }
+        let reach = ((self.min_distance * self.rescaling + relative * t_max) / s)
+            * (1.0 + 16.0 * f64::EPSILON);
         !reach.is_finite() || within_at_start(vertex_face, x0, reach)
     }
 }
@@ -1741,6 +1750,51 @@ mod tests {
             );
         }
         assert!(ended > total / 4, "{ended} of {total}");
+    }
+
+    /// The reach test refuses only pairs that stay outside the gap they would be kept at
+    /// (the exact test at [`Gap::at_gap`] finds no contact up to `t_max`), for small
+    /// rescalings too, where the kept gap's rounding is largest against the rule's; and it
+    /// refuses a fair share (not vacuous).
+    #[test]
+    fn the_reach_test_refuses_only_pairs_outside_their_kept_gap() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut grid = |steps: u64, size: f64| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 33) % (2 * steps + 1)) as f64 * size - steps as f64 * size
+        };
+        let (mut refused, mut total) = (0u32, 0u32);
+        for case in 0..6000 {
+            let vf = case % 2 == 0;
+            let x0: [[f64; 3]; 4] =
+                std::array::from_fn(|_| std::array::from_fn(|_| grid(8, 0.125)));
+            let x1: [[f64; 3]; 4] =
+                std::array::from_fn(|i| std::array::from_fn(|k| x0[i][k] + grid(4, 1.0 / 32.0)));
+            let gap = Gap {
+                min_distance: [0.0, 1.0 / 64.0, 0.125][case % 3],
+                rescaling: [0.8, 0.5, 0.1, 0.25, 0.01][(case / 3) % 5],
+            };
+            let t_max = [1.0, 0.5, 0.2][(case / 15) % 3];
+            total += 1;
+            if gap.may_reach(vf, &x0, &x1, t_max) {
+                continue;
+            }
+            refused += 1;
+            let o = CcdOptions::new(t_max, 0.0).unwrap();
+            let at_gap = gap.at_gap(vf, &x0, o);
+            let exact = if vf {
+                crate::ccd::vertex_face_exact(&x0, &x1, &at_gap)
+            } else {
+                crate::ccd::edge_edge_exact(&x0, &x1, &at_gap)
+            };
+            assert_eq!(
+                exact, None,
+                "vf {vf} {x0:?} -> {x1:?} {gap:?} until {t_max}"
+            );
+        }
+        assert!(refused > total / 4, "{refused} of {total}");
     }
 
     /// A vertex 1 above a face closing in by `1 - g` reaches the rule's gap `g` exactly at
