@@ -405,6 +405,88 @@ mod tests {
         most
     }
 
+    /// A 12 x 12 jittered sheet folded onto itself at x = 0.6: its triangles, and its
+    /// positions with the far layer lifted `lift` above the near one, the jitter drawn from
+    /// `seed`.
+    fn folded_sheet(lift: f32, seed: u64) -> (Vec<[u32; 3]>, Vec<[f64; 3]>) {
+        use crate::shapes::{fold_x, grid, jitter};
+        let rest = grid(12, 12, 0.1, [0.0; 3]);
+        let jittered = jitter(&fold_x(rest.positions(), 0.6), [1e-3, 1e-3, 2e-4], seed);
+        let at = jittered.iter().zip(rest.positions());
+        let lifted = at.map(|(p, r)| [p[0], p[1], p[2] + if r[0] > 0.6 { lift } else { 0.0 }]);
+        let lifted = lifted.map(|p| p.map(f64::from)).collect();
+        (rest.triangles().to_vec(), lifted)
+    }
+
+    /// The rules the listing tests run: the IPC Toolkit's default, one with a minimum
+    /// distance, and a small rescaling (a large culling distance).
+    const RULES: [StepOptions; 3] = [
+        StepOptions {
+            min_distance: 0.0,
+            rescaling: 0.8,
+        },
+        StepOptions {
+            min_distance: 1e-4,
+            rescaling: 0.8,
+        },
+        StepOptions {
+            min_distance: 0.0,
+            rescaling: 0.5,
+        },
+    ];
+
+    /// The first impact's walk under `o` with its listing (`whole_step`: passes over the
+    /// whole step list too): its time and its list's pairs of each kind ([`Listed::counts`]),
+    /// which must be more than a few.
+    fn first_impact_listing<K: BoundingVolume>(
+        a: &Swept<'_, K>,
+        b: &Swept<'_, K>,
+        self_query: bool,
+        motions: &[Motion<'_>],
+        o: &StepOptions,
+        whole_step: bool,
+        at: &str,
+    ) -> (f64, [usize; 3]) {
+        let control = crate::control::Control::default();
+        let budget = Budget::new(&control);
+        let cull_for = |horizon: f64| cull_distance(o, motions, false, horizon);
+        let listing = Listing {
+            cull_for: &cull_for,
+            gap: Gap::of(o),
+            most: MAX_LISTED,
+            whole_step,
+        };
+        let mut ws = Workspace::default();
+        let (best, _, listed) = first_impact(
+            a,
+            b,
+            self_query,
+            o,
+            Some(&listing),
+            &budget,
+            &mut ws,
+            Par::Seq,
+        )
+        .unwrap();
+        let first = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
+        let listed = listed.unwrap_or_else(|| panic!("{at}: the last pass lists"));
+        assert!(listed.len() > 3, "{at}: {} pairs listed", listed.len());
+        (first, listed.counts())
+    }
+
+    /// The step from the list is the walk's, with the same limiting pairs, and the walk
+    /// tested nodes the list did not.
+    fn assert_list_matches_walk(from_list: &StepSize, walked: &StepSize, at: &str) {
+        assert_eq!(from_list.step, walked.step, "{at}");
+        let (l, w) = (&from_list.limiting, &walked.limiting);
+        assert_eq!(l.vertex_face, w.vertex_face, "{at}");
+        assert_eq!(l.face_vertex, w.face_vertex, "{at}");
+        assert_eq!(l.edge_edge, w.edge_edge, "{at}");
+        assert_eq!(l.toi, w.toi, "{at}");
+        // The walk's node tests are counted, the list's only its pairs.
+        assert!(w.counters.bv_tests > l.counters.bv_tests, "{at}");
+    }
+
     /// A jittered sheet folded onto itself, its far layer just above the near one at t0 and
     /// pushed through it by t1: the first impact comes early in the step, so its walk
     /// restarts on bounds fitted short of the step and its last pass lists its pairs. The
@@ -413,70 +495,29 @@ mod tests {
     /// thread count.
     #[test]
     fn the_listed_pairs_give_the_second_walks_step() {
-        use crate::shapes::{fold_x, grid, jitter};
         use crate::{Hierarchy, Mesh, Options};
-        let rest = grid(12, 12, 0.1, [0.0; 3]);
-        let far: Vec<bool> = rest.positions().iter().map(|p| p[0] > 0.6).collect();
-        let layered = |lift: f32, seed: u64| -> Vec<[f64; 3]> {
-            let folded = fold_x(rest.positions(), 0.6);
-            let jittered = jitter(&folded, [1e-3, 1e-3, 2e-4], seed);
-            let at = jittered.iter().zip(&far);
-            at.map(|(p, &f)| [p[0], p[1], p[2] + if f { lift } else { 0.0 }])
-                .map(|p| p.map(f64::from))
-                .collect()
-        };
-        let (x0, x1) = (layered(2e-3, 1), layered(-0.05, 2));
-        let m = Mesh::new_f64(x0.clone(), rest.triangles().to_vec()).unwrap();
-        let motion = Motion::new(&x0, &x1);
-        let rules = [
-            StepOptions::default(),
-            StepOptions {
-                min_distance: 1e-4,
-                rescaling: 0.8,
-            },
-            StepOptions {
-                min_distance: 0.0,
-                rescaling: 0.5,
-            },
-        ];
+        let (triangles, x0) = folded_sheet(2e-3, 1);
+        let (_, x1) = folded_sheet(-0.05, 2);
+        let m = Mesh::new_f64(x0.clone(), triangles).unwrap();
+        let motions = [Motion::new(&x0, &x1)];
         crate::for_each_method!(K => {
             let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
-            let s = Swept::new(&h, motion).unwrap();
-            for o in &rules {
-                let control = crate::control::Control::default();
-                let budget = Budget::new(&control);
-                let cull_for = |horizon: f64| cull_distance(o, &[motion], false, horizon);
-                let listing = Listing {
-                    cull_for: &cull_for,
-                    gap: Gap::of(o),
-                    most: MAX_LISTED,
-                    whole_step: false,
-                };
+            let s = Swept::new(&h, motions[0]).unwrap();
+            for o in &RULES {
+                let at = format!("{:?} {o:?}", K::METHOD);
+                let (first, listed) = first_impact_listing(&s, &s, true, &motions, o, false, &at);
+                assert!(first < 1.0 / 16.0, "{at}: the first impact at {first}");
                 let mut ws = Workspace::default();
-                let (best, _, listed) =
-                    first_impact(&s, &s, true, o, Some(&listing), &budget, &mut ws, Par::Seq)
-                        .unwrap();
-                let first = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
-                assert!(first < 1.0 / 16.0, "{:?} {o:?}: the first impact at {first}", K::METHOD);
-                let listed = listed.expect("the last pass was fitted short of the step").len();
-                assert!(listed > 3, "{:?} {o:?}: {listed} pairs listed", K::METHOD);
                 for par in [Par::Seq, Par::Rayon(2)] {
                     let mut step = |most: usize| {
-                        let motions = [motion];
                         step_between(&s, &s, true, &motions, o, most, &mut ws, par).unwrap()
                     };
                     let from_list = step(MAX_LISTED);
-                    for most in [0, 3, listed / 2] {
+                    for most in [0, 3, listed.iter().sum::<usize>() / 2] {
                         let walked = step(most);
-                        let at = format!("{:?} {o:?} {par:?} at most {most}", K::METHOD);
+                        let at = format!("{at} {par:?} at most {most}");
                         assert!(walked.step < 1.0, "{at}");
-                        assert_eq!(from_list.step, walked.step, "{at}");
-                        let (l, w) = (&from_list.limiting, &walked.limiting);
-                        assert_eq!(l.vertex_face, w.vertex_face, "{at}");
-                        assert_eq!(l.edge_edge, w.edge_edge, "{at}");
-                        assert_eq!(l.toi, w.toi, "{at}");
-                        // The walk's node tests are counted, the list's only its pairs.
-                        assert!(w.counters.bv_tests > l.counters.bv_tests, "{at}");
+                        assert_list_matches_walk(&from_list, &walked, &at);
                     }
                 }
             }
@@ -490,70 +531,76 @@ mod tests {
     /// same limiting pairs, for every method, rule and thread count.
     #[test]
     fn a_pass_over_the_whole_step_lists_when_the_motion_is_small() {
-        use crate::shapes::{fold_x, grid, jitter};
         use crate::{Hierarchy, Mesh, Options};
-        let rest = grid(12, 12, 0.1, [0.0; 3]);
-        let far: Vec<bool> = rest.positions().iter().map(|p| p[0] > 0.6).collect();
-        let jittered = jitter(&fold_x(rest.positions(), 0.6), [1e-3, 1e-3, 2e-4], 1);
-        let layered = |lift: f32| -> Vec<[f64; 3]> {
-            let at = jittered.iter().zip(&far);
-            at.map(|(p, &f)| [p[0], p[1], p[2] + if f { lift } else { 0.0 }])
-                .map(|p| p.map(f64::from))
-                .collect()
-        };
-        let (x0, x1) = (layered(2e-3), layered(6e-4));
-        let m = Mesh::new_f64(x0.clone(), rest.triangles().to_vec()).unwrap();
-        let motion = Motion::new(&x0, &x1);
-        let rules = [
-            StepOptions::default(),
-            StepOptions {
-                min_distance: 1e-4,
-                rescaling: 0.8,
-            },
-            StepOptions {
-                min_distance: 0.0,
-                rescaling: 0.5,
-            },
-        ];
+        let (triangles, x0) = folded_sheet(2e-3, 1);
+        let (_, x1) = folded_sheet(6e-4, 1);
+        let m = Mesh::new_f64(x0.clone(), triangles).unwrap();
+        let motions = [Motion::new(&x0, &x1)];
         crate::for_each_method!(K => {
             let h = Hierarchy::<K>::new(&m, Options::default()).unwrap();
-            let s = Swept::new(&h, motion).unwrap();
-            for o in &rules {
+            let s = Swept::new(&h, motions[0]).unwrap();
+            for o in &RULES {
                 let at = format!("{:?} {o:?}", K::METHOD);
-                assert!(lists_whole_step(&s, &s, true, &[motion], o), "{at}");
-                let control = crate::control::Control::default();
-                let budget = Budget::new(&control);
-                let cull_for = |horizon: f64| cull_distance(o, &[motion], false, horizon);
-                let listing = Listing {
-                    cull_for: &cull_for,
-                    gap: Gap::of(o),
-                    most: MAX_LISTED,
-                    whole_step: true,
-                };
-                let mut ws = Workspace::default();
-                let (best, _, listed) =
-                    first_impact(&s, &s, true, o, Some(&listing), &budget, &mut ws, Par::Seq)
-                        .unwrap();
-                let first = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
+                assert!(lists_whole_step(&s, &s, true, &motions, o), "{at}");
+                let (first, _) = first_impact_listing(&s, &s, true, &motions, o, true, &at);
                 assert_eq!(first, f64::INFINITY, "{at}: nothing touches");
-                let listed = listed.expect("the pass over the whole step lists").len();
-                assert!(listed > 3, "{at}: {listed} pairs listed");
+                let mut ws = Workspace::default();
                 for par in [Par::Seq, Par::Rayon(2)] {
                     let mut step = |most: usize| {
-                        let motions = [motion];
                         step_between(&s, &s, true, &motions, o, most, &mut ws, par).unwrap()
                     };
-                    let from_list = step(MAX_LISTED);
-                    let walked = step(0);
+                    let (from_list, walked) = (step(MAX_LISTED), step(0));
                     let at = format!("{at} {par:?}");
                     assert!(from_list.step < 1.0, "{at}: some pair reaches its gap");
-                    assert_eq!(from_list.step, walked.step, "{at}");
-                    let (l, w) = (&from_list.limiting, &walked.limiting);
+                    let l = &from_list.limiting;
                     assert!(!l.vertex_face.is_empty() || !l.edge_edge.is_empty(), "{at}");
-                    assert_eq!(l.vertex_face, w.vertex_face, "{at}");
-                    assert_eq!(l.edge_edge, w.edge_edge, "{at}");
-                    assert_eq!(l.toi, w.toi, "{at}");
-                    assert!(w.counters.bv_tests > l.counters.bv_tests, "{at}");
+                    assert_list_matches_walk(&from_list, &walked, &at);
+                }
+            }
+        });
+    }
+
+    /// Two separate sheets, the upper one closing from 2e-3 to 6e-4 above the lower (a pair
+    /// query): its pass over the whole step lists vertices of each against triangles of the
+    /// other, and the step from that list is the second walk's, for every method, rule and
+    /// thread count.
+    #[test]
+    fn a_pair_query_over_the_whole_step_lists_both_sides() {
+        use crate::shapes::{grid, jitter};
+        use crate::{Hierarchy, Mesh, Options};
+        let rest = grid(12, 12, 0.1, [0.0; 3]);
+        let sheet = |seed: u64, lift: f32| -> Vec<[f64; 3]> {
+            let jittered = jitter(rest.positions(), [1e-3, 1e-3, 2e-4], seed);
+            jittered
+                .iter()
+                .map(|p| [p[0], p[1], p[2] + lift].map(f64::from))
+                .collect()
+        };
+        let (low, high0, high1) = (sheet(1, 0.0), sheet(2, 2e-3), sheet(2, 6e-4));
+        let lower = Mesh::new_f64(low.clone(), rest.triangles().to_vec()).unwrap();
+        let upper = Mesh::new_f64(high0.clone(), rest.triangles().to_vec()).unwrap();
+        let motions = [Motion::new(&low, &low), Motion::new(&high0, &high1)];
+        crate::for_each_method!(K => {
+            let ha = Hierarchy::<K>::new(&lower, Options::default()).unwrap();
+            let hb = Hierarchy::<K>::new(&upper, Options::default()).unwrap();
+            let sa = Swept::new(&ha, motions[0]).unwrap();
+            let sb = Swept::new(&hb, motions[1]).unwrap();
+            for o in &RULES {
+                let at = format!("{:?} {o:?}", K::METHOD);
+                assert!(lists_whole_step(&sa, &sb, false, &motions, o), "{at}");
+                let (first, [vf, fv, ee]) =
+                    first_impact_listing(&sa, &sb, false, &motions, o, true, &at);
+                assert_eq!(first, f64::INFINITY, "{at}: nothing touches");
+                assert!(vf > 0 && fv > 0 && ee > 0, "{at}: listed {vf} {fv} {ee}");
+                let mut ws = Workspace::default();
+                for par in [Par::Seq, Par::Rayon(2)] {
+                    let mut step = |most: usize| {
+                        step_between(&sa, &sb, false, &motions, o, most, &mut ws, par).unwrap()
+                    };
+                    let (from_list, walked) = (step(MAX_LISTED), step(0));
+                    let at = format!("{at} {par:?}");
+                    assert!(from_list.step < 1.0, "{at}: some pair reaches its gap");
+                    assert_list_matches_walk(&from_list, &walked, &at);
                 }
             }
         });

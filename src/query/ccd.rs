@@ -1700,32 +1700,66 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
 mod tests {
     use super::*;
 
-    /// Under the step size's rule, every pair the motion cull ends (at [`Gap::motion_cull`]'s
-    /// distance and closing) stays outside the gap it would be kept at: the exact test at
-    /// that gap finds no contact up to the horizon. Motions on a coarse grid, so pairs that
-    /// reach their gap exactly are frequent; and the cull ends a fair share (not vacuous).
-    #[test]
-    fn the_motion_cull_keeps_every_pair_outside_its_gap() {
-        use dhcd_kernels::reference::moving_apart_beyond_motion;
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut grid = |steps: u64, size: f64| {
+    /// Pair motions on a coarse grid, so pairs that reach their gap exactly are frequent:
+    /// 6000 cases of (vertex-face?, x0, x1, rule, horizon), vertex-face and edge-edge
+    /// alternating, the rule's rescaling taken from `rescalings`.
+    fn coarse_grid_pairs(
+        seed: u64,
+        rescalings: &[f64],
+    ) -> impl Iterator<Item = (bool, [[f64; 3]; 4], [[f64; 3]; 4], Gap, f64)> + '_ {
+        let mut state = seed;
+        let mut grid = move |steps: u64, size: f64| {
             state = state
                 .wrapping_mul(6_364_136_223_846_793_005)
                 .wrapping_add(1_442_695_040_888_963_407);
             ((state >> 33) % (2 * steps + 1)) as f64 * size - steps as f64 * size
         };
-        let (mut ended, mut total) = (0u32, 0u32);
-        for case in 0..6000 {
-            let vf = case % 2 == 0;
+        (0..6000).map(move |case| {
             let x0: [[f64; 3]; 4] =
                 std::array::from_fn(|_| std::array::from_fn(|_| grid(8, 0.125)));
             let x1: [[f64; 3]; 4] =
                 std::array::from_fn(|i| std::array::from_fn(|k| x0[i][k] + grid(4, 1.0 / 32.0)));
             let gap = Gap {
                 min_distance: [0.0, 1.0 / 64.0, 0.125][case % 3],
-                rescaling: [0.8, 0.5, 1.0, 0.3][(case / 3) % 4],
+                rescaling: rescalings[(case / 3) % rescalings.len()],
             };
-            let t_max = [1.0, 0.5, 0.2][(case / 12) % 3];
+            let t_max = [1.0, 0.5, 0.2][(case / (3 * rescalings.len())) % 3];
+            (case % 2 == 0, x0, x1, gap, t_max)
+        })
+    }
+
+    /// The exact test at the gap `gap` keeps the pair at finds no contact up to `t_max`.
+    fn assert_stays_outside_kept_gap(
+        gap: &Gap,
+        vf: bool,
+        x0: &[[f64; 3]; 4],
+        x1: &[[f64; 3]; 4],
+        t_max: f64,
+    ) {
+        let o = CcdOptions::new(t_max, 0.0).unwrap();
+        let at_gap = gap.at_gap(vf, x0, o);
+        let exact = if vf {
+            crate::ccd::vertex_face_exact(x0, x1, &at_gap)
+        } else {
+            crate::ccd::edge_edge_exact(x0, x1, &at_gap)
+        };
+        assert_eq!(
+            exact, None,
+            "vf {vf} {x0:?} -> {x1:?} {gap:?} until {t_max}"
+        );
+    }
+
+    /// Under the step size's rule, every pair the motion cull ends (at [`Gap::motion_cull`]'s
+    /// distance and closing) stays outside the gap it would be kept at: the exact test at
+    /// that gap finds no contact up to the horizon; and the cull ends a fair share (not
+    /// vacuous).
+    #[test]
+    fn the_motion_cull_keeps_every_pair_outside_its_gap() {
+        use dhcd_kernels::reference::moving_apart_beyond_motion;
+        let (mut ended, mut total) = (0u32, 0u32);
+        for (vf, x0, x1, gap, t_max) in
+            coarse_grid_pairs(0x2545_f491_4f6c_dd1d, &[0.8, 0.5, 1.0, 0.3])
+        {
             let m = x0
                 .iter()
                 .chain(&x1)
@@ -1733,66 +1767,27 @@ mod tests {
                 .fold(0.0f64, |m, x| m.max(x.abs()));
             let (delta, closing) = gap.motion_cull().expect("a rule the cull serves");
             total += 1;
-            if !moving_apart_beyond_motion(&x0, &x1, vf, delta, closing, m, t_max) {
-                continue;
+            if moving_apart_beyond_motion(&x0, &x1, vf, delta, closing, m, t_max) {
+                ended += 1;
+                assert_stays_outside_kept_gap(&gap, vf, &x0, &x1, t_max);
             }
-            ended += 1;
-            let o = CcdOptions::new(t_max, 0.0).unwrap();
-            let at_gap = gap.at_gap(vf, &x0, o);
-            let exact = if vf {
-                crate::ccd::vertex_face_exact(&x0, &x1, &at_gap)
-            } else {
-                crate::ccd::edge_edge_exact(&x0, &x1, &at_gap)
-            };
-            assert_eq!(
-                exact, None,
-                "vf {vf} {x0:?} -> {x1:?} {gap:?} until {t_max}"
-            );
         }
         assert!(ended > total / 4, "{ended} of {total}");
     }
 
-    /// The reach test refuses only pairs that stay outside the gap they would be kept at
-    /// (the exact test at [`Gap::at_gap`] finds no contact up to `t_max`), for small
-    /// rescalings too, where the kept gap's rounding is largest against the rule's; and it
-    /// refuses a fair share (not vacuous).
+    /// The reach test refuses only pairs that stay outside the gap they would be kept at,
+    /// for small rescalings too, where the kept gap's rounding is largest against the
+    /// rule's; and it refuses a fair share (not vacuous).
     #[test]
     fn the_reach_test_refuses_only_pairs_outside_their_kept_gap() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut grid = |steps: u64, size: f64| {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            ((state >> 33) % (2 * steps + 1)) as f64 * size - steps as f64 * size
-        };
         let (mut refused, mut total) = (0u32, 0u32);
-        for case in 0..6000 {
-            let vf = case % 2 == 0;
-            let x0: [[f64; 3]; 4] =
-                std::array::from_fn(|_| std::array::from_fn(|_| grid(8, 0.125)));
-            let x1: [[f64; 3]; 4] =
-                std::array::from_fn(|i| std::array::from_fn(|k| x0[i][k] + grid(4, 1.0 / 32.0)));
-            let gap = Gap {
-                min_distance: [0.0, 1.0 / 64.0, 0.125][case % 3],
-                rescaling: [0.8, 0.5, 0.1, 0.25, 0.01][(case / 3) % 5],
-            };
-            let t_max = [1.0, 0.5, 0.2][(case / 15) % 3];
+        let rescalings = [0.8, 0.5, 0.1, 0.25, 0.01];
+        for (vf, x0, x1, gap, t_max) in coarse_grid_pairs(0x9e37_79b9_7f4a_7c15, &rescalings) {
             total += 1;
-            if gap.may_reach(vf, &x0, &x1, t_max) {
-                continue;
+            if !gap.may_reach(vf, &x0, &x1, t_max) {
+                refused += 1;
+                assert_stays_outside_kept_gap(&gap, vf, &x0, &x1, t_max);
             }
-            refused += 1;
-            let o = CcdOptions::new(t_max, 0.0).unwrap();
-            let at_gap = gap.at_gap(vf, &x0, o);
-            let exact = if vf {
-                crate::ccd::vertex_face_exact(&x0, &x1, &at_gap)
-            } else {
-                crate::ccd::edge_edge_exact(&x0, &x1, &at_gap)
-            };
-            assert_eq!(
-                exact, None,
-                "vf {vf} {x0:?} -> {x1:?} {gap:?} until {t_max}"
-            );
         }
         assert!(refused > total / 4, "{refused} of {total}");
     }

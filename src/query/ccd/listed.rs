@@ -68,6 +68,16 @@ impl Listed {
         self.vertex_face.len() + self.face_vertex.len() + self.edge_edge.len()
     }
 
+    /// Pairs held of each kind: vertex-face, face-vertex, edge-edge.
+    #[cfg(test)]
+    pub(crate) fn counts(&self) -> [usize; 3] {
+        [
+            self.vertex_face.len(),
+            self.face_vertex.len(),
+            self.edge_edge.len(),
+        ]
+    }
+
     /// `other`'s pairs after this one's.
     pub(super) fn append(&mut self, mut other: Listed) {
         self.vertex_face.append(&mut other.vertex_face);
@@ -144,16 +154,16 @@ pub(crate) fn gap_over_listed<K: BoundingVolume>(
         &listed.vertex_face,
         true,
         par,
-        SweptQuery::vertex_face_poses,
-        SweptQuery::vertex_face,
+        SweptQuery::vertex_face_poses::<false>,
+        SweptQuery::vertex_face::<false>,
     );
     q.merge(&mut out, vertex_face);
     let face_vertex = q.each_listed(
         &listed.face_vertex,
         true,
         par,
-        SweptQuery::face_vertex_poses,
-        SweptQuery::face_vertex,
+        SweptQuery::vertex_face_poses::<true>,
+        SweptQuery::vertex_face::<true>,
     );
     q.merge(&mut out, face_vertex);
     let edge_edge = q.each_listed(
@@ -174,7 +184,7 @@ pub(crate) fn gap_over_listed<K: BoundingVolume>(
     Ok(q.impacts(out, counters))
 }
 
-impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
+impl<'s, 'h, K: BoundingVolume> SweptQuery<'s, 'h, K> {
     /// The gap rule on each of `pairs` (`vf`: vertex-triangle pairs) into one output, in
     /// tasks of [`LISTED_PER_TASK`] pairs when `par` is parallel (outputs merged in task
     /// order): `points` reads a pair's two poses, `report` records its impact.
@@ -220,16 +230,25 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         self.pair_toi_with(vertex_face, x0, x1, &o)
     }
 
-    /// A listed vertex of `a` and triangle of `b`: its poses.
+    /// The sides holding a listed pair's vertex and triangle: `a` and `b`, or `b` and `a`
+    /// when `flipped` (a vertex of `b` against a triangle of `a`, pair queries only).
     #[inline(always)]
-    fn vertex_face_poses(&self, &[v, t]: &[u32; 2]) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
-        vertex_face_points(self.a, v as usize, self.b, t as usize)
+    fn vertex_and_face_sides(&self, flipped: bool) -> (&'s Swept<'h, K>, &'s Swept<'h, K>) {
+        if flipped {
+            (self.b, self.a)
+        } else {
+            (self.a, self.b)
+        }
     }
 
-    /// A listed vertex of `b` and triangle of `a` (pair queries): its poses.
+    /// A listed vertex and triangle (of `b` and `a` when `FLIPPED`): its poses.
     #[inline(always)]
-    fn face_vertex_poses(&self, &[v, t]: &[u32; 2]) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
-        vertex_face_points(self.b, v as usize, self.a, t as usize)
+    fn vertex_face_poses<const FLIPPED: bool>(
+        &self,
+        &[v, t]: &[u32; 2],
+    ) -> ([[f64; 3]; 4], [[f64; 3]; 4]) {
+        let (sv, st) = self.vertex_and_face_sides(FLIPPED);
+        vertex_face_points(sv, v as usize, st, t as usize)
     }
 
     /// A listed edge of `a` and edge of `b`: its poses.
@@ -238,27 +257,28 @@ impl<K: BoundingVolume> SweptQuery<'_, '_, K> {
         edge_edge_points(self.a, ea, self.b, eb)
     }
 
-    /// A listed vertex of `a` against a triangle of `b` reaches its gap at `toi`.
+    /// A listed vertex and triangle (of `b` and `a` when `FLIPPED`) reach their gap at
+    /// `toi`: a vertex-face impact, or a face-vertex one when flipped.
     #[inline(always)]
-    fn vertex_face(&self, &[v, t]: &[u32; 2], toi: f64, out: &mut ImpactOut) {
-        let impact = VertexImpact {
-            vertex: self.a.tree().vert_order()[v as usize],
-            triangle: self.b.tree().tri_order()[t as usize],
-            toi,
-        };
-        self.budget.push(&mut out.vertex_face, impact);
-    }
-
-    /// A listed vertex of `b` against a triangle of `a` (pair queries) reaches its gap at
-    /// `toi`.
-    #[inline(always)]
-    fn face_vertex(&self, &[v, t]: &[u32; 2], toi: f64, out: &mut ImpactOut) {
-        let impact = FaceImpact {
-            triangle: self.a.tree().tri_order()[t as usize],
-            vertex: self.b.tree().vert_order()[v as usize],
-            toi,
-        };
-        self.budget.push(&mut out.face_vertex, impact);
+    fn vertex_face<const FLIPPED: bool>(&self, &[v, t]: &[u32; 2], toi: f64, out: &mut ImpactOut) {
+        let (sv, st) = self.vertex_and_face_sides(FLIPPED);
+        let vertex = sv.tree().vert_order()[v as usize];
+        let triangle = st.tree().tri_order()[t as usize];
+        if FLIPPED {
+            let impact = FaceImpact {
+                triangle,
+                vertex,
+                toi,
+            };
+            self.budget.push(&mut out.face_vertex, impact);
+        } else {
+            let impact = VertexImpact {
+                vertex,
+                triangle,
+                toi,
+            };
+            self.budget.push(&mut out.vertex_face, impact);
+        }
     }
 
     /// A listed edge of `a` against an edge of `b` reaches its gap at `toi`.
