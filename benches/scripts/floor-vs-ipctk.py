@@ -174,7 +174,7 @@ def tables(rows):
 
 rows = [measure(*c) for c in (([] if a.no_real else real_frames()) + sheets() + degenerate(a.n))]
 commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                        cwd=here).stdout.strip()
+                        cwd=os.path.dirname(os.path.abspath(__file__))).stdout.strip()
 load = open("/proc/loadavg").read().split()[:3]
 
 
