@@ -436,8 +436,8 @@ mod tests {
     ];
 
     /// The first impact's walk under `o` with its listing (`whole_step`: passes over the
-    /// whole step list too): its time and its list's pairs of each kind ([`Listed::counts`]),
-    /// which must be more than a few.
+    /// whole step list too): its time, its list's pairs of each kind ([`Listed::counts`]),
+    /// which must be more than a few, and the candidates its passes met.
     fn first_impact_listing<K: BoundingVolume>(
         a: &Swept<'_, K>,
         b: &Swept<'_, K>,
@@ -446,7 +446,7 @@ mod tests {
         o: &StepOptions,
         whole_step: bool,
         at: &str,
-    ) -> (f64, [usize; 3]) {
+    ) -> (f64, [usize; 3], u64) {
         let control = crate::control::Control::default();
         let budget = Budget::new(&control);
         let cull_for = |horizon: f64| cull_distance(o, motions, false, horizon);
@@ -457,7 +457,7 @@ mod tests {
             whole_step,
         };
         let mut ws = Workspace::default();
-        let (best, _, listed) = first_impact(
+        let (best, work, listed) = first_impact(
             a,
             b,
             self_query,
@@ -471,7 +471,7 @@ mod tests {
         let first = f64::from_bits(best.load(std::sync::atomic::Ordering::Relaxed));
         let listed = listed.unwrap_or_else(|| panic!("{at}: the last pass lists"));
         assert!(listed.len() > 3, "{at}: {} pairs listed", listed.len());
-        (first, listed.counts())
+        (first, listed.counts(), work.prim_tests)
     }
 
     /// The step from the list is the walk's, with the same limiting pairs, and the walk
@@ -505,7 +505,8 @@ mod tests {
             let s = Swept::new(&h, motions[0]).unwrap();
             for o in &RULES {
                 let at = format!("{:?} {o:?}", K::METHOD);
-                let (first, listed) = first_impact_listing(&s, &s, true, &motions, o, false, &at);
+                let (first, listed, _) =
+                    first_impact_listing(&s, &s, true, &motions, o, false, &at);
                 assert!(first < 1.0 / 16.0, "{at}: the first impact at {first}");
                 let mut ws = Workspace::default();
                 for par in [Par::Seq, Par::Rayon(2)] {
@@ -542,8 +543,13 @@ mod tests {
             for o in &RULES {
                 let at = format!("{:?} {o:?}", K::METHOD);
                 assert!(lists_whole_step(&s, &s, true, &motions, o), "{at}");
-                let (first, _) = first_impact_listing(&s, &s, true, &motions, o, true, &at);
+                let (first, listed, met) =
+                    first_impact_listing(&s, &s, true, &motions, o, true, &at);
                 assert_eq!(first, f64::INFINITY, "{at}: nothing touches");
+                // One pass (no impact, no restart): its batch cull ended some of the
+                // candidates it met.
+                let listed: usize = listed.iter().sum();
+                assert!((listed as u64) < met, "{at}: listed {listed} of {met} candidates");
                 let mut ws = Workspace::default();
                 for par in [Par::Seq, Par::Rayon(2)] {
                     let mut step = |most: usize| {
@@ -588,10 +594,12 @@ mod tests {
             for o in &RULES {
                 let at = format!("{:?} {o:?}", K::METHOD);
                 assert!(lists_whole_step(&sa, &sb, false, &motions, o), "{at}");
-                let (first, [vf, fv, ee]) =
+                let (first, [vf, fv, ee], met) =
                     first_impact_listing(&sa, &sb, false, &motions, o, true, &at);
                 assert_eq!(first, f64::INFINITY, "{at}: nothing touches");
                 assert!(vf > 0 && fv > 0 && ee > 0, "{at}: listed {vf} {fv} {ee}");
+                let listed = (vf + fv + ee) as u64;
+                assert!(listed < met, "{at}: listed {listed} of {met} candidates");
                 let mut ws = Workspace::default();
                 for par in [Par::Seq, Par::Rayon(2)] {
                     let mut step = |most: usize| {
