@@ -175,9 +175,13 @@ pub(crate) fn positions_at(x0: &Points, x1: &Points, t: f64) -> Points {
 }
 
 /// The features certainly farther than `delta` apart along `c` at every time of `[lo, hi]`,
-/// from their poses at `lo` and `hi` interpolated by [`positions_at`] (the gap is concave on
-/// any time interval). `m`: at least the query's largest coordinate magnitude; nothing is
-/// certified outside `[2^-400, 2^400]`.
+/// from their poses at `lo` and `hi` (the gap is concave on any time interval). `m`: at
+/// least every exact coordinate's magnitude over the motion (the query's largest, or the
+/// largest relative to a corner when the poses are taken relative to it: a translation at
+/// each time changes no gap), each given coordinate within `8.1 u m` of the exact one
+/// ([`positions_at`]: `5.01 u m`); nothing is certified outside `[2^-400, 2^400]`. The
+/// bound's `32 u m C` holds for such poses: each projection is within `(8.1 + 3.01) u m C`,
+/// the gap within twice that plus `2.01 u m C` for its own rounding, `24.3 u m C`.
 #[inline(always)]
 pub(crate) fn apart_between(
     vf: bool,

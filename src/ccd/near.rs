@@ -36,14 +36,20 @@
 //! Otherwise (the distance touches `delta` without crossing it, or crosses it too slowly
 //! for floats to place within `2^-40`), the query is left to the exact path.
 //!
-//! **Relative corners.** The interval tests and the float estimates see the corners
-//! relative to the first one as it moves (`x_i(t) - x_0(t)`, the same distances): their
-//! rounding is a few ulps of the features' extent (each corner's distance from the first),
-//! not of the coordinates. A feature a hundredth of the mesh's size approaching at a few
-//! `delta` per step is then placed within `2^-40`; enclosed at the coordinates' magnitude
-//! it was not, and took the exact path. The fixed-axis test (`axis.rs`) still rounds at the
-//! coordinates' magnitude, which is what bounds how close before the estimate its piece
-//! can end ([`ESTIMATE_LEAD`]).
+//! **Relative corners.** Every test and estimate sees the corners relative to the first
+//! one as it moves (`x_i(t) - x_0(t)`, the same distances, still moving on straight lines):
+//! their rounding is a few ulps of the features' extent (each corner's distance from the
+//! first), not of the coordinates. A feature a hundredth of the mesh's size approaching at a
+//! few `delta` per step is then placed within `2^-40`; enclosed at the coordinates'
+//! magnitude it was not, and took the exact path. The fixed-axis test (`axis.rs`) reads the
+//! relative poses in plain floats too, each coordinate within `8.03 u R` of the exact one
+//! (`R` the extent, [`Relative::extent`]), inside the error its bound allows at magnitude
+//! `R`. What still bounds how close before a slow crossing a piece can be certified is the
+//! axis itself: the float closest direction's angle error spreads each feature's
+//! projection by about its length times that error, which a pair closing at a small
+//! fraction of its corners' relative speed does not clear [`ESTIMATE_LEAD`] before the
+//! crossing; the piece up to the estimate is then halved down to the leaves (~90 pieces,
+//! most of the time of a contact step at `delta > 0` on cloth resting on a body).
 //!
 //! Every test compares squared distances times a positive squared length with `delta^2`, so no
 //! division or square root is needed, and uses only these facts:
@@ -92,9 +98,14 @@ const PROBES: u32 = 16;
 struct Relative {
     y0: [V3<Iv>; 4],
     u: [V3<Iv>; 4],
-    /// The same in plain floats, for the estimates that steer the search.
+    /// The same in plain floats: for the estimates that steer the search, and the poses of
+    /// the fixed-axis test ([`Relative::poses_at`]).
     y0_float: [P3; 4],
     u_float: [P3; 4],
+    /// At least every exact relative coordinate at both ends, `|x_i - x_0|` per axis at t0
+    /// and at t1 (so at every time between), rounded up: the magnitude the fixed-axis test's
+    /// rounding is bounded at.
+    extent: f64,
 }
 
 impl Relative {
@@ -121,11 +132,19 @@ impl Relative {
         let u_float = std::array::from_fn(|i| {
             std::array::from_fn(|k| (x1[i][k] - x1[0][k]) - (x0[i][k] - x0[0][k]))
         });
+        // Each difference is correctly rounded, so within a factor `1 + 2^-53` of the exact
+        // one: `1 + 2^-50` covers it.
+        let largest = (1..4)
+            .flat_map(|i| (0..3).map(move |k| (i, k)))
+            .map(|(i, k)| (x0[i][k] - x0[0][k]).abs().max((x1[i][k] - x1[0][k]).abs()))
+            .fold(0.0f64, f64::max);
+        let extent = (largest * (1.0 + 4.0 * f64::EPSILON)).next_up();
         Relative {
             y0,
             u,
             y0_float,
             u_float,
+            extent,
         }
     }
 
@@ -135,6 +154,17 @@ impl Relative {
         std::array::from_fn(|i| {
             std::array::from_fn(|k| self.y0_float[i][k] + t * self.u_float[i][k])
         })
+    }
+
+    /// The corners at `t` in `[0, 1]` for the fixed-axis test: [`Relative::estimate_at`],
+    /// each coordinate within `8.03 u R` of the exact one (`u = 2^-53`, `R` the
+    /// [`Relative::extent`]): the differences `A = x0_i - x0_0` and `B = x1_i - x1_0` are each
+    /// within `u R`, `fl(B) - fl(A)` within `4.01 u R` of `B - A` after its own rounding, its
+    /// product by `t` within `6.02 u R` of `t (B - A)`, and the sum within `7.02 u R` before its
+    /// last rounding (`1.01 u R`). `axis::apart_between` allows for that at magnitude `R`.
+    #[inline(always)]
+    fn poses_at(&self, t: f64) -> [P3; 4] {
+        self.estimate_at(t)
     }
 
     /// Encloses the corners at every time of `t`.
@@ -182,17 +212,13 @@ pub(crate) fn decide(
         return Verdict::Hit(0.0);
     }
     let speed = max_relative_speed(vf, x0, x1);
-    let magnitude = super::max_magnitude(x0, x1);
     // `[lo, hi]` certainly apart, `c` the features' closest direction at `hi` (plain
     // floats): along `c` as a fixed axis; by the Lipschitz bound from `mid`; or with the
     // corners enclosed over the whole piece, sharper where they slide past each other fast
     // at a nearly constant distance (then the speed is large and the margin wide).
     let apart_over = |lo: f64, hi: f64, c: &P3| {
-        let poses = (
-            &axis::positions_at(x0, x1, lo),
-            &axis::positions_at(x0, x1, hi),
-        );
-        if axis::apart_between(vf, poses, c, delta, magnitude) {
+        let poses = (&relative.poses_at(lo), &relative.poses_at(hi));
+        if axis::apart_between(vf, poses, c, delta, relative.extent) {
             return true;
         }
         let mid = 0.5 * (lo + hi);
@@ -781,5 +807,65 @@ mod tests {
         }
         // Most come within delta inside the step (the rest never do, or start within it).
         assert!(hits * 2 > total, "{hits} of {total}");
+    }
+
+    /// Edge pairs of cloth-ball 92 -> 93 at min distance 1e-3, scaled to unit magnitude (as
+    /// the filter sees them): cloth resting on the ball, the edges closing at a small
+    /// fraction of their corners' relative speed, so the piece up to the estimate cannot be
+    /// certified in one and is halved down to the leaves. Still decided in floats, at the
+    /// exact path's time.
+    #[test]
+    fn slow_crossings_of_cloth_on_a_body_are_decided_at_the_exact_time() {
+        let cases: [(f64, Q, Q); 3] = [
+            (
+                0.000125,
+                [
+                    [0.31500986218452454, 1.0018688440322876, 0.5700922608375549],
+                    [0.31031137704849243, 0.9655402302742004, 0.5494006276130676],
+                    [0.33802250027656555, 0.9691216349601746, 0.5384153723716736],
+                    [0.30778101086616516, 0.9696661233901978, 0.5540878772735596],
+                ],
+                [
+                    [0.36078113317489624, 1.005311131477356, 0.5447271466255188],
+                    [0.3570365011692047, 0.9673414826393127, 0.5208415985107422],
+                    [0.3827912509441376, 0.9708395004272461, 0.5041888952255249],
+                    [0.3561403751373291, 0.9723827242851257, 0.5232808589935303],
+                ],
+            ),
+            (
+                0.00025,
+                [
+                    [1.0884745121002197, 0.9406185150146484, 0.2342892438173294],
+                    [1.0868264436721802, 0.8939495086669922, 0.26079151034355164],
+                    [1.0429060459136963, 0.8931862711906433, 0.27221348881721497],
+                    [1.0905817747116089, 0.9065985083580017, 0.25620025396347046],
+                ],
+                [
+                    [1.1147245168685913, 0.9471560120582581, 0.13657300174236298],
+                    [1.117666482925415, 0.9008902311325073, 0.15845650434494019],
+                    [1.0781562328338623, 0.893862247467041, 0.17393074929714203],
+                    [1.117993950843811, 0.9086407423019409, 0.1482515037059784],
+                ],
+            ),
+            (
+                0.00025,
+                [
+                    [1.0666261911392212, 0.9302307367324829, 0.27342474460601807],
+                    [1.0905817747116089, 0.9065985083580017, 0.25620025396347046],
+                    [1.0884745121002197, 0.9406185150146484, 0.2342892438173294],
+                    [1.0868264436721802, 0.8939495086669922, 0.26079151034355164],
+                ],
+                [
+                    [1.1001527309417725, 0.9321942329406738, 0.17490075528621674],
+                    [1.117993950843811, 0.9086407423019409, 0.1482515037059784],
+                    [1.1147245168685913, 0.9471560120582581, 0.13657300174236298],
+                    [1.117666482925415, 0.9008902311325073, 0.15845650434494019],
+                ],
+            ),
+        ];
+        for (delta, x0, x1) in &cases {
+            let verdict = decided_as_exact(false, x0, x1, 1.0, *delta);
+            assert!(matches!(verdict, Verdict::Hit(t) if t > 0.0), "{verdict:?}");
+        }
     }
 }
