@@ -99,7 +99,7 @@ struct Relative {
     y0: [V3<Iv>; 4],
     u: [V3<Iv>; 4],
     /// The same in plain floats: for the estimates that steer the search, and the poses of
-    /// the fixed-axis test ([`Relative::poses_at`]).
+    /// the fixed-axis test ([`Relative::estimate_at`]).
     y0_float: [P3; 4],
     u_float: [P3; 4],
     /// At least every exact relative coordinate at both ends, `|x_i - x_0|` per axis at t0
@@ -136,7 +136,7 @@ impl Relative {
         // one: `1 + 2^-50` covers it.
         let largest = (1..4)
             .flat_map(|i| (0..3).map(move |k| (i, k)))
-            .map(|(i, k)| (x0[i][k] - x0[0][k]).abs().max((x1[i][k] - x1[0][k]).abs()))
+            .map(|(i, k)| y0_float[i][k].abs().max((x1[i][k] - x1[0][k]).abs()))
             .fold(0.0f64, f64::max);
         let extent = (largest * (1.0 + 4.0 * f64::EPSILON)).next_up();
         Relative {
@@ -148,23 +148,18 @@ impl Relative {
         }
     }
 
-    /// The corners at `t` in plain floats (no guarantee: for estimates).
+    /// The corners at `t` in `[0, 1]` in plain floats: the poses the estimates steer by,
+    /// and those of the fixed-axis test, which relies on their bound: each coordinate within
+    /// `8.03 u R` of the exact one (`u = 2^-53`, `R` the [`Relative::extent`]). The
+    /// differences `A = x0_i - x0_0` and `B = x1_i - x1_0` are each within `u R`, `fl(B) -
+    /// fl(A)` within `4.01 u R` of `B - A` after its own rounding, its product by `t` within
+    /// `6.02 u R` of `t (B - A)`, and the sum within `7.02 u R` before its last rounding
+    /// (`1.01 u R`). `axis::apart_between` allows for that at magnitude `R`.
     #[inline(always)]
     fn estimate_at(&self, t: f64) -> [P3; 4] {
         std::array::from_fn(|i| {
             std::array::from_fn(|k| self.y0_float[i][k] + t * self.u_float[i][k])
         })
-    }
-
-    /// The corners at `t` in `[0, 1]` for the fixed-axis test: [`Relative::estimate_at`],
-    /// each coordinate within `8.03 u R` of the exact one (`u = 2^-53`, `R` the
-    /// [`Relative::extent`]): the differences `A = x0_i - x0_0` and `B = x1_i - x1_0` are each
-    /// within `u R`, `fl(B) - fl(A)` within `4.01 u R` of `B - A` after its own rounding, its
-    /// product by `t` within `6.02 u R` of `t (B - A)`, and the sum within `7.02 u R` before its
-    /// last rounding (`1.01 u R`). `axis::apart_between` allows for that at magnitude `R`.
-    #[inline(always)]
-    fn poses_at(&self, t: f64) -> [P3; 4] {
-        self.estimate_at(t)
     }
 
     /// Encloses the corners at every time of `t`.
@@ -217,7 +212,7 @@ pub(crate) fn decide(
     // corners enclosed over the whole piece, sharper where they slide past each other fast
     // at a nearly constant distance (then the speed is large and the margin wide).
     let apart_over = |lo: f64, hi: f64, c: &P3| {
-        let poses = (&relative.poses_at(lo), &relative.poses_at(hi));
+        let poses = (&relative.estimate_at(lo), &relative.estimate_at(hi));
         if axis::apart_between(vf, poses, c, delta, relative.extent) {
             return true;
         }

@@ -487,6 +487,43 @@ mod tests {
         assert!(w.counters.bv_tests > l.counters.bv_tests, "{at}");
     }
 
+    /// A step where nothing touches but pairs reach their gap, its relative motion small:
+    /// the first impact's one pass over the whole step lists (fewer pairs than it met: its
+    /// batch cull ended some), and the step from that list, below 1 with some limiting pair,
+    /// is the second walk's on 1 and 2 threads. Returns the list's pairs of each kind.
+    fn assert_whole_step_list_matches_walk<K: BoundingVolume>(
+        a: &Swept<'_, K>,
+        b: &Swept<'_, K>,
+        self_query: bool,
+        motions: &[Motion<'_>],
+        o: &StepOptions,
+        at: &str,
+    ) -> [usize; 3] {
+        assert!(lists_whole_step(a, b, self_query, motions, o), "{at}");
+        let (first, listed, met) = first_impact_listing(a, b, self_query, motions, o, true, at);
+        assert_eq!(first, f64::INFINITY, "{at}: nothing touches");
+        // One pass (no impact, no restart).
+        let total: usize = listed.iter().sum();
+        assert!(
+            (total as u64) < met,
+            "{at}: listed {total} of {met} candidates"
+        );
+        let mut ws = Workspace::default();
+        for par in [Par::Seq, Par::Rayon(2)] {
+            let mut step = |most: usize| {
+                step_between(a, b, self_query, motions, o, most, &mut ws, par).unwrap()
+            };
+            let (from_list, walked) = (step(MAX_LISTED), step(0));
+            let at = format!("{at} {par:?}");
+            assert!(from_list.step < 1.0, "{at}: some pair reaches its gap");
+            let l = &from_list.limiting;
+            let limited = l.vertex_face.len() + l.face_vertex.len() + l.edge_edge.len();
+            assert!(limited > 0, "{at}: no limiting pair");
+            assert_list_matches_walk(&from_list, &walked, &at);
+        }
+        listed
+    }
+
     /// A jittered sheet folded onto itself, its far layer just above the near one at t0 and
     /// pushed through it by t1: the first impact comes early in the step, so its walk
     /// restarts on bounds fitted short of the step and its last pass lists its pairs. The
@@ -542,26 +579,7 @@ mod tests {
             let s = Swept::new(&h, motions[0]).unwrap();
             for o in &RULES {
                 let at = format!("{:?} {o:?}", K::METHOD);
-                assert!(lists_whole_step(&s, &s, true, &motions, o), "{at}");
-                let (first, listed, met) =
-                    first_impact_listing(&s, &s, true, &motions, o, true, &at);
-                assert_eq!(first, f64::INFINITY, "{at}: nothing touches");
-                // One pass (no impact, no restart): its batch cull ended some of the
-                // candidates it met.
-                let listed: usize = listed.iter().sum();
-                assert!((listed as u64) < met, "{at}: listed {listed} of {met} candidates");
-                let mut ws = Workspace::default();
-                for par in [Par::Seq, Par::Rayon(2)] {
-                    let mut step = |most: usize| {
-                        step_between(&s, &s, true, &motions, o, most, &mut ws, par).unwrap()
-                    };
-                    let (from_list, walked) = (step(MAX_LISTED), step(0));
-                    let at = format!("{at} {par:?}");
-                    assert!(from_list.step < 1.0, "{at}: some pair reaches its gap");
-                    let l = &from_list.limiting;
-                    assert!(!l.vertex_face.is_empty() || !l.edge_edge.is_empty(), "{at}");
-                    assert_list_matches_walk(&from_list, &walked, &at);
-                }
+                assert_whole_step_list_matches_walk(&s, &s, true, &motions, o, &at);
             }
         });
     }
@@ -593,23 +611,9 @@ mod tests {
             let sb = Swept::new(&hb, motions[1]).unwrap();
             for o in &RULES {
                 let at = format!("{:?} {o:?}", K::METHOD);
-                assert!(lists_whole_step(&sa, &sb, false, &motions, o), "{at}");
-                let (first, [vf, fv, ee], met) =
-                    first_impact_listing(&sa, &sb, false, &motions, o, true, &at);
-                assert_eq!(first, f64::INFINITY, "{at}: nothing touches");
+                let [vf, fv, ee] =
+                    assert_whole_step_list_matches_walk(&sa, &sb, false, &motions, o, &at);
                 assert!(vf > 0 && fv > 0 && ee > 0, "{at}: listed {vf} {fv} {ee}");
-                let listed = (vf + fv + ee) as u64;
-                assert!(listed < met, "{at}: listed {listed} of {met} candidates");
-                let mut ws = Workspace::default();
-                for par in [Par::Seq, Par::Rayon(2)] {
-                    let mut step = |most: usize| {
-                        step_between(&sa, &sb, false, &motions, o, most, &mut ws, par).unwrap()
-                    };
-                    let (from_list, walked) = (step(MAX_LISTED), step(0));
-                    let at = format!("{at} {par:?}");
-                    assert!(from_list.step < 1.0, "{at}: some pair reaches its gap");
-                    assert_list_matches_walk(&from_list, &walked, &at);
-                }
             }
         });
     }
