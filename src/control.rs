@@ -190,8 +190,11 @@ impl<'c> Budget<'c> {
         false
     }
 
-    /// `Ok` if the query ran to the end, else why it stopped.
+    /// `Ok` if the query ran to the end, else why it stopped. A cancel flag set by now
+    /// cancels the query however little work it had (a walk that proved every node clear
+    /// never stops to look).
     pub(crate) fn finish(&self) -> Result<()> {
+        self.stopped();
         match self.stop.load(Ordering::Relaxed) {
             RUNNING => Ok(()),
             CANCELLED => Err(Error::Cancelled),

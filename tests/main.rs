@@ -8,6 +8,7 @@ mod ccd_reference;
 mod ccd_samples;
 mod ccd_wide;
 mod central;
+mod clearance;
 mod contact_set;
 mod control;
 mod distance;

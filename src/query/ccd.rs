@@ -1337,6 +1337,21 @@ impl<'s, 'h, K: BoundingVolume> Query for SweptQuery<'s, 'h, K> {
         K::swept_extent(block, i)
     }
 
+    /// Clear when no pair of the node comes within the walk's culling distance by its
+    /// horizon, on the exact motion.
+    #[inline(always)]
+    fn clear(&self, x: usize) -> bool {
+        let step = self.a.step.as_ref();
+        super::clearance::motion_is_clear(
+            self.a.tree(),
+            x,
+            &step.x0,
+            &step.x1,
+            self.horizon,
+            self.cull,
+        )
+    }
+
     #[inline(always)]
     fn leaf_pair<S: Simd>(
         &self,

@@ -9,13 +9,16 @@
 //! - `ccd.rs`: continuous collision detection over a step ([`ccd_pair`], [`self_ccd`]): every
 //!   vertex-triangle and edge-edge pair that touches during the step with its time of
 //!   impact, or the earliest time, on the bounds of each region over the step;
-//! - `features.rs`: the feature boxes and their SIMD culling that proximity and CCD share.
+//! - `features.rs`: the feature boxes and their SIMD culling that proximity and CCD share;
+//! - `clearance.rs`: the proof that a node of a self query holds no feature pair within the
+//!   query's distance, so that its walk is skipped (proximity and CCD).
 //!
 //! Queries on the current pose share `Posed`: two hierarchies' lazily fitted volumes and a
 //! node test (`Overlap`, or `Within` a distance); they differ in the leaf action. CCD
 //! implements the walk's `Query` itself, on the bounds over a step.
 
 pub(crate) mod ccd;
+pub(crate) mod clearance;
 pub(crate) mod contacts;
 mod features;
 pub(crate) mod proximity;
@@ -149,6 +152,11 @@ pub(crate) trait LeafAction<'h, K: BoundingVolume>: Sync {
         out: &mut Self::Out,
     );
     fn merge(&self, out: &mut Self::Out, other: Self::Out);
+    /// See [`Query::clear`].
+    #[inline(always)]
+    fn clear<T: NodeTest>(&self, _posed: &Posed<'h, K, T>, _x: usize) -> bool {
+        false
+    }
     /// See [`Query::stopped`].
     #[inline(always)]
     fn stopped(&self, _poll: bool) -> bool {
@@ -210,6 +218,11 @@ impl<'h, K: BoundingVolume, T: NodeTest, L: LeafAction<'h, K>> Query for PosedQu
 
     fn merge(&self, out: &mut L::Out, other: L::Out) {
         self.action.merge(out, other)
+    }
+
+    #[inline(always)]
+    fn clear(&self, x: usize) -> bool {
+        self.action.clear(&self.posed, x)
     }
 
     #[inline(always)]

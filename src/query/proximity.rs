@@ -389,6 +389,11 @@ impl<'h, K: BoundingVolume> LeafAction<'h, K> for Features<'_, '_> {
     }
 
     #[inline(always)]
+    fn clear<T: NodeTest>(&self, posed: &Posed<'h, K, T>, x: usize) -> bool {
+        super::clearance::pose_is_clear(posed.a, x, self.d)
+    }
+
+    #[inline(always)]
     fn stopped(&self, poll: bool) -> bool {
         if poll {
             self.budget.poll()

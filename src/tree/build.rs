@@ -215,6 +215,7 @@ impl RegionTree {
             shared: OnceLock::new(),
             edges: OnceLock::new(),
             tables: OnceLock::new(),
+            patches: OnceLock::new(),
         };
         debug_assert_eq!(tree.check_topology(mesh), Ok(()));
         Ok(tree)

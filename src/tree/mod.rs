@@ -19,6 +19,8 @@
 mod build;
 mod edges;
 pub(crate) use edges::MeshTables;
+mod patches;
+pub(crate) use patches::{Patch, Patches};
 mod shared;
 mod validate;
 
@@ -136,6 +138,9 @@ pub struct RegionTree {
     /// The caller's triangles and the unique edge table, built by the first call that needs
     /// them ([`RegionTree::edges`], the contact set).
     tables: OnceLock<edges::MeshTables>,
+    /// Which nodes are disks of triangles, with their boundaries, built by the first
+    /// query that tests a node's clearance (`patches.rs`).
+    patches: OnceLock<patches::Patches>,
 }
 
 impl RegionTree {
@@ -394,6 +399,12 @@ impl RegionTree {
         self.tables.get_or_init(|| edges::MeshTables::build(self))
     }
 
+    /// Which nodes are patches (disks of triangles), built by the first call (see
+    /// `patches.rs`).
+    pub(crate) fn patches(&self) -> &Patches {
+        self.patches.get_or_init(|| Patches::build(self))
+    }
+
     /// Bytes of topology (shared by the three methods; not part of a BV's record; the
     /// shared-pair table once a self query built it).
     pub fn topology_bytes(&self) -> usize {
@@ -418,5 +429,6 @@ impl RegionTree {
                 .get()
                 .and_then(Option::as_ref)
                 .map_or(0, |s| s.bytes())
+            + self.patches.get().map_or(0, Patches::bytes)
     }
 }

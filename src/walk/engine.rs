@@ -79,7 +79,8 @@ impl<'q, Q: Query> Task<'q, Q> {
     }
 
     /// Pushes the overlapping children pairs of the overlapping pair `[x, y]` to `next`;
-    /// false (nothing pushed) for a leaf pair.
+    /// false (nothing pushed) for a leaf pair. A self pair the query proves clear pushes
+    /// nothing and is done (true).
     #[inline(always)]
     pub(super) fn split<S: Simd>(
         &mut self,
@@ -91,6 +92,9 @@ impl<'q, Q: Query> Task<'q, Q> {
         let q = self.query;
         let (ta, tb) = (q.tree(Side::A), q.tree(Side::B));
         if q.is_self() && x == y {
+            if q.clear(x) {
+                return true;
+            }
             let Some(g) = ta.child_group(x) else {
                 return false;
             };

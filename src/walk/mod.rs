@@ -16,7 +16,8 @@
 //! - self queries start from the *self pair* `(root, root)`, which is never tested (a node
 //!   overlaps itself): an internal `x` pushes the self pairs of its children and, for each
 //!   child `c_i`, the overlapping `(c_i, c_j)`, `j > i` (one wide test of `c_i` against the
-//!   rest of its group); a leaf self pair goes to the leaf action.
+//!   rest of its group); a leaf self pair goes to the leaf action. A self pair the query
+//!   proves clear ([`Query::clear`]) is dropped, with everything under it.
 //!
 //! Memory does not grow with the work: the stack holds at most
 //! `depth * (MAX_CHILDREN + MAX_CHILDREN^2 / 2)` pairs; the only output is the query's.
@@ -81,6 +82,13 @@ pub(crate) trait Query: Sync {
         counters: &mut Counters,
         out: &mut Self::Out,
     );
+    /// Whether every feature pair of node `x` (a self query's) is proven farther apart than
+    /// the query looks: its self pair is then skipped, children and all
+    /// ([`crate::query::clearance`]). Asked once per self pair the walk meets.
+    #[inline(always)]
+    fn clear(&self, _x: usize) -> bool {
+        false
+    }
     /// Appends `other` (a later task's output) to `out`.
     fn merge(&self, out: &mut Self::Out, other: Self::Out);
     /// Whether the walk must stop now (its budget spent, or cancelled); `poll`: ask the

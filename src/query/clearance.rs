@@ -1,0 +1,408 @@
+//! The clearance test: a node of one mesh whose feature pairs (a vertex and a triangle not
+//! containing it, two edges sharing no vertex) are all farther apart than a distance,
+//! proved from the node's triangles and boundary without enumerating a pair. A self query's
+//! walk skips the self pair of such a node: the pairs between mesh neighbours of a smooth
+//! sheet, most of the candidates of cloth, never reach the feature-pair layer.
+//!
+//! The proof. Let the node be a patch (disks of triangles touching at most at vertices,
+//! [`crate::tree::Patches`]) and project it along a coordinate axis onto the plane of the
+//! other two (dropping a coordinate: exact). If every triangle's projection has the same
+//! strict orientation, each disk's projected boundary loop is a simple closed curve, no two
+//! loops cross and none lies inside another, the projection is one-to-one on the patch (an
+//! orientation-preserving, locally one-to-one map of a disk whose boundary goes once around
+//! a simple curve has degree one: a point inside has exactly one preimage; and the disks'
+//! images, bounded by loops neither crossing nor nested, meet at most at the vertices the
+//! disks share). In the plane, then:
+//! - a segment from a vertex `v` to a point of a triangle not containing `v` leaves the
+//!   image of `v`'s triangles, through an edge opposite `v` in one of them (so it is longer
+//!   than that triangle's height over `v`) or, at a boundary vertex, through the outside of
+//!   the patch, which it enters again across a boundary edge not at `v`;
+//! - two edges sharing no vertex are disjoint, so their distance is that of an endpoint of
+//!   one to the other edge: a vertex-triangle distance or a height, as above.
+//!
+//! So if every triangle's three heights and every boundary vertex's distance to every
+//! boundary edge not at it exceed `c`, and no two boundary edges cross, every pair is more
+//! than `c` apart in the plane, hence in space (a projection does not lengthen). Over a
+//! step, two points of two features approach each other in the plane by at most the
+//! largest difference of two vertex displacements (projected), `D`: with `c = distance + D`
+//! no pair comes within `distance` during the step. A sheet translating or turning a little
+//! as a whole has a small `D` however far it moves.
+//!
+//! Everything is computed in `f64` from the exact positions, and every comparison keeps a
+//! margin of [`REL`] of the magnitudes it combines, far above their few roundings: a node
+//! passes only when the proof holds for the exact positions. A node that fails is walked as
+//! before, so the test changes the work, never an answer.
+
+use crate::bv::BoundingVolume;
+use crate::hierarchy::Hierarchy;
+use crate::tree::{Patch, RegionTree};
+
+/// The relative margin of every comparison (each side is a few roundings, at most `4
+/// EPSILON` relative, from its exact value).
+const REL: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// The most triangles whose normals choose the projection axis.
+const AXIS_SAMPLE: usize = 64;
+
+/// A point of the projection plane.
+type P2 = [f64; 2];
+
+/// The most loops of a patch the test compares pairwise for nesting.
+const MOST_LOOPS: usize = 16;
+
+/// Whether every feature pair of node `n` of `tree` that shares no vertex is farther apart
+/// than `reach(axis)` at the positions `at` (internal vertex index to position), projected
+/// along the coordinate `axis`. Only patches pass.
+pub(crate) fn node_is_clear(
+    tree: &RegionTree,
+    n: usize,
+    at: &impl Fn(usize) -> [f64; 3],
+    reach: impl Fn(usize) -> f64,
+) -> bool {
+    let Some(patch) = tree.patches().patch(n) else {
+        return false;
+    };
+    if patch.loops.len() > MOST_LOOPS {
+        return false;
+    }
+    let tris = &tree.triangles()[tree.tri_range(n)];
+    let Some((k, sign)) = axis(tris, at) else {
+        return false;
+    };
+    let c = reach(k);
+    if !(c.is_finite() && c >= 0.0) {
+        return false;
+    }
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    let plane = |v: u32| {
+        let p = at(v as usize);
+        [p[i], p[j]]
+    };
+    let c2 = c * c * (1.0 + REL);
+    tris.iter()
+        .all(|t| triangle_is_clear(t.map(plane), sign, c2))
+        && boundary_is_clear(&patch, &plane, c)
+}
+
+/// Whether node `n` of `h` holds no feature pair within `distance` in its current pose.
+#[inline(never)]
+pub(crate) fn pose_is_clear<K: BoundingVolume>(h: &Hierarchy<K>, n: usize, distance: f64) -> bool {
+    let reach = (distance * (1.0 + REL)).next_up();
+    node_is_clear(h.tree(), n, &|v| h.position_f64(v), |_| reach)
+}
+
+/// Whether node `n` of `tree` holds no feature pair that comes within `distance` during
+/// `[0, horizon]` of the linear motion from `x0` to `x1` (internal vertex order).
+#[inline(never)]
+pub(crate) fn motion_is_clear(
+    tree: &RegionTree,
+    n: usize,
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    horizon: f64,
+    distance: f64,
+) -> bool {
+    if !tree.patches().is_patch(n) {
+        return false;
+    }
+    let moves = Moves::of(tree, n, x0, x1);
+    node_is_clear(tree, n, &|v| x0[v], |axis| {
+        let approach = moves.approach(axis) * horizon * (1.0 + REL);
+        ((distance + approach) * (1.0 + REL)).next_up()
+    })
+}
+
+/// The displacements `x1 - x0` of a node's vertices: the box holding them and the longest.
+struct Moves {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    longest: f64,
+}
+
+impl Moves {
+    fn of(tree: &RegionTree, n: usize, x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let mut longest_sq = 0.0f64;
+        for v in tree.region_vertices(n) {
+            let (p, q) = (x0[v as usize], x1[v as usize]);
+            let u = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+            longest_sq = longest_sq.max(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            for k in 0..3 {
+                lo[k] = lo[k].min(u[k]);
+                hi[k] = hi[k].max(u[k]);
+            }
+        }
+        Self {
+            lo,
+            hi,
+            longest: longest_sq.sqrt(),
+        }
+    }
+
+    /// An upper bound on how much two points of the node's features can approach each
+    /// other in the plane across `axis` over the whole motion: the largest difference of two
+    /// projected displacements (a point of a feature moves by a convex combination of its
+    /// vertices' displacements), at most twice the longest displacement and at most the
+    /// diagonal of their box in the plane. Each computed displacement is within a rounding
+    /// of `longest` of the exact one: the box grows by [`REL`] of it.
+    fn approach(&self, axis: usize) -> f64 {
+        if !self.longest.is_finite() {
+            return f64::INFINITY;
+        }
+        let slack = REL * self.longest;
+        let extent = |k: usize| (self.hi[k] - self.lo[k]).max(0.0) + slack;
+        let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+        let diagonal = (extent(i) * extent(i) + extent(j) * extent(j)).sqrt();
+        (2.0 * self.longest).min(diagonal) * (1.0 + REL)
+    }
+}
+
+/// The coordinate axis the triangles' normals lean along most (sampled), and the sign of
+/// their lean; `None` when the sample's normals cancel.
+fn axis(tris: &[[u32; 3]], at: &impl Fn(usize) -> [f64; 3]) -> Option<(usize, f64)> {
+    let stride = tris.len().div_ceil(AXIS_SAMPLE).max(1);
+    let mut sum = [0.0f64; 3];
+    for t in tris.iter().step_by(stride) {
+        let [a, b, c] = t.map(|v| at(v as usize));
+        let e = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let f = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        sum[0] += e[1] * f[2] - e[2] * f[1];
+        sum[1] += e[2] * f[0] - e[0] * f[2];
+        sum[2] += e[0] * f[1] - e[1] * f[0];
+    }
+    let k = (0..3).max_by(|&x, &y| sum[x].abs().total_cmp(&sum[y].abs()))?;
+    (sum[k] != 0.0 && sum[k].is_finite()).then(|| (k, sum[k].signum()))
+}
+
+/// `u x v` in the plane and the sum of its two products' magnitudes (its rounding scale).
+#[inline(always)]
+fn cross(u: P2, v: P2) -> (f64, f64) {
+    let (x, y) = (u[0] * v[1], u[1] * v[0]);
+    (x - y, x.abs() + y.abs())
+}
+
+#[inline(always)]
+fn sub(a: P2, b: P2) -> P2 {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+#[inline(always)]
+fn norm_sq(u: P2) -> f64 {
+    u[0] * u[0] + u[1] * u[1]
+}
+
+/// A triangle's projection has orientation `sign` and its three heights exceed `c` (`c2`:
+/// `c^2` rounded up): `sign (b - a) x (c - a) > c |e|` for each edge `e`.
+#[inline(always)]
+fn triangle_is_clear([a, b, c]: [P2; 3], sign: f64, c2: f64) -> bool {
+    let (e, f) = (sub(b, a), sub(c, a));
+    let (o, scale) = cross(e, f);
+    let low = sign * o - REL * scale;
+    if low <= 0.0 {
+        return false;
+    }
+    let low2 = low * low * (1.0 - REL);
+    let longest = norm_sq(e).max(norm_sq(f)).max(norm_sq(sub(c, b)));
+    low2 > c2 * longest
+}
+
+/// Whether `v` is farther than `c` from the segment `p q` (`c2`: `c^2` rounded up): beyond
+/// `c` from its line, or past one end and beyond `c` from that end.
+#[inline(always)]
+fn point_clear_of_segment(v: P2, p: P2, q: P2, c2: f64) -> bool {
+    let (d, w) = (sub(q, p), sub(v, p));
+    let (o, scale) = cross(d, w);
+    let low = o.abs() - REL * scale;
+    if low > 0.0 && low * low * (1.0 - REL) > c2 * norm_sq(d) {
+        return true;
+    }
+    let dot = |x: P2, y: P2| {
+        (
+            x[0] * y[0] + x[1] * y[1],
+            (x[0] * y[0]).abs() + (x[1] * y[1]).abs(),
+        )
+    };
+    let (before, scale) = dot(w, d);
+    if before < -REL * scale {
+        // Closest to `p`.
+        return norm_sq(w) * (1.0 - REL) > c2;
+    }
+    let u = sub(v, q);
+    let (after, scale) = dot(u, d);
+    after > REL * scale && norm_sq(u) * (1.0 - REL) > c2
+}
+
+/// Whether `p` and `q` lie strictly on one side of the line through `a` and `b`.
+#[inline(always)]
+fn one_side(a: P2, b: P2, p: P2, q: P2) -> bool {
+    let d = sub(b, a);
+    let side = |x: P2| {
+        let (o, scale) = cross(d, sub(x, a));
+        if o > REL * scale {
+            1
+        } else if o < -REL * scale {
+            -1
+        } else {
+            0
+        }
+    };
+    let s = side(p);
+    s != 0 && s == side(q)
+}
+
+/// The projected boundary loops are simple, do not cross and are not nested, and each
+/// boundary vertex is farther than `c` from each boundary edge not at it. Edges whose boxes
+/// are more than `c` apart on an axis are never compared (a sweep along the first axis).
+fn boundary_is_clear(patch: &Patch<'_>, plane: &impl Fn(u32) -> P2, c: f64) -> bool {
+    let boundary = patch.edges;
+    let c2 = c * c * (1.0 + REL);
+    let reach = c * (1.0 + REL);
+    let ends: Vec<[P2; 2]> = boundary.iter().map(|e| e.map(plane)).collect();
+    let boxes: Vec<[P2; 2]> = ends
+        .iter()
+        .map(|[p, q]| {
+            [
+                [p[0].min(q[0]), p[1].min(q[1])],
+                [p[0].max(q[0]), p[1].max(q[1])],
+            ]
+        })
+        .collect();
+    let mut order: Vec<u32> = (0..boundary.len() as u32).collect();
+    order.sort_unstable_by(|&x, &y| boxes[x as usize][0][0].total_cmp(&boxes[y as usize][0][0]));
+    for (s, &x) in order.iter().enumerate() {
+        let x = x as usize;
+        for &y in &order[s + 1..] {
+            let y = y as usize;
+            if boxes[y][0][0] - boxes[x][1][0] > reach {
+                break;
+            }
+            let gap_y = (boxes[y][0][1] - boxes[x][1][1]).max(boxes[x][0][1] - boxes[y][1][1]);
+            if gap_y > reach {
+                continue;
+            }
+            if !edges_clear(boundary[x], ends[x], boundary[y], ends[y], c2) {
+                return false;
+            }
+        }
+    }
+    // Loops that neither cross nor touch but at shared vertices are nested or apart: a
+    // vertex of one, not on the other, outside it.
+    patch.loops.iter().enumerate().all(|(a, la)| {
+        patch.loops.iter().enumerate().all(|(b, lb)| {
+            if a == b {
+                return true;
+            }
+            let mut on_b: Vec<u32> = boundary[lb.clone()].iter().map(|e| e[0]).collect();
+            on_b.sort_unstable();
+            let Some(x) = la
+                .clone()
+                .find(|&e| on_b.binary_search(&boundary[e][0]).is_err())
+            else {
+                return false;
+            };
+            winding(ends[x][0], &ends[lb.clone()]) == Some(0)
+        })
+    })
+}
+
+/// The winding number of the closed polygon `edges` around `x`, `None` when an edge passes
+/// too close to `x` to tell the side: crossings of the ray from `x` along the first axis,
+/// each edge taken half-open in the second coordinate (exact comparisons of the inputs).
+fn winding(x: P2, edges: &[[P2; 2]]) -> Option<i32> {
+    let mut w = 0;
+    for &[p, q] in edges {
+        let (up, down) = (p[1] <= x[1] && q[1] > x[1], q[1] <= x[1] && p[1] > x[1]);
+        if !(up || down) {
+            continue;
+        }
+        // The side of `x` from the edge: left of an upward edge is a crossing to the right.
+        let (o, scale) = cross(sub(q, p), sub(x, p));
+        if o.abs() <= REL * scale {
+            return None;
+        }
+        if up && o > 0.0 {
+            w += 1;
+        } else if down && o < 0.0 {
+            w -= 1;
+        }
+    }
+    Some(w)
+}
+
+/// Two boundary edges (vertex ids and projected ends): each endpoint not on the other edge
+/// farther than `c` from it, and, sharing no vertex, not crossing.
+#[inline(always)]
+fn edges_clear(e: [u32; 2], [a, b]: [P2; 2], f: [u32; 2], [p, q]: [P2; 2], c2: f64) -> bool {
+    let on = |v: u32, g: [u32; 2]| v == g[0] || v == g[1];
+    let shared = on(e[0], f) || on(e[1], f);
+    let ends_clear = [(e[0], a), (e[1], b)]
+        .iter()
+        .all(|&(v, x)| on(v, f) || point_clear_of_segment(x, p, q, c2))
+        && [(f[0], p), (f[1], q)]
+            .iter()
+            .all(|&(v, x)| on(v, e) || point_clear_of_segment(x, a, b, c2));
+    ends_clear && (shared || one_side(a, b, p, q) || one_side(p, q, a, b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_point_is_clear_of_a_segment_only_beyond_the_distance() {
+        let c2 = |c: f64| c * c * (1.0 + REL);
+        let (p, q) = ([0.0, 0.0], [1.0, 0.0]);
+        // Above the middle at 0.5.
+        assert!(point_clear_of_segment([0.5, 0.5], p, q, c2(0.49)));
+        assert!(!point_clear_of_segment([0.5, 0.5], p, q, c2(0.5)));
+        // Past an end: its distance to that end.
+        let v = [-0.3, 0.4];
+        assert!(point_clear_of_segment(v, p, q, c2(0.49)));
+        assert!(!point_clear_of_segment(v, p, q, c2(0.5)));
+        assert!(point_clear_of_segment([1.3, -0.4], p, q, c2(0.49)));
+        assert!(!point_clear_of_segment([1.3, -0.4], p, q, c2(0.5)));
+        // On the line, past the end by 0.25.
+        assert!(point_clear_of_segment([1.25, 0.0], p, q, c2(0.24)));
+        assert!(!point_clear_of_segment([1.25, 0.0], p, q, c2(0.25)));
+        // On the segment.
+        assert!(!point_clear_of_segment([0.5, 0.0], p, q, 0.0));
+    }
+
+    #[test]
+    fn a_triangle_is_clear_when_its_least_height_exceeds_the_distance() {
+        // Right triangle with legs 1: heights 1, 1 and sqrt(2) / 2.
+        let t = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let c2 = |c: f64| c * c * (1.0 + REL);
+        assert!(triangle_is_clear(t, 1.0, c2(0.7)));
+        assert!(!triangle_is_clear(t, 1.0, c2(0.71)));
+        assert!(!triangle_is_clear(t, -1.0, 0.0));
+        // Degenerate: no orientation.
+        assert!(!triangle_is_clear(
+            [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]],
+            1.0,
+            0.0
+        ));
+    }
+
+    #[test]
+    fn the_winding_number_of_a_square() {
+        let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let ccw: Vec<[P2; 2]> = (0..4).map(|i| [sq[i], sq[(i + 1) % 4]]).collect();
+        let cw: Vec<[P2; 2]> = ccw.iter().rev().map(|&[p, q]| [q, p]).collect();
+        assert_eq!(winding([0.5, 0.5], &ccw), Some(1));
+        assert_eq!(winding([0.5, 0.5], &cw), Some(-1));
+        assert_eq!(winding([1.5, 0.5], &ccw), Some(0));
+        assert_eq!(winding([-0.5, 0.0], &ccw), Some(0));
+        assert_eq!(winding([1.0, 0.5], &ccw), None);
+    }
+
+    #[test]
+    fn crossing_boundary_edges_are_never_clear() {
+        let e = [[0.0, 0.0], [2.0, 2.0]];
+        let f = [[0.0, 2.0], [2.0, 0.0]];
+        assert!(!edges_clear([0, 1], e, [2, 3], f, 0.0));
+        let g = [[3.0, 0.0], [3.0, 2.0]];
+        assert!(edges_clear([0, 1], e, [2, 3], g, 0.5));
+        assert!(!edges_clear([0, 1], e, [2, 3], g, 1.0));
+    }
+}
