@@ -57,31 +57,38 @@ pub(crate) fn node_is_clear(
     tree: &RegionTree,
     n: usize,
     at: &impl Fn(usize) -> [f64; 3],
-    reach: impl Fn(usize) -> f64,
+    reach: impl FnOnce(usize) -> f64,
 ) -> bool {
-    let Some(patch) = tree.patches().patch(n) else {
-        return false;
-    };
-    if patch.loops.len() > MOST_LOOPS {
+    let patches = tree.patches();
+    if !patches.is_patch(n) {
         return false;
     }
     let tris = &tree.triangles()[tree.tri_range(n)];
     let Some((k, sign)) = axis(tris, at) else {
         return false;
     };
-    let c = reach(k);
-    if !(c.is_finite() && c >= 0.0) {
-        return false;
-    }
     let (i, j) = ((k + 1) % 3, (k + 2) % 3);
     let plane = |v: u32| {
         let p = at(v as usize);
         [p[i], p[j]]
     };
-    let c2 = c * c * (1.0 + REL);
-    tris.iter()
-        .all(|t| triangle_is_clear(t.map(plane), sign, c2))
-        && boundary_is_clear(&patch, &plane, c)
+    // Most nodes that fail have a triangle facing the other way: found before the reach
+    // (a pass over the node's vertices in CCD) is computed.
+    let mut least_height_sq = f64::INFINITY;
+    for t in tris {
+        match height_sq(t.map(plane), sign) {
+            Some(h2) => least_height_sq = least_height_sq.min(h2),
+            None => return false,
+        }
+    }
+    let c = reach(k);
+    if !(c.is_finite() && c >= 0.0) || least_height_sq <= c * c * (1.0 + REL) {
+        return false;
+    }
+    let Some(patch) = patches.patch(n) else {
+        return false;
+    };
+    patch.loops.len() <= MOST_LOOPS && boundary_is_clear(&patch, &plane, c)
 }
 
 /// Whether node `n` of `h` holds no feature pair within `distance` in its current pose.
@@ -102,11 +109,8 @@ pub(crate) fn motion_is_clear(
     horizon: f64,
     distance: f64,
 ) -> bool {
-    if !tree.patches().is_patch(n) {
-        return false;
-    }
-    let moves = Moves::of(tree, n, x0, x1);
     node_is_clear(tree, n, &|v| x0[v], |axis| {
+        let moves = Moves::of(tree, n, x0, x1);
         let approach = moves.approach(axis) * horizon * (1.0 + REL);
         ((distance + approach) * (1.0 + REL)).next_up()
     })
@@ -158,20 +162,32 @@ impl Moves {
 }
 
 /// The coordinate axis the triangles' normals lean along most (sampled), and the sign of
-/// their lean; `None` when the sample's normals cancel.
+/// their lean; `None` when the sample's normals cancel or one of them leans the other way
+/// (the node cannot pass: its triangle would face the other way).
 fn axis(tris: &[[u32; 3]], at: &impl Fn(usize) -> [f64; 3]) -> Option<(usize, f64)> {
     let stride = tris.len().div_ceil(AXIS_SAMPLE).max(1);
+    let mut normals = [[0.0f64; 3]; AXIS_SAMPLE];
     let mut sum = [0.0f64; 3];
+    let mut sampled = 0;
     for t in tris.iter().step_by(stride) {
         let [a, b, c] = t.map(|v| at(v as usize));
         let e = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let f = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        sum[0] += e[1] * f[2] - e[2] * f[1];
-        sum[1] += e[2] * f[0] - e[0] * f[2];
-        sum[2] += e[0] * f[1] - e[1] * f[0];
+        let normal = [
+            e[1] * f[2] - e[2] * f[1],
+            e[2] * f[0] - e[0] * f[2],
+            e[0] * f[1] - e[1] * f[0],
+        ];
+        for k in 0..3 {
+            sum[k] += normal[k];
+        }
+        normals[sampled] = normal;
+        sampled += 1;
     }
     let k = (0..3).max_by(|&x, &y| sum[x].abs().total_cmp(&sum[y].abs()))?;
-    (sum[k] != 0.0 && sum[k].is_finite()).then(|| (k, sum[k].signum()))
+    let sign = sum[k].signum();
+    let agree = normals[..sampled].iter().all(|n| sign * n[k] > 0.0);
+    (agree && sum[k] != 0.0 && sum[k].is_finite()).then_some((k, sign))
 }
 
 /// `u x v` in the plane and the sum of its two products' magnitudes (its rounding scale).
@@ -191,19 +207,19 @@ fn norm_sq(u: P2) -> f64 {
     u[0] * u[0] + u[1] * u[1]
 }
 
-/// A triangle's projection has orientation `sign` and its three heights exceed `c` (`c2`:
-/// `c^2` rounded up): `sign (b - a) x (c - a) > c |e|` for each edge `e`.
+/// A lower bound on the square of a projected triangle's least height if its orientation
+/// is certainly `sign`: `((sign (b - a) x (c - a))_low)^2 / |longest edge|^2`, rounded down
+/// by [`REL`].
 #[inline(always)]
-fn triangle_is_clear([a, b, c]: [P2; 3], sign: f64, c2: f64) -> bool {
+fn height_sq([a, b, c]: [P2; 3], sign: f64) -> Option<f64> {
     let (e, f) = (sub(b, a), sub(c, a));
     let (o, scale) = cross(e, f);
     let low = sign * o - REL * scale;
     if low <= 0.0 {
-        return false;
+        return None;
     }
-    let low2 = low * low * (1.0 - REL);
     let longest = norm_sq(e).max(norm_sq(f)).max(norm_sq(sub(c, b)));
-    low2 > c2 * longest
+    Some(low * low / longest * (1.0 - REL))
 }
 
 /// Whether `v` is farther than `c` from the segment `p q` (`c2`: `c^2` rounded up): beyond
@@ -372,16 +388,11 @@ mod tests {
     fn a_triangle_is_clear_when_its_least_height_exceeds_the_distance() {
         // Right triangle with legs 1: heights 1, 1 and sqrt(2) / 2.
         let t = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-        let c2 = |c: f64| c * c * (1.0 + REL);
-        assert!(triangle_is_clear(t, 1.0, c2(0.7)));
-        assert!(!triangle_is_clear(t, 1.0, c2(0.71)));
-        assert!(!triangle_is_clear(t, -1.0, 0.0));
+        let h2 = height_sq(t, 1.0).unwrap();
+        assert!(h2 <= 0.5 && h2 > 0.5 * (1.0 - 4.0 * REL));
+        assert!(height_sq(t, -1.0).is_none());
         // Degenerate: no orientation.
-        assert!(!triangle_is_clear(
-            [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]],
-            1.0,
-            0.0
-        ));
+        assert!(height_sq([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]], 1.0).is_none());
     }
 
     #[test]

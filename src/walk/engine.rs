@@ -79,8 +79,8 @@ impl<'q, Q: Query> Task<'q, Q> {
     }
 
     /// Pushes the overlapping children pairs of the overlapping pair `[x, y]` to `next`;
-    /// false (nothing pushed) for a leaf pair. A self pair the query proves clear pushes
-    /// nothing and is done (true).
+    /// false (nothing pushed) for a leaf pair. An internal self pair the query proves clear
+    /// pushes nothing and is done (true).
     #[inline(always)]
     pub(super) fn split<S: Simd>(
         &mut self,
@@ -92,12 +92,14 @@ impl<'q, Q: Query> Task<'q, Q> {
         let q = self.query;
         let (ta, tb) = (q.tree(Side::A), q.tree(Side::B));
         if q.is_self() && x == y {
-            if q.clear(x) {
-                return true;
-            }
             let Some(g) = ta.child_group(x) else {
                 return false;
             };
+            // A leaf's self pair is cheap to enumerate: only internal nodes, whose proof
+            // also saves the pairs between their children, are asked.
+            if q.clear(x) {
+                return true;
+            }
             let block = self.group(simd, Side::A, g);
             let nodes = ta.group_nodes(g);
             let m = nodes.len();

@@ -16,8 +16,8 @@
 //! - self queries start from the *self pair* `(root, root)`, which is never tested (a node
 //!   overlaps itself): an internal `x` pushes the self pairs of its children and, for each
 //!   child `c_i`, the overlapping `(c_i, c_j)`, `j > i` (one wide test of `c_i` against the
-//!   rest of its group); a leaf self pair goes to the leaf action. A self pair the query
-//!   proves clear ([`Query::clear`]) is dropped, with everything under it.
+//!   rest of its group); a leaf self pair goes to the leaf action. An internal self pair
+//!   the query proves clear ([`Query::clear`]) is dropped, with everything under it.
 //!
 //! Memory does not grow with the work: the stack holds at most
 //! `depth * (MAX_CHILDREN + MAX_CHILDREN^2 / 2)` pairs; the only output is the query's.
@@ -82,9 +82,9 @@ pub(crate) trait Query: Sync {
         counters: &mut Counters,
         out: &mut Self::Out,
     );
-    /// Whether every feature pair of node `x` (a self query's) is proven farther apart than
-    /// the query looks: its self pair is then skipped, children and all
-    /// ([`crate::query::clearance`]). Asked once per self pair the walk meets.
+    /// Whether every feature pair of node `x` (an internal node of a self query) is proven
+    /// farther apart than the query looks: its self pair is then skipped, children and all
+    /// ([`crate::query::clearance`]). Asked once per internal self pair the walk meets.
     #[inline(always)]
     fn clear(&self, _x: usize) -> bool {
         false
