@@ -4,11 +4,12 @@
 //! force where the proof holds (and then no candidate pair is enumerated at all) and where
 //! it must fail: layers over each other in projection with the same orientation (a ramp
 //! turning more than once), a distance at the sheet's least height, a vertex moving across
-//! its neighbours, a fold, and seeded sheets with a second sheet over them (two disks whose
+//! its neighbours, a fold, and seeded sheets (proximity, CCD and the step size) with a second sheet over them (two disks whose
 //! projections nest) or beside them.
 
 use dhcd::bv::BoundingVolume;
 use dhcd::ccd::CcdOptions;
+use dhcd::contact::StepOptions;
 use dhcd::narrow::{brute_force_self_ccd, brute_force_self_proximity, earliest_of};
 use dhcd::shapes::{grid, jitter, splitmix64, wave};
 use dhcd::{
@@ -114,6 +115,23 @@ fn a_smooth_sheet_is_proven_clear_and_enumerates_nothing() {
     assert_eq!(ccd_checked(&m, &x0, &x1, 0.005, "wavy step"), 0);
     // At a distance above the least height the proof fails and the walk finds the pairs.
     assert!(proximity_checked(&m, 0.05, "wavy sheet") > 0);
+    // The step size of a smaller sheet's small step: every pair keeps its gap.
+    let m = wavy_sheet(8);
+    let x0 = f64s(m.positions());
+    let x1: Vec<[f64; 3]> = x0
+        .iter()
+        .map(|p| [p[0] + 0.002, p[1], p[2] + 0.004 * p[1]])
+        .collect();
+    for o in [
+        StepOptions::default(),
+        StepOptions {
+            min_distance: 0.005,
+            rescaling: 0.8,
+        },
+    ] {
+        assert_eq!(crate::step_size::brute_force_step(&m, &x0, &x1, &o), 1.0);
+        for_each_method!(K => crate::step_size::check::<K>(&m, &x0, &x1, &o, 1.0));
+    }
 }
 
 #[test]
@@ -259,6 +277,16 @@ fn seeded_sheets_with_a_sheet_over_or_beside_them_equal_the_brute_force() {
             .collect();
         for delta in [0.0, 0.1 * cell as f64] {
             ccd_checked(&m, &x0, &x1, delta, &what);
+        }
+        if seed < 4 {
+            for min_distance in [0.0, 0.05 * cell as f64] {
+                let o = StepOptions {
+                    min_distance,
+                    rescaling: 0.8,
+                };
+                let want = crate::step_size::brute_force_step(&m, &x0, &x1, &o);
+                for_each_method!(K => crate::step_size::check::<K>(&m, &x0, &x1, &o, want));
+            }
         }
     }
     // The proof held somewhere (a sheet beside the base, at a small distance).

@@ -58,8 +58,8 @@ use crate::error::{Error, Result};
 use crate::hierarchy::Hierarchy;
 use crate::par::Par;
 use crate::query::ccd::{
-    earliest_bound, gap_over_listed, horizon_for, run, run_passes, Gap, Listed, Listing, Swept,
-    MAX_LISTED,
+    checked_step, earliest_bound, gap_over_listed, horizon_for, run, run_passes,
+    whole_mesh_is_clear, Gap, Listed, Listing, Swept, MAX_LISTED,
 };
 use crate::query::{CcdMode, CcdQuery, Impacts, Motion};
 use crate::walk::Workspace;
@@ -359,7 +359,18 @@ pub fn collision_free_stepsize_with<K: BoundingVolume>(
     par: Par,
 ) -> Result<StepSize> {
     options.validate()?;
-    let s = Swept::new(h, motion)?;
+    let step = checked_step(h.tree(), motion)?;
+    // No pair can reach its gap when none comes within the gap walk's culling distance
+    // over the whole step.
+    let reach = cull_distance(options, &[motion], false, 1.0).max(options.min_distance);
+    if whole_mesh_is_clear(h.tree(), &step, 1.0, reach) {
+        Budget::new(&ws.control).finish()?;
+        return Ok(StepSize {
+            step: 1.0,
+            limiting: Impacts::default(),
+        });
+    }
+    let s = Swept::of_step(h, std::borrow::Cow::Owned(step));
     step_between(&s, &s, true, &[motion], options, MAX_LISTED, ws, par)
 }
 

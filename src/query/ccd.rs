@@ -269,11 +269,33 @@ pub fn self_ccd_with<K: BoundingVolume>(
     par: Par,
 ) -> Result<Impacts> {
     query.options.validate()?;
-    let s = Swept::new(h, motion)?;
-    let best = earliest_bound(query);
+    let step = checked_step(h.tree(), motion)?;
     let control = ws.control.clone();
     let budget = Budget::new(&control);
+    if whole_mesh_is_clear(
+        h.tree(),
+        &step,
+        query.options.t_max,
+        query.options.min_distance,
+    ) {
+        budget.finish()?;
+        return Ok(Impacts::default());
+    }
+    let s = Swept::of_step(h, Cow::Owned(step));
+    let best = earliest_bound(query);
     Ok(run(&s, &s, true, query, best.as_ref(), &budget, None, ws, par)?.0)
+}
+
+/// Whether no feature pair of the whole mesh comes within `distance` by `horizon` of
+/// `step` ([`super::clearance`] on the root): nothing to fit or walk, as for a smooth sheet
+/// moving a small step. The walk would ask the same of the root first.
+pub(crate) fn whole_mesh_is_clear(
+    tree: &RegionTree,
+    step: &Step,
+    horizon: f64,
+    distance: f64,
+) -> bool {
+    super::clearance::motion_is_clear(tree, 0, &step.x0, &step.x1, horizon, distance)
 }
 
 /// One hierarchy over a step: its positions at t0 and t1 (internal order), its node bounds
