@@ -8,7 +8,8 @@
 //! [`crate::tree::Patches`]) and project it along a coordinate axis onto the plane of the
 //! other two (dropping a coordinate: exact). If every triangle's projection has the same
 //! strict orientation, each disk's projected boundary loop is a simple closed curve, no two
-//! loops cross and none lies inside another, the projection is one-to-one on the patch (an
+//! loops cross, share more than one vertex, or lie one inside the other, the projection is
+//! one-to-one on the patch (an
 //! orientation-preserving, locally one-to-one map of a disk whose boundary goes once around
 //! a simple curve has degree one: a point inside has exactly one preimage; and the disks'
 //! images, bounded by loops neither crossing nor nested, meet at most at the vertices the
@@ -301,8 +302,10 @@ fn boundary_is_clear(patch: &Patch<'_>, plane: &impl Fn(u32) -> P2, c: f64) -> b
             }
         }
     }
-    // Loops that neither cross nor touch but at shared vertices are nested or apart: a
-    // vertex of one, not on the other, outside it.
+    // Two loops that neither cross nor touch but at one shared vertex are nested or apart:
+    // the rest of one is a connected curve off the other, so one of its vertices tells
+    // which. Loops sharing two vertices or more are refused: the arcs between those
+    // vertices could lie on either side.
     patch.loops.iter().enumerate().all(|(a, la)| {
         patch.loops.iter().enumerate().all(|(b, lb)| {
             if a == b {
@@ -310,13 +313,14 @@ fn boundary_is_clear(patch: &Patch<'_>, plane: &impl Fn(u32) -> P2, c: f64) -> b
             }
             let mut on_b: Vec<u32> = boundary[lb.clone()].iter().map(|e| e[0]).collect();
             on_b.sort_unstable();
-            let Some(x) = la
+            let off_b: Vec<usize> = la
                 .clone()
-                .find(|&e| on_b.binary_search(&boundary[e][0]).is_err())
-            else {
-                return false;
-            };
-            winding(ends[x][0], &ends[lb.clone()]) == Some(0)
+                .filter(|&e| on_b.binary_search(&boundary[e][0]).is_err())
+                .collect();
+            off_b.len() + 1 >= la.len()
+                && off_b
+                    .first()
+                    .is_some_and(|&x| winding(ends[x][0], &ends[lb.clone()]) == Some(0))
         })
     })
 }
@@ -405,6 +409,60 @@ mod tests {
         assert_eq!(winding([1.5, 0.5], &ccw), Some(0));
         assert_eq!(winding([-0.5, 0.0], &ccw), Some(0));
         assert_eq!(winding([1.0, 0.5], &ccw), None);
+    }
+
+    #[test]
+    fn loops_sharing_two_vertices_are_refused() {
+        // A square, and a loop through its corners 0 and 2: one arc inside the square (by
+        // vertex 4), one outside (by vertex 5); listed from the outside arc.
+        let at = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 2.0],
+            [0.0, 2.0],
+            [1.2, 0.8],
+            [-1.0, 3.0],
+        ];
+        let edges = [
+            [0, 1],
+            [1, 2],
+            [2, 3],
+            [3, 0],
+            [2, 5],
+            [5, 0],
+            [0, 4],
+            [4, 2],
+        ];
+        let plane = |v: u32| at[v as usize];
+        let both = Patch {
+            edges: &edges,
+            loops: vec![0..4, 4..8],
+        };
+        assert!(!boundary_is_clear(&both, &plane, 0.01));
+        // Each loop alone is simple and clear.
+        for edges in [&edges[..4], &edges[4..]] {
+            let alone = Patch {
+                edges,
+                loops: std::iter::once(0..4).collect(),
+            };
+            assert!(boundary_is_clear(&alone, &plane, 0.01));
+        }
+        // The square beside a triangle sharing its corner 1 only: apart.
+        let at2 = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 2.0],
+            [0.0, 2.0],
+            [3.0, -1.0],
+            [3.0, 1.0],
+        ];
+        let plane2 = |v: u32| at2[v as usize];
+        let edges2 = [[0, 1], [1, 2], [2, 3], [3, 0], [1, 4], [4, 5], [5, 1]];
+        let touching = Patch {
+            edges: &edges2,
+            loops: vec![0..4, 4..7],
+        };
+        assert!(boundary_is_clear(&touching, &plane2, 0.01));
     }
 
     #[test]
