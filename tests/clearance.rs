@@ -1,11 +1,12 @@
 //! The clearance proof of self queries ([`dhcd`]'s `query::clearance`): a node whose
-//! projection along an axis is one-to-one, with every height and boundary distance above
+//! projection along its mean normal is one-to-one, with every height and boundary distance above
 //! the query's reach, is skipped without enumerating its pairs. Checked against the brute
 //! force where the proof holds (and then no candidate pair is enumerated at all) and where
 //! it must fail: layers over each other in projection with the same orientation (a ramp
 //! turning more than once), a distance at the sheet's least height, a vertex moving across
-//! its neighbours, a fold, and seeded sheets (proximity, CCD and the step size) with a second sheet over them (two disks whose
-//! projections nest) or beside them.
+//! its neighbours, a fold, a cylinder rolled past a turn, and seeded sheets (proximity, CCD
+//! and the step size) with a second sheet over them (two disks whose projections nest) or
+//! beside them, half of them turned off the coordinate axes.
 
 use dhcd::bv::BoundingVolume;
 use dhcd::ccd::CcdOptions;
@@ -252,8 +253,14 @@ fn seeded_sheets_with_a_sheet_over_or_beside_them_equal_the_brute_force() {
             .iter()
             .map(|p| [p[0] + at[0], p[1] + at[1], p[2] + at[2]])
             .collect();
-        let m = stacked(&with_positions(&base, bent), &top, &small);
-        let what = format!("seed {seed} over {over}");
+        let mut m = stacked(&with_positions(&base, bent), &top, &small);
+        // Half the seeds turned as a whole: projected along a direction off the axes.
+        let turn = seed >= 6;
+        if turn {
+            let angles = [draw(), draw(), draw()].map(|x| x * std::f64::consts::TAU);
+            m = with_positions(&m, f32s(&turned(m.positions(), angles, [0.0; 3])));
+        }
+        let what = format!("seed {seed} over {over} turned {turn}");
         for d in [0.02, 0.3, 0.6, 1.2].map(|f| f * cell as f64) {
             if proximity_checked(&m, d, &what) == 0 {
                 proven += 1;
@@ -291,4 +298,104 @@ fn seeded_sheets_with_a_sheet_over_or_beside_them_equal_the_brute_force() {
     }
     // The proof held somewhere (a sheet beside the base, at a small distance).
     assert!(proven > 0);
+}
+
+/// `p` turned by the rotation of Euler angles `[a, b, c]` (about z, then y, then z), and
+/// moved by `shift`.
+fn turned(p: &[[f32; 3]], [a, b, c]: [f64; 3], shift: [f64; 3]) -> Vec<[f64; 3]> {
+    let about_z = |t: f64, q: [f64; 3]| {
+        let (s, k) = t.sin_cos();
+        [k * q[0] - s * q[1], s * q[0] + k * q[1], q[2]]
+    };
+    let about_y = |t: f64, q: [f64; 3]| {
+        let (s, k) = t.sin_cos();
+        [k * q[0] + s * q[2], q[1], -s * q[0] + k * q[2]]
+    };
+    p.iter()
+        .map(|q| {
+            let r = about_z(c, about_y(b, about_z(a, q.map(f64::from))));
+            [r[0] + shift[0], r[1] + shift[1], r[2] + shift[2]]
+        })
+        .collect()
+}
+
+fn f32s(p: &[[f64; 3]]) -> Vec<[f32; 3]> {
+    p.iter().map(|q| q.map(|x| x as f32)).collect()
+}
+
+/// A generic rotation: no coordinate axis near the z axis it turns.
+const TURN: [f64; 3] = [0.7, 1.1, 0.3];
+
+#[test]
+fn a_turned_flat_sheet_at_its_least_height() {
+    // The flat sheet of the test above, turned: no coordinate plane holds it, and the
+    // proof projects it along its normal with roundings.
+    let flat = grid(8, 8, 0.125, [0.0; 3]);
+    let m = with_positions(&flat, f32s(&turned(flat.positions(), TURN, [0.3; 3])));
+    let h = 2f64.sqrt() / 16.0;
+    assert_eq!(proximity_checked(&m, h * 0.999, "turned flat below"), 0);
+    assert!(brute_force_self_proximity(&m, h * 1.001).counters.contacts > 0);
+    proximity_checked(&m, h * 1.001, "turned flat above");
+}
+
+/// A quarter-and-more of a cylinder of radius 1 (150 degrees around, `n` cells, and 1 long,
+/// `n` cells), turned by [`TURN`]: its normals spread 75 degrees either side of their
+/// mean, so no coordinate axis sees every triangle face one way, while the mean does.
+fn turned_cylinder(n: u32) -> Mesh {
+    let flat = grid(n, n, 1.0 / n as f32, [0.0; 3]);
+    let spread = 150f64.to_radians();
+    let bent: Vec<[f32; 3]> = flat
+        .positions()
+        .iter()
+        .map(|p| {
+            let a = spread * (f64::from(p[0]) - 0.5);
+            [a.sin() as f32, p[1], a.cos() as f32]
+        })
+        .collect();
+    with_positions(&flat, f32s(&turned(&bent, TURN, [0.0; 3])))
+}
+
+#[test]
+fn a_turned_cylinder_is_proven_clear_along_its_mean_normal() {
+    let m = turned_cylinder(12);
+    // Cells 0.22 around by 0.083 long; at the rims the projection shortens them to a
+    // quarter: the least projected height is about 0.05.
+    assert_eq!(proximity_checked(&m, 0.005, "cylinder"), 0);
+    assert!(proximity_checked(&m, 0.1, "cylinder") > 0);
+    // A step turning it by 0.005 radians about its axis and moving it by 0.05: the
+    // displacements differ by at most about 0.01.
+    let x0 = f64s(m.positions());
+    let x1 = turned(m.positions(), [0.0, 0.0, 0.005], [0.05, -0.02, 0.03]);
+    assert_eq!(ccd_checked(&m, &x0, &x1, 0.0, "cylinder step"), 0);
+    assert_eq!(ccd_checked(&m, &x0, &x1, 0.005, "cylinder step"), 0);
+    let o = StepOptions {
+        min_distance: 0.005,
+        rescaling: 0.8,
+    };
+    assert_eq!(crate::step_size::brute_force_step(&m, &x0, &x1, &o), 1.0);
+    for_each_method!(K => crate::step_size::check::<K>(&m, &x0, &x1, &o, 1.0));
+    // Rolled up by 2.5 times its curvature, its rims come within 0.1 of each other.
+    let rolled: Vec<[f64; 3]> = {
+        let flat = grid(12, 12, 1.0 / 12.0, [0.0; 3]);
+        let spread = 375f64.to_radians();
+        let p: Vec<[f32; 3]> = flat
+            .positions()
+            .iter()
+            .map(|p| {
+                let a = spread * (f64::from(p[0]) - 0.5);
+                let r = 1.0 - 0.05 * a / spread;
+                [(r * a.sin()) as f32, p[1], (r * a.cos()) as f32]
+            })
+            .collect();
+        turned(&p, TURN, [0.0; 3])
+    };
+    let rolled_mesh = with_positions(&m, f32s(&rolled));
+    assert!(
+        brute_force_self_proximity(&rolled_mesh, 0.1)
+            .counters
+            .contacts
+            > 0
+    );
+    proximity_checked(&rolled_mesh, 0.1, "rolled");
+    ccd_checked(&m, &x0, &f64s(rolled_mesh.positions()), 0.0, "rolling up");
 }

@@ -5,11 +5,12 @@
 //! sheet, most of the candidates of cloth, never reach the feature-pair layer.
 //!
 //! The proof. Let the node be a patch (disks of triangles touching at most at vertices,
-//! [`crate::tree::Patches`]) and project it along a coordinate axis onto the plane of the
-//! other two (dropping a coordinate: exact). If every triangle's projection has the same
-//! strict orientation, each disk's projected boundary loop is a simple closed curve, no two
-//! loops cross, share more than one vertex, or lie one inside the other, the projection is
-//! one-to-one on the patch (an
+//! [`crate::tree::Patches`]) and map its vertices into a plane by a linear map `P` (a
+//! projection along the mean of its triangles' normals, [`Projection`]), computed with
+//! roundings: the *image* is the surface whose triangles have the computed points as
+//! corners. If every triangle's image has the same strict orientation, each disk's boundary
+//! image is a simple closed curve, and no two loops cross, share more than one vertex, or
+//! lie one inside the other, the image is one-to-one on the patch (an
 //! orientation-preserving, locally one-to-one map of a disk whose boundary goes once around
 //! a simple curve has degree one: a point inside has exactly one preimage; and the disks'
 //! images, bounded by loops neither crossing nor nested, meet at most at the vertices the
@@ -23,9 +24,11 @@
 //!
 //! So if every triangle's three heights and every boundary vertex's distance to every
 //! boundary edge not at it exceed `c`, and no two boundary edges cross, every pair is more
-//! than `c` apart in the plane, hence in space (a projection does not lengthen). Over a
-//! step, two points of two features approach each other in the plane by at most the
-//! largest difference of two vertex displacements (projected), `D`: with `c = distance + D`
+//! than `c` apart in the image. Each computed point is within `e` of the exact `P` of its
+//! vertex, and a point of a feature is the same convex combination in both, so the pair is
+//! more than `c - 2e` apart under `P`, and more than `(c - 2e) / |P|` apart in space. Over a
+//! step, two points of two features approach each other under `P` by at most the largest
+//! difference of two vertex displacements under `P`, `D`: with `c = |P| distance + D + 2e`
 //! no pair comes within `distance` during the step. A sheet translating or turning a little
 //! as a whole has a small `D` however far it moves.
 //!
@@ -42,8 +45,8 @@ use crate::tree::{Patch, RegionTree};
 /// EPSILON` relative, from its exact value).
 const REL: f64 = 1.0 / (1u64 << 40) as f64;
 
-/// The most triangles whose normals choose the projection axis.
-const AXIS_SAMPLE: usize = 64;
+/// The most triangles whose normals choose the projection.
+const NORMAL_SAMPLE: usize = 64;
 
 /// A point of the projection plane.
 type P2 = [f64; 2];
@@ -52,37 +55,42 @@ type P2 = [f64; 2];
 const MOST_LOOPS: usize = 16;
 
 /// Whether every feature pair of node `n` of `tree` that shares no vertex is farther apart
-/// than `reach(axis)` at the positions `at` (internal vertex index to position), projected
-/// along the coordinate `axis`. Only patches pass.
+/// than a distance at the positions `at` (internal vertex index to position): `reach` gives,
+/// for the node's projection, the distance in the plane beyond which its pairs are clear
+/// (see [`Projection::stretch`]). Only patches pass.
 pub(crate) fn node_is_clear(
     tree: &RegionTree,
     n: usize,
     at: &impl Fn(usize) -> [f64; 3],
-    reach: impl FnOnce(usize) -> f64,
+    reach: impl FnOnce(&Projection) -> f64,
 ) -> bool {
     let patches = tree.patches();
     if !patches.is_patch(n) {
         return false;
     }
     let tris = &tree.triangles()[tree.tri_range(n)];
-    let Some((k, sign)) = axis(tris, at) else {
+    let Some(projection) = Projection::facing(tris, at) else {
         return false;
     };
-    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-    let plane = |v: u32| {
-        let p = at(v as usize);
-        [p[i], p[j]]
-    };
+    let plane = |v: u32| projection.apply(at(v as usize));
     // Most nodes that fail have a triangle facing the other way: found before the reach
     // (a pass over the node's vertices in CCD) is computed.
     let mut least_height_sq = f64::INFINITY;
+    let mut farthest = 0.0f64;
     for t in tris {
-        match height_sq(t.map(plane), sign) {
+        let corners = t.map(|v| at(v as usize));
+        for p in &corners {
+            farthest = farthest.max(p[0].abs() + p[1].abs() + p[2].abs());
+        }
+        match height_sq(corners.map(|p| projection.apply(p))) {
             Some(h2) => least_height_sq = least_height_sq.min(h2),
             None => return false,
         }
     }
-    let c = reach(k);
+    // Each computed point of the plane is within `REL * farthest` of the exact projection
+    // of its vertex, so a pair's exact projections are farther apart than their computed
+    // ones less twice that.
+    let c = ((reach(&projection) + 2.0 * REL * farthest) * (1.0 + REL)).next_up();
     if !(c.is_finite() && c >= 0.0) || least_height_sq <= c * c * (1.0 + REL) {
         return false;
     }
@@ -95,8 +103,9 @@ pub(crate) fn node_is_clear(
 /// Whether node `n` of `h` holds no feature pair within `distance` in its current pose.
 #[inline(never)]
 pub(crate) fn pose_is_clear<K: BoundingVolume>(h: &Hierarchy<K>, n: usize, distance: f64) -> bool {
-    let reach = (distance * (1.0 + REL)).next_up();
-    node_is_clear(h.tree(), n, &|v| h.position_f64(v), |_| reach)
+    node_is_clear(h.tree(), n, &|v| h.position_f64(v), |projection| {
+        projection.stretch(distance)
+    })
 }
 
 /// Whether node `n` of `tree` holds no feature pair that comes within `distance` during
@@ -110,85 +119,142 @@ pub(crate) fn motion_is_clear(
     horizon: f64,
     distance: f64,
 ) -> bool {
-    node_is_clear(tree, n, &|v| x0[v], |axis| {
-        let moves = Moves::of(tree, n, x0, x1);
-        let approach = moves.approach(axis) * horizon * (1.0 + REL);
-        ((distance + approach) * (1.0 + REL)).next_up()
+    node_is_clear(tree, n, &|v| x0[v], |projection| {
+        let approach = Moves::of(tree, n, x0, x1, projection).approach(projection);
+        projection.stretch(distance) + approach * horizon * (1.0 + REL)
     })
 }
 
-/// The displacements `x1 - x0` of a node's vertices: the box holding them and the longest.
+/// A linear map `p -> (u . p, v . p)` from space onto a plane, with `u x v` along the
+/// normals of the triangles it projects (so they turn counterclockwise), and a bound on
+/// how much it can lengthen a vector. Any linear map would serve the proof: two points at
+/// least `c` apart in the plane are at least `c / norm` apart in space.
+pub(crate) struct Projection {
+    u: [f64; 3],
+    v: [f64; 3],
+    /// An upper bound on the map's operator norm (1 up to roundings).
+    norm: f64,
+}
+
+impl Projection {
+    /// The projection along the sum of a sample of the triangles' normals, `None` when the
+    /// sum vanishes or a sampled normal faces away from it (that triangle would turn
+    /// clockwise: the node cannot pass).
+    fn facing(tris: &[[u32; 3]], at: &impl Fn(usize) -> [f64; 3]) -> Option<Self> {
+        let stride = tris.len().div_ceil(NORMAL_SAMPLE).max(1);
+        let mut normals = [[0.0f64; 3]; NORMAL_SAMPLE];
+        let mut sum = [0.0f64; 3];
+        let mut sampled = 0;
+        for t in tris.iter().step_by(stride) {
+            let [a, b, c] = t.map(|v| at(v as usize));
+            let e = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let f = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let normal = [
+                e[1] * f[2] - e[2] * f[1],
+                e[2] * f[0] - e[0] * f[2],
+                e[0] * f[1] - e[1] * f[0],
+            ];
+            for k in 0..3 {
+                sum[k] += normal[k];
+            }
+            normals[sampled] = normal;
+            sampled += 1;
+        }
+        let dot = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+        let length = dot(sum, sum).sqrt();
+        if !(length.is_finite() && length > 0.0)
+            || normals[..sampled].iter().any(|&m| dot(m, sum) <= 0.0)
+        {
+            return None;
+        }
+        let n = sum.map(|x| x / length);
+        // A right-handed orthonormal pair across `n` (Duff et al., "Building an orthonormal
+        // basis, revisited", 2017): `u x v = n`, and the coordinate axes when `n` is one.
+        let sign = 1.0f64.copysign(n[2]);
+        let a = -1.0 / (sign + n[2]);
+        let b = n[0] * n[1] * a;
+        let u = [1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]];
+        let v = [b, sign + n[1] * n[1] * a, -n[1]];
+        // The operator norm's square is the largest eigenvalue of the 2x2 Gram matrix, at
+        // most its largest diagonal entry plus the off-diagonal's magnitude.
+        let gram = dot(u, u).max(dot(v, v)) + dot(u, v).abs();
+        let norm = (gram * (1.0 + REL)).sqrt() * (1.0 + REL);
+        norm.is_finite().then_some(Self { u, v, norm })
+    }
+
+    /// The computed image of `p`: within `REL * |p|_1` of the exact one (two roundings of
+    /// a three-term dot product whose coefficients are at most 1 up to a rounding).
+    #[inline(always)]
+    fn apply(&self, p: [f64; 3]) -> P2 {
+        let (u, v) = (self.u, self.v);
+        [
+            u[0] * p[0] + u[1] * p[1] + u[2] * p[2],
+            v[0] * p[0] + v[1] * p[1] + v[2] * p[2],
+        ]
+    }
+
+    /// The distance in the plane that proves a distance `d` in space: `d` times the norm,
+    /// rounded up.
+    fn stretch(&self, d: f64) -> f64 {
+        ((d * self.norm) * (1.0 + REL)).next_up()
+    }
+}
+
+/// The displacements `x1 - x0` of a node's vertices, projected: the box holding them in
+/// the plane, the longest in space and the largest `|x1 - x0|_1` (the projection's rounding
+/// scale).
 struct Moves {
-    lo: [f64; 3],
-    hi: [f64; 3],
+    lo: P2,
+    hi: P2,
     longest: f64,
+    farthest: f64,
 }
 
 impl Moves {
-    fn of(tree: &RegionTree, n: usize, x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Self {
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        let mut longest_sq = 0.0f64;
+    fn of(
+        tree: &RegionTree,
+        n: usize,
+        x0: &[[f64; 3]],
+        x1: &[[f64; 3]],
+        projection: &Projection,
+    ) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let (mut longest_sq, mut farthest) = (0.0f64, 0.0f64);
         for v in tree.region_vertices(n) {
             let (p, q) = (x0[v as usize], x1[v as usize]);
             let u = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
             longest_sq = longest_sq.max(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-            for k in 0..3 {
-                lo[k] = lo[k].min(u[k]);
-                hi[k] = hi[k].max(u[k]);
+            farthest = farthest.max(u[0].abs() + u[1].abs() + u[2].abs());
+            let w = projection.apply(u);
+            for k in 0..2 {
+                lo[k] = lo[k].min(w[k]);
+                hi[k] = hi[k].max(w[k]);
             }
         }
         Self {
             lo,
             hi,
             longest: longest_sq.sqrt(),
+            farthest,
         }
     }
 
     /// An upper bound on how much two points of the node's features can approach each
-    /// other in the plane across `axis` over the whole motion: the largest difference of two
-    /// projected displacements (a point of a feature moves by a convex combination of its
-    /// vertices' displacements), at most twice the longest displacement and at most the
-    /// diagonal of their box in the plane. Each computed displacement is within a rounding
-    /// of `longest` of the exact one: the box grows by [`REL`] of it.
-    fn approach(&self, axis: usize) -> f64 {
-        if !self.longest.is_finite() {
+    /// other in the plane over the whole motion: the largest difference of two projected
+    /// displacements (a point of a feature moves by a convex combination of its vertices'
+    /// displacements), at most the norm times twice the longest displacement and at most
+    /// the diagonal of their box in the plane. Each computed displacement is within a
+    /// rounding of `longest` of the exact one and its computed image within `REL *
+    /// farthest` of that one's: the box grows by [`REL`] of both.
+    fn approach(&self, projection: &Projection) -> f64 {
+        if !(self.longest.is_finite() && self.farthest.is_finite()) {
             return f64::INFINITY;
         }
-        let slack = REL * self.longest;
+        let slack = REL * (self.longest + 2.0 * self.farthest);
         let extent = |k: usize| (self.hi[k] - self.lo[k]).max(0.0) + slack;
-        let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
-        let diagonal = (extent(i) * extent(i) + extent(j) * extent(j)).sqrt();
-        (2.0 * self.longest).min(diagonal) * (1.0 + REL)
+        let diagonal = (extent(0) * extent(0) + extent(1) * extent(1)).sqrt();
+        (2.0 * self.longest * projection.norm).min(diagonal) * (1.0 + REL)
     }
-}
-
-/// The coordinate axis the triangles' normals lean along most (sampled), and the sign of
-/// their lean; `None` when the sample's normals cancel or one of them leans the other way
-/// (the node cannot pass: its triangle would face the other way).
-fn axis(tris: &[[u32; 3]], at: &impl Fn(usize) -> [f64; 3]) -> Option<(usize, f64)> {
-    let stride = tris.len().div_ceil(AXIS_SAMPLE).max(1);
-    let mut normals = [[0.0f64; 3]; AXIS_SAMPLE];
-    let mut sum = [0.0f64; 3];
-    let mut sampled = 0;
-    for t in tris.iter().step_by(stride) {
-        let [a, b, c] = t.map(|v| at(v as usize));
-        let e = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let f = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let normal = [
-            e[1] * f[2] - e[2] * f[1],
-            e[2] * f[0] - e[0] * f[2],
-            e[0] * f[1] - e[1] * f[0],
-        ];
-        for k in 0..3 {
-            sum[k] += normal[k];
-        }
-        normals[sampled] = normal;
-        sampled += 1;
-    }
-    let k = (0..3).max_by(|&x, &y| sum[x].abs().total_cmp(&sum[y].abs()))?;
-    let sign = sum[k].signum();
-    let agree = normals[..sampled].iter().all(|n| sign * n[k] > 0.0);
-    (agree && sum[k] != 0.0 && sum[k].is_finite()).then_some((k, sign))
 }
 
 /// `u x v` in the plane and the sum of its two products' magnitudes (its rounding scale).
@@ -208,14 +274,14 @@ fn norm_sq(u: P2) -> f64 {
     u[0] * u[0] + u[1] * u[1]
 }
 
-/// A lower bound on the square of a projected triangle's least height if its orientation
-/// is certainly `sign`: `((sign (b - a) x (c - a))_low)^2 / |longest edge|^2`, rounded down
-/// by [`REL`].
+/// A lower bound on the square of a projected triangle's least height if it certainly
+/// turns counterclockwise: `((b - a) x (c - a))_low^2 / |longest edge|^2`, rounded down by
+/// [`REL`].
 #[inline(always)]
-fn height_sq([a, b, c]: [P2; 3], sign: f64) -> Option<f64> {
+fn height_sq([a, b, c]: [P2; 3]) -> Option<f64> {
     let (e, f) = (sub(b, a), sub(c, a));
     let (o, scale) = cross(e, f);
-    let low = sign * o - REL * scale;
+    let low = o - REL * scale;
     if low <= 0.0 {
         return None;
     }
@@ -327,7 +393,7 @@ fn boundary_is_clear(patch: &Patch<'_>, plane: &impl Fn(u32) -> P2, c: f64) -> b
 
 /// The winding number of the closed polygon `edges` around `x`, `None` when an edge passes
 /// too close to `x` to tell the side: crossings of the ray from `x` along the first axis,
-/// each edge taken half-open in the second coordinate (exact comparisons of the inputs).
+/// each edge taken half-open in the second coordinate (exact comparisons of the points).
 fn winding(x: P2, edges: &[[P2; 2]]) -> Option<i32> {
     let mut w = 0;
     for &[p, q] in edges {
@@ -392,11 +458,11 @@ mod tests {
     fn a_triangle_is_clear_when_its_least_height_exceeds_the_distance() {
         // Right triangle with legs 1: heights 1, 1 and sqrt(2) / 2.
         let t = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-        let h2 = height_sq(t, 1.0).unwrap();
+        let h2 = height_sq(t).unwrap();
         assert!(h2 <= 0.5 && h2 > 0.5 * (1.0 - 4.0 * REL));
-        assert!(height_sq(t, -1.0).is_none());
+        assert!(height_sq([t[0], t[2], t[1]]).is_none());
         // Degenerate: no orientation.
-        assert!(height_sq([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]], 1.0).is_none());
+        assert!(height_sq([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]).is_none());
     }
 
     #[test]
