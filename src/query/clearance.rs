@@ -64,10 +64,6 @@ pub(crate) fn node_is_clear(
     at: &impl Fn(usize) -> [f64; 3],
     reach: impl FnOnce(&Projection) -> f64,
 ) -> bool {
-    let patches = tree.patches();
-    if !patches.is_patch(n) {
-        return false;
-    }
     let tris = &tree.triangles()[tree.tri_range(n)];
     let Some(projection) = Projection::facing(tris, at) else {
         return false;
@@ -94,7 +90,9 @@ pub(crate) fn node_is_clear(
     if !(c.is_finite() && c >= 0.0) || least_height_sq <= c * c * (1.0 + REL) {
         return false;
     }
-    let Some(patch) = patches.patch(n) else {
+    // The topology last: only a node whose triangles all face one way, with heights above
+    // the reach, asks for its disks (computed on the first ask).
+    let Some(patch) = tree.patches().patch(tree, n) else {
         return false;
     };
     patch.loops.len() <= MOST_LOOPS && boundary_is_clear(&patch, &plane, c)
@@ -502,14 +500,15 @@ mod tests {
         let plane = |v: u32| at[v as usize];
         let both = Patch {
             edges: &edges,
-            loops: vec![0..4, 4..8],
+            loops: &[0..4, 4..8],
         };
         assert!(!boundary_is_clear(&both, &plane, 0.01));
         // Each loop alone is simple and clear.
         for edges in [&edges[..4], &edges[4..]] {
+            let one_loop = [std::ops::Range { start: 0, end: 4 }];
             let alone = Patch {
                 edges,
-                loops: std::iter::once(0..4).collect(),
+                loops: &one_loop,
             };
             assert!(boundary_is_clear(&alone, &plane, 0.01));
         }
@@ -526,7 +525,7 @@ mod tests {
         let edges2 = [[0, 1], [1, 2], [2, 3], [3, 0], [1, 4], [4, 5], [5, 1]];
         let touching = Patch {
             edges: &edges2,
-            loops: vec![0..4, 4..7],
+            loops: &[0..4, 4..7],
         };
         assert!(boundary_is_clear(&touching, &plane2, 0.01));
     }

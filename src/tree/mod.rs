@@ -138,8 +138,8 @@ pub struct RegionTree {
     /// The caller's triangles and the unique edge table, built by the first call that needs
     /// them ([`RegionTree::edges`], the contact set).
     tables: OnceLock<edges::MeshTables>,
-    /// Which nodes are disks of triangles, with their boundaries, built by the first
-    /// query that tests a node's clearance (`patches.rs`).
+    /// Which nodes are disks of triangles, with their boundaries, computed per node as
+    /// the clearance test asks (`patches.rs`).
     patches: OnceLock<patches::Patches>,
 }
 
@@ -399,10 +399,10 @@ impl RegionTree {
         self.tables.get_or_init(|| edges::MeshTables::build(self))
     }
 
-    /// Which nodes are patches (disks of triangles), built by the first call (see
+    /// Which nodes are patches (disks of triangles), each computed on its first ask (see
     /// `patches.rs`).
     pub(crate) fn patches(&self) -> &Patches {
-        self.patches.get_or_init(|| Patches::build(self))
+        self.patches.get_or_init(|| Patches::new(self))
     }
 
     /// Bytes of topology (shared by the three methods; not part of a BV's record; the

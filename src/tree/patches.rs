@@ -1,7 +1,7 @@
 //! Which nodes are *patches*: nodes whose triangles form one or more topological disks
 //! (touching at most at vertices), with each disk's boundary loop. The clearance test of the queries on
 //! features ([`crate::query::clearance`]) proves a patch free of close feature pairs from
-//! its triangles and its boundary loops alone; a node that is not a patch is never tested.
+//! its triangles and its boundary loops alone; a node that is not a patch is never proven.
 //!
 //! A node is a patch when the mesh is *clean* (every triangle has three distinct corners;
 //! around every vertex its triangles form one fan, an arc or a cycle, each edge of it shared
@@ -13,113 +13,116 @@
 //! so the part is a connected, oriented surface with one boundary loop and `V - E + F = 1`,
 //! genus 0.
 //!
-//! Built once per tree by the first query that asks, bottom up by gluing disks along
-//! edges ([`glue`]): a leaf from its triangles (disks of three edges), an internal node from
-//! its children's disks. Gluing needs only the disks' boundaries: in a clean mesh a vertex
-//! inside one disk (its whole fan there) is in no other, so disks share only boundary
-//! vertices.
+//! Computed per node on demand, memoized, by gluing disks along edges ([`glue`]): a leaf
+//! from its triangles (disks of three edges), an internal node from its children's disks
+//! (each asked in turn; a child that is no patch ends it). Gluing needs only the disks'
+//! boundaries: in a clean mesh a vertex inside one disk (its whole fan there) is in no
+//! other, so disks share only boundary vertices. Only nodes whose geometry the clearance
+//! test has already accepted ask, so a mesh the proof never takes (a tube, a crumpled
+//! cloth) pays for no topology.
+
+use std::ops::Range;
+use std::sync::OnceLock;
 
 use super::RegionTree;
 
-/// Per node, the boundary loops of its disks if it is a patch (internal vertex indices,
-/// each edge directed as its triangle runs it).
+/// Per node, once asked, the boundary loops of its disks if it is a patch (internal vertex
+/// indices, each edge directed as its triangle runs it); and, once a node is asked, whether
+/// the mesh is clean.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Patches {
-    /// Node `n`'s loops are `loops[range[n].0..range[n].1]`; `range[n].0 == u32::MAX`: not a
-    /// patch.
-    range: Vec<(u32, u32)>,
-    /// Each loop as its edges `boundary[start..end]`; a node's loops are consecutive, so its
-    /// edges are one run.
-    loops: Vec<(u32, u32)>,
-    boundary: Vec<[u32; 2]>,
+    /// Which vertices some triangle uses, if the mesh is clean.
+    clean: OnceLock<Option<Vec<bool>>>,
+    nodes: Vec<OnceLock<Option<Box<Disks>>>>,
 }
 
-const NOT_A_PATCH: (u32, u32) = (u32::MAX, u32::MAX);
+/// A patch's disks: every loop's boundary edges (one run) and each loop as a range of them.
+#[derive(Clone, Debug)]
+struct Disks {
+    edges: Vec<[u32; 2]>,
+    loops: Vec<Range<usize>>,
+}
 
 /// A patch: its boundary edges (every loop's, one run) and each loop as a range of them.
 pub(crate) struct Patch<'a> {
     pub(crate) edges: &'a [[u32; 2]],
-    pub(crate) loops: Vec<std::ops::Range<usize>>,
+    pub(crate) loops: &'a [Range<usize>],
 }
 
 impl Patches {
-    pub(crate) fn build(tree: &RegionTree) -> Self {
-        let nodes = tree.node_count();
-        let mut patches = Self {
-            range: vec![NOT_A_PATCH; nodes],
-            loops: Vec::new(),
-            boundary: Vec::new(),
-        };
-        let Some(used) = clean_mesh(tree) else {
-            return patches;
-        };
-        let tris = tree.triangles();
-        // Children have larger ids than their parent (breadth-first numbering).
-        for n in (0..nodes).rev() {
-            let glued = if tree.is_leaf(n) {
-                // A free point among its own vertices is a feature no triangle bounds.
-                if tree.vert_run(n).any(|v| !used[v]) || tree.tri_range(n).is_empty() {
-                    continue;
-                }
-                let parts: Vec<[[u32; 2]; 3]> = tris[tree.tri_range(n)]
-                    .iter()
-                    .map(|&[a, b, c]| [[a, b], [b, c], [c, a]])
-                    .collect();
-                glue(parts.iter().map(|p| &p[..]))
-            } else {
-                let children = tree.children(n);
-                if children.clone().any(|c| patches.range[c] == NOT_A_PATCH) {
-                    continue;
-                }
-                let parts: Vec<&[[u32; 2]]> = children
-                    .flat_map(|c| patches.loops_of(c))
-                    .map(|(s, e)| &patches.boundary[s as usize..e as usize])
-                    .collect();
-                glue(parts.into_iter())
-            };
-            if let Some(disks) = glued {
-                let first = patches.loops.len() as u32;
-                for edges in disks {
-                    let start = patches.boundary.len() as u32;
-                    patches.boundary.extend(edges);
-                    patches.loops.push((start, patches.boundary.len() as u32));
-                }
-                patches.range[n] = (first, patches.loops.len() as u32);
-            }
+    /// Nothing computed yet, for the nodes of `tree`.
+    pub(crate) fn new(tree: &RegionTree) -> Self {
+        Self {
+            clean: OnceLock::new(),
+            nodes: (0..tree.node_count()).map(|_| OnceLock::new()).collect(),
         }
-        patches
     }
 
-    fn loops_of(&self, n: usize) -> impl Iterator<Item = (u32, u32)> + '_ {
-        let (s, e) = self.range[n];
-        self.loops[s as usize..e as usize].iter().copied()
-    }
-
-    /// Node `n`'s disks if it is a patch.
-    pub(crate) fn patch(&self, n: usize) -> Option<Patch<'_>> {
-        if self.range[n] == NOT_A_PATCH {
-            return None;
-        }
-        let loops: Vec<(u32, u32)> = self.loops_of(n).collect();
-        let (first, last) = (loops[0].0 as usize, loops[loops.len() - 1].1 as usize);
+    /// Node `n` of `tree` (the tree these patches were made for) if it is a patch: its
+    /// disks, computed by the first call (with its descendants').
+    pub(crate) fn patch<'s>(&'s self, tree: &RegionTree, n: usize) -> Option<Patch<'s>> {
+        let disks = self.nodes[n]
+            .get_or_init(|| self.glued(tree, n))
+            .as_deref()?;
         Some(Patch {
-            edges: &self.boundary[first..last],
-            loops: loops
-                .iter()
-                .map(|&(s, e)| s as usize - first..e as usize - first)
-                .collect(),
+            edges: &disks.edges,
+            loops: &disks.loops,
         })
     }
 
-    /// Whether node `n` is a patch.
-    pub(crate) fn is_patch(&self, n: usize) -> bool {
-        self.range[n] != NOT_A_PATCH
+    fn glued(&self, tree: &RegionTree, n: usize) -> Option<Box<Disks>> {
+        let used = self.clean.get_or_init(|| clean_mesh(tree)).as_ref()?;
+        let glued = if tree.is_leaf(n) {
+            // A free point among its own vertices is a feature no triangle bounds.
+            if tree.vert_run(n).any(|v| !used[v]) || tree.tri_range(n).is_empty() {
+                return None;
+            }
+            let parts: Vec<[[u32; 2]; 3]> = tree.triangles()[tree.tri_range(n)]
+                .iter()
+                .map(|&[a, b, c]| [[a, b], [b, c], [c, a]])
+                .collect();
+            glue(parts.iter().map(|p| &p[..]))
+        } else {
+            let children: Vec<Patch<'_>> = tree
+                .children(n)
+                .map(|c| self.patch(tree, c))
+                .collect::<Option<_>>()?;
+            glue(
+                children
+                    .iter()
+                    .flat_map(|p| p.loops.iter().map(|l| &p.edges[l.clone()])),
+            )
+        }?;
+        let mut disks = Disks {
+            edges: Vec::with_capacity(glued.iter().map(Vec::len).sum()),
+            loops: Vec::with_capacity(glued.len()),
+        };
+        for edges in glued {
+            let start = disks.edges.len();
+            disks.edges.extend(edges);
+            disks.loops.push(start..disks.edges.len());
+        }
+        Some(Box::new(disks))
     }
 
+    /// Bytes held: the memo and every patch computed so far.
     pub(crate) fn bytes(&self) -> usize {
-        std::mem::size_of_val(&self.range[..])
-            + std::mem::size_of_val(&self.loops[..])
-            + std::mem::size_of_val(&self.boundary[..])
+        let patches: usize = self
+            .nodes
+            .iter()
+            .filter_map(|n| n.get()?.as_deref())
+            .map(|d| {
+                std::mem::size_of::<Disks>()
+                    + std::mem::size_of_val(&d.edges[..])
+                    + std::mem::size_of_val(&d.loops[..])
+            })
+            .sum();
+        let clean = self
+            .clean
+            .get()
+            .and_then(Option::as_ref)
+            .map_or(0, |u| u.len());
+        std::mem::size_of_val(&self.nodes[..]) + patches + clean
     }
 }
 
@@ -374,6 +377,52 @@ mod tests {
         let mut with_ring = ring.clone();
         with_ring.push([10, 11, 12]);
         assert!(glued(&with_ring).is_none());
+    }
+
+    /// Node 0 of the tree of `mesh` (leaves of at most 8 triangles): its loops' lengths
+    /// if it is a patch.
+    fn root_loops(mesh: &crate::Mesh) -> Option<Vec<usize>> {
+        let tree =
+            RegionTree::build(mesh, crate::tree::TreeShape::Adaptive { leaf_size: 8 }).unwrap();
+        assert!(tree.node_count() > 1);
+        let patches = tree.patches();
+        let p = patches.patch(&tree, 0)?;
+        // The memo answers the same the second time.
+        assert_eq!(patches.patch(&tree, 0).unwrap().edges, p.edges);
+        Some(p.loops.iter().map(|l| l.len()).collect())
+    }
+
+    #[test]
+    fn nodes_are_patches_on_demand() {
+        // A 6 x 6 grid: one loop of 24 edges around it.
+        let sheet = crate::shapes::grid(6, 6, 1.0, [0.0; 3]);
+        assert_eq!(root_loops(&sheet), Some(vec![24]));
+        // Rolled into a tube (the last column of vertices is the first): no disk.
+        let n = 6u32;
+        let at = |i: u32, j: u32| j * n + i % n;
+        let positions: Vec<[f32; 3]> = (0..=n)
+            .flat_map(|j| {
+                (0..n).map(move |i| {
+                    let a = std::f32::consts::TAU * i as f32 / n as f32;
+                    [a.cos(), a.sin(), j as f32]
+                })
+            })
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..n)
+            .flat_map(|j| {
+                (0..n).flat_map(move |i| {
+                    let [a, b, c, d] = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+                    [[a, b, c], [a, c, d]]
+                })
+            })
+            .collect();
+        let tube = crate::Mesh::new(positions, triangles).unwrap();
+        assert_eq!(root_loops(&tube), None);
+        // The sheet with a point no triangle uses: its leaf is no patch, nor the root.
+        let mut p = sheet.positions().to_vec();
+        p.push([2.5, 2.5, 1.0]);
+        let with_point = crate::Mesh::new(p, sheet.triangles().to_vec()).unwrap();
+        assert_eq!(root_loops(&with_point), None);
     }
 
     #[test]
