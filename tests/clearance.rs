@@ -374,7 +374,18 @@ fn a_turned_cylinder_is_proven_clear_along_its_mean_normal() {
     };
     assert_eq!(crate::step_size::brute_force_step(&m, &x0, &x1, &o), 1.0);
     for_each_method!(K => crate::step_size::check::<K>(&m, &x0, &x1, &o, 1.0));
-    // Rolled up by 2.5 times its curvature, its rims come within 0.1 of each other.
+    // The same step 10^4 away from the origin (in f64): each projected point now rounds by
+    // about 10^-12, still far below the heights, so the proof holds and stays exact.
+    let far = |x: &[[f64; 3]]| -> Vec<[f64; 3]> {
+        x.iter()
+            .map(|p| [p[0] + 1.0e4, p[1] - 2.0e4, p[2] + 0.5e4])
+            .collect()
+    };
+    assert_eq!(
+        ccd_checked(&m, &far(&x0), &far(&x1), 0.0, "cylinder step far away"),
+        0
+    );
+    // Rolled up into a spiral past a turn, its rims come within 0.02 of each other.
     let rolled: Vec<[f64; 3]> = {
         let flat = grid(12, 12, 1.0 / 12.0, [0.0; 3]);
         let spread = 375f64.to_radians();
@@ -383,7 +394,7 @@ fn a_turned_cylinder_is_proven_clear_along_its_mean_normal() {
             .iter()
             .map(|p| {
                 let a = spread * (f64::from(p[0]) - 0.5);
-                let r = 1.0 - 0.05 * a / spread;
+                let r = 1.0 - 0.02 * a / spread;
                 [(r * a.sin()) as f32, p[1], (r * a.cos()) as f32]
             })
             .collect();
@@ -397,5 +408,11 @@ fn a_turned_cylinder_is_proven_clear_along_its_mean_normal() {
             > 0
     );
     proximity_checked(&rolled_mesh, 0.1, "rolled");
-    ccd_checked(&m, &x0, &f64s(rolled_mesh.positions()), 0.0, "rolling up");
+    // Rolling up, at a distance below the least projected height: the proof would pass at
+    // the start, but the motion moves the rims by about 1.
+    let x1 = f64s(rolled_mesh.positions());
+    let options = CcdOptions::new(1.0, 0.03).unwrap();
+    let want = brute_force_self_ccd(&m, Motion::new(&x0, &x1), &options);
+    assert!(want.counters.contacts > 0);
+    ccd_checked(&m, &x0, &x1, 0.03, "rolling up");
 }
