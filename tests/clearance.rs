@@ -338,21 +338,28 @@ fn a_turned_flat_sheet_at_its_least_height() {
     proximity_checked(&m, h * 1.001, "turned flat above");
 }
 
-/// A quarter-and-more of a cylinder of radius 1 (150 degrees around, `n` cells, and 1 long,
-/// `n` cells), turned by [`TURN`]: its normals spread 75 degrees either side of their
-/// mean, so no coordinate axis sees every triangle face one way, while the mean does.
-fn turned_cylinder(n: u32) -> Mesh {
+/// An `n` x `n` sheet of side 1 rolled `degrees` around the y axis, its radius shrinking
+/// from 1 by `shrink` over the roll (a spiral), then turned by [`TURN`].
+fn rolled_sheet(n: u32, degrees: f64, shrink: f64) -> Mesh {
     let flat = grid(n, n, 1.0 / n as f32, [0.0; 3]);
-    let spread = 150f64.to_radians();
-    let bent: Vec<[f32; 3]> = flat
+    let spread = degrees.to_radians();
+    let rolled: Vec<[f32; 3]> = flat
         .positions()
         .iter()
         .map(|p| {
             let a = spread * (f64::from(p[0]) - 0.5);
-            [a.sin() as f32, p[1], a.cos() as f32]
+            let r = 1.0 - shrink * a / spread;
+            [(r * a.sin()) as f32, p[1], (r * a.cos()) as f32]
         })
         .collect();
-    with_positions(&flat, f32s(&turned(&bent, TURN, [0.0; 3])))
+    with_positions(&flat, f32s(&turned(&rolled, TURN, [0.0; 3])))
+}
+
+/// A quarter-and-more of a cylinder of radius 1 (150 degrees around, `n` cells, and 1 long,
+/// `n` cells), turned by [`TURN`]: its normals spread 75 degrees either side of their
+/// mean, so no coordinate axis sees every triangle face one way, while the mean does.
+fn turned_cylinder(n: u32) -> Mesh {
+    rolled_sheet(n, 150.0, 0.0)
 }
 
 #[test]
@@ -386,21 +393,7 @@ fn a_turned_cylinder_is_proven_clear_along_its_mean_normal() {
         0
     );
     // Rolled up into a spiral past a turn, its rims come within 0.02 of each other.
-    let rolled: Vec<[f64; 3]> = {
-        let flat = grid(12, 12, 1.0 / 12.0, [0.0; 3]);
-        let spread = 375f64.to_radians();
-        let p: Vec<[f32; 3]> = flat
-            .positions()
-            .iter()
-            .map(|p| {
-                let a = spread * (f64::from(p[0]) - 0.5);
-                let r = 1.0 - 0.02 * a / spread;
-                [(r * a.sin()) as f32, p[1], (r * a.cos()) as f32]
-            })
-            .collect();
-        turned(&p, TURN, [0.0; 3])
-    };
-    let rolled_mesh = with_positions(&m, f32s(&rolled));
+    let rolled_mesh = rolled_sheet(12, 375.0, 0.02);
     assert!(
         brute_force_self_proximity(&rolled_mesh, 0.1)
             .counters
