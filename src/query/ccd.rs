@@ -557,9 +557,9 @@ impl<'h, K: BoundingVolume> Swept<'h, K> {
         let r = edges.range_of_rank(rank);
         LeafEdges {
             edges: edges.of_rank(rank),
+            ids: edges.ids_of_rank(rank),
             rows: std::array::from_fn(|f| &self.edge_rows[f][r.clone()]),
             bounds: self.leaf_bounds[leaf][1],
-            order: tree.vert_order(),
         }
     }
 

@@ -56,18 +56,6 @@ fn grown(b: &FeatureBox, m: f32) -> FeatureBox {
     )
 }
 
-/// An edge (internal vertex indices) as its original indices, smaller first, and its
-/// internal indices in that same order. `order` maps internal to original indices.
-#[inline(always)]
-fn ordered_edge(order: &[u32], [s, t]: [u32; 2]) -> ([u32; 2], [u32; 2]) {
-    let (os, ot) = (order[s as usize], order[t as usize]);
-    if os < ot {
-        ([os, ot], [s, t])
-    } else {
-        ([ot, os], [t, s])
-    }
-}
-
 /// A leaf's triangles as candidates: their boxes (the first `len` of six rows) and a box
 /// holding them all (`bounds`), the internal index of the first, and every triangle's corners
 /// (internal indices).
@@ -86,13 +74,14 @@ pub(crate) struct LeafVertices<'a> {
     pub(crate) first: usize,
 }
 
-/// A leaf's own edges as candidates (internal vertex indices) with their boxes and a box
-/// holding them all (`bounds`), and the internal-to-original vertex order of their mesh.
+/// A leaf's own edges as candidates: each as its internal and (`ids`, same place) original
+/// vertex indices, the smaller original index first (`tree::edges::LeafEdges`), with their
+/// boxes and a box holding them all (`bounds`).
 pub(crate) struct LeafEdges<'a> {
     pub(crate) edges: &'a [[u32; 2]],
+    pub(crate) ids: &'a [[u32; 2]],
     pub(crate) rows: BoxRows<'a>,
     pub(crate) bounds: FeatureBox,
-    pub(crate) order: &'a [u32],
 }
 
 /// The box of `rows`' first `n` boxes (empty: `+inf..-inf`): the bounds a leaf keeps with
@@ -107,7 +96,7 @@ pub(crate) fn bounds_of(rows: &BoxRows, n: usize) -> FeatureBox {
 }
 
 /// An edge of a candidate pair: its original vertex indices, smaller first, and its
-/// internal indices in the same order ([`ordered_edge`]).
+/// internal indices in the same order.
 #[derive(Clone, Copy)]
 pub(crate) struct CandidateEdge {
     pub(crate) ids: [u32; 2],
@@ -204,8 +193,10 @@ impl Candidates<'_> {
                     [ra[3][i], ra[4][i], ra[5][i]],
                 );
                 let probe = grown(&abox, self.margin);
-                let (ids, internal) = ordered_edge(a.order, ea[i]);
-                let x = CandidateEdge { ids, internal };
+                let x = CandidateEdge {
+                    ids: a.ids[i],
+                    internal: ea[i],
+                };
                 // A leaf with itself: only j > i.
                 let from = if same_leaf { i + 1 } else { 0 };
                 for base in (from..eb.len()).step_by(MAX_BOX_ROW) {
@@ -221,8 +212,10 @@ impl Candidates<'_> {
                             continue;
                         }
                         counters.prim_tests += 1;
-                        let (ids, internal) = ordered_edge(b.order, eb[j]);
-                        let y = CandidateEdge { ids, internal };
+                        let y = CandidateEdge {
+                            ids: b.ids[j],
+                            internal: eb[j],
+                        };
                         if self.self_query && y.ids < x.ids {
                             decide(y, x);
                         } else {

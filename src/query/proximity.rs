@@ -214,7 +214,9 @@ fn sort_rows(p: &mut Proximity) {
         .sort_unstable_by_key(|x| (u64::from(x.triangle) << 32) | u64::from(x.vertex));
     // PERF: one 128-bit key; the arrays compared field by field made the proximity query
     // 3-5% slower on cloth-ball and rod-twist. A counting sort by `a[0]` (`crate::sort`)
-    // was no faster on cloth-ball (7 rows a vertex: the scatter and a second buffer).
+    // was no faster on cloth-ball (7 rows a vertex: the scatter and a second buffer), nor
+    // was a 64-bit key where the indices fit in 16 bits (the moves of the 32-byte rows
+    // cost more than the comparisons).
     p.edge_edge
         .sort_unstable_by_key(|x| crate::sort::as_one([x.a[0], x.a[1], x.b[0], x.b[1]]));
 }
@@ -259,13 +261,12 @@ impl<'h, K: BoundingVolume> Leaf<'h, K> {
     fn edges(&self) -> LeafEdges<'h> {
         let tree = self.h.tree();
         let boxes = self.h.leaf_feature_boxes(self.node);
+        let rank = tree.leaf_rank(self.node).expect("a leaf");
         LeafEdges {
-            edges: tree
-                .leaf_edges()
-                .of_rank(tree.leaf_rank(self.node).expect("a leaf")),
+            edges: tree.leaf_edges().of_rank(rank),
+            ids: tree.leaf_edges().ids_of_rank(rank),
             rows: boxes.edges,
             bounds: boxes.edge_bounds,
-            order: tree.vert_order(),
         }
     }
 

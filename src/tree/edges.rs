@@ -9,12 +9,16 @@
 
 use super::RegionTree;
 
-/// Per leaf rank `r`: its own edges `edges[start[r]..start[r + 1]]`, each as its two
-/// internal vertex indices (smaller first), in the order of their first triangles.
+/// Per leaf rank `r`: its own edges `edges[start[r]..start[r + 1]]`, in the order of their
+/// first triangles, each as its two internal vertex indices and (`ids`, same place) its two
+/// original indices, both with the smaller original index first: the order in which the
+/// queries report an edge, kept here so that a candidate pair reads it rather than looking
+/// both ends up.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) struct LeafEdges {
     start: Vec<u32>,
     edges: Vec<[u32; 2]>,
+    ids: Vec<[u32; 2]>,
 }
 
 impl LeafEdges {
@@ -46,20 +50,35 @@ impl LeafEdges {
         for r in 0..leaves {
             start[r + 1] += start[r];
         }
+        let order = tree.vert_order();
         let mut fill = start.clone();
         let mut edges = vec![[0u32; 2]; all.len()];
-        for &(e, t) in &all {
-            let r = tri_leaf[t as usize] as usize;
-            edges[fill[r] as usize] = e;
+        let mut ids = vec![[0u32; 2]; all.len()];
+        for &([s, t], tri) in &all {
+            let r = tri_leaf[tri as usize] as usize;
+            let (os, ot) = (order[s as usize], order[t as usize]);
+            let at = fill[r] as usize;
+            (edges[at], ids[at]) = if os < ot {
+                ([s, t], [os, ot])
+            } else {
+                ([t, s], [ot, os])
+            };
             fill[r] += 1;
         }
-        Self { start, edges }
+        Self { start, edges, ids }
     }
 
-    /// The own edges of the leaf of rank `r`.
+    /// The own edges of the leaf of rank `r` (internal indices).
     #[inline]
     pub(crate) fn of_rank(&self, r: usize) -> &[[u32; 2]] {
         &self.edges[self.range_of_rank(r)]
+    }
+
+    /// The original indices of the own edges of the leaf of rank `r`, in [`Self::of_rank`]'s
+    /// order.
+    #[inline]
+    pub(crate) fn ids_of_rank(&self, r: usize) -> &[[u32; 2]] {
+        &self.ids[self.range_of_rank(r)]
     }
 
     /// Where the own edges of the leaf of rank `r` sit in [`LeafEdges::all`].
