@@ -221,7 +221,7 @@ impl Impacts {
     }
 
     /// A scene's result flattened with object ids (as
-    /// [`scene_proximity_rows`](crate::proximity::scene_proximity_rows)), each list sorted by
+    /// [`scene_proximity_columns`](crate::proximity::scene_proximity_columns)), each list sorted by
     /// its rows.
     pub(crate) fn of_scene(py: Python<'_>, r: dhcd::SceneImpacts) -> PyResult<Self> {
         let mut rows: (TimeRows<4>, TimeRows<4>, TimeRows<6>) = Default::default();

@@ -1,7 +1,7 @@
 //! Many deformable objects: the `Scene` class, its objects (by id or name) and its queries.
 //! A query method parses its arguments here ([`Scene::updates`], [`Scene::motions`]), runs
 //! the library's scene query and returns its family's result through that family's one
-//! conversion (`Contacts::of_scene`, `scene_proximity_rows`, `Impacts::of_scene`,
+//! conversion (`Contacts::of_scene`, `scene_proximity_columns`, `Impacts::of_scene`,
 //! `ContactSet::new`).
 
 use std::collections::{HashMap, HashSet};
@@ -15,7 +15,7 @@ use pyo3::types::{PyList, PyMapping, PyString, PyTuple};
 use crate::arrays::{ccd_positions, faces, rows_of, Positions, Vertices};
 use crate::ccd::{ccd_query, Impacts};
 use crate::collide::Contacts;
-use crate::proximity::{scene_proximity_rows, Proximity};
+use crate::proximity::{scene_proximity_columns, Proximity};
 use crate::step::step_options;
 use crate::{contact, distance_arg, int_arg, interrupt, method, options, par, to_py, value_error};
 
@@ -360,7 +360,7 @@ impl Scene {
         let scene = &mut self.scene;
         let rows = interrupt::run(py, par, |control| {
             scene.set_control(control.clone());
-            Ok(scene_proximity_rows(scene.proximity(d, par)?))
+            Ok(scene_proximity_columns(scene.proximity(d, par)?))
         })?;
         Proximity::new(py, rows)
     }
