@@ -618,9 +618,11 @@ fn contact_set_of<K: BoundingVolume>(
     let side =
         |i: usize| contact::Side::new(&objects[i].h, None, vertex_offsets[i], edge_offsets[i]);
     let mut set = ContactSet::default();
+    let mut scratch = contact::ContactScratch::default();
     for pair in rows.per_pair {
         let (ia, ib) = (index(pair.a), index(pair.b));
-        let part = contact::from_rows(pair.proximity, &side(ia)?, &side(ib)?, ia == ib, par);
+        let (sa, sb) = (side(ia)?, side(ib)?);
+        let part = contact::from_rows(pair.proximity, &sa, &sb, ia == ib, par, &mut scratch);
         set.contacts.extend(part.contacts);
         set.positions.extend(part.positions);
     }

@@ -405,6 +405,43 @@ fn two_sheets_number_vertices_and_edges_a_then_b() {
     for_each_method!(K => check_pair::<K>(&a, &b, 0.05));
 }
 
+/// One workspace carried through contact sets of different meshes, distances and threads,
+/// self and pair queries (its scratch holds the previous query's rows, larger or smaller):
+/// each set is the one a fresh workspace gives.
+#[test]
+fn a_reused_workspace_gives_the_sets_of_a_fresh_one() {
+    let rest = grid(9, 9, 0.1, [0.0, 0.0, 0.0]);
+    let folded = f64_mesh(
+        &rest,
+        jitter(&fold_x(rest.positions(), 0.45), [0.004; 3], 7),
+    );
+    let small = grid(5, 7, 0.11, [0.03, -0.02, 0.0]);
+    let lifted = f64_mesh(&small, jitter(small.positions(), [0.0, 0.0, 0.03], 3));
+    let (hf, hl) = (
+        Hierarchy::<dhcd::bv::Dh>::new(&folded, Options::default()).unwrap(),
+        Hierarchy::<dhcd::bv::Dh>::new(&lifted, Options::default()).unwrap(),
+    );
+    let mut ws = Workspace::default();
+    let mut sizes = Vec::new();
+    for (dhat, par) in [(0.12, Par::Seq), (0.02, Par::Rayon(2)), (0.06, Par::Seq)] {
+        for self_query in [true, false] {
+            let run = |ws: &mut Workspace| {
+                if self_query {
+                    self_contact_set_with(&hf, dhat, None, ws, par).unwrap()
+                } else {
+                    contact_set_with(&hf, &hl, dhat, [None, None], ws, par).unwrap()
+                }
+            };
+            let (reused, fresh) = (run(&mut ws), run(&mut Workspace::default()));
+            assert_eq!(reused, fresh, "dhat {dhat} {par:?} self {self_query}");
+            sizes.push(reused.len());
+        }
+    }
+    // The scratch is exercised both ways: a set smaller, then larger, than the one before.
+    assert!(sizes.windows(2).any(|w| w[0] > w[1]), "{sizes:?}");
+    assert!(sizes.windows(2).any(|w| w[0] < w[1]), "{sizes:?}");
+}
+
 /// A vertex above the middle of a shared edge is one point-edge contact, not one per
 /// triangle (and not again from the edges at its ends).
 #[test]

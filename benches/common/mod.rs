@@ -96,9 +96,10 @@ impl ParrySelf {
     }
 }
 
-/// A built implementation, ready to step.
+/// A built implementation, ready to step (dhcd's workspace boxed: it is several times the
+/// size of parry's state).
 enum Runner {
-    Dhcd(AnyHierarchy, Workspace),
+    Dhcd(AnyHierarchy, Box<Workspace>),
     Parry(ParrySelf),
 }
 
@@ -107,7 +108,7 @@ impl Runner {
         match imp {
             Impl::Dhcd(m) => Runner::Dhcd(
                 AnyHierarchy::new(m, rest, Options::default()).expect("a valid mesh"),
-                Workspace::default(),
+                Box::default(),
             ),
             Impl::Parry => Runner::Parry(ParrySelf::new(rest)),
         }

@@ -25,7 +25,7 @@ pub mod geometry;
 mod set;
 pub(crate) mod step;
 
-pub(crate) use set::{from_rows, offset, Side};
+pub(crate) use set::{from_rows, offset, ContactScratch, Side};
 
 pub use geometry::{distance_gradient, distance_hessian, distance_sq, ContactType};
 pub use set::{

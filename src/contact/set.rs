@@ -152,7 +152,7 @@ pub fn self_contact_set_with<K: BoundingVolume>(
 ) -> Result<ContactSet> {
     let side = Side::new(h, rest, 0, 0)?;
     let rows = proximity::self_proximity_in(h, dhat, ws, par, Rows::AsFound)?;
-    Ok(from_rows(rows, &side, &side, true, par))
+    Ok(from_rows(rows, &side, &side, true, par, &mut ws.contact))
 }
 
 /// Every contact between `a` and `b` within `dhat`. Vertices are numbered `a`'s first, then
@@ -189,7 +189,7 @@ pub fn contact_set_with<K: BoundingVolume>(
         offset(a.tree().edges().len(), b.tree().edges().len())?,
     )?;
     let rows = proximity::proximity_in(a, b, dhat, ws, par, Rows::AsFound)?;
-    Ok(from_rows(rows, &sa, &sb, false, par))
+    Ok(from_rows(rows, &sa, &sb, false, par, &mut ws.contact))
 }
 
 /// An offset `first` before `then` more, if both fit the `u32` numbering.
@@ -604,6 +604,15 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
     }
 }
 
+/// The scratch of [`from_rows`], kept in the caller's [`Workspace`] so that a contact set
+/// built again reuses its memory: the keyed rows, sorted, and the counting sort's starts.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ContactScratch {
+    keyed: Vec<Keyed>,
+    sorted: Vec<Keyed>,
+    starts: Vec<usize>,
+}
+
 /// The contact set of proximity `rows` between sides `a` and `b` (the same side, and
 /// `self_query`, for a self query): each row's contact, once (from its producer, see
 /// [`Sides`]), sorted by `(kind, vertices)`. The rows are keyed, sorted and their contacts
@@ -614,24 +623,34 @@ pub(crate) fn from_rows<K: BoundingVolume>(
     b: &Side<'_, K>,
     self_query: bool,
     par: Par,
+    scratch: &mut ContactScratch,
 ) -> ContactSet {
     let sides = Sides { a, b, self_query };
     let n = rows.vertex_face.len() + rows.face_vertex.len() + rows.edge_edge.len();
-    let keyed: Vec<Keyed> = if par.is_parallel() {
+    let ContactScratch {
+        keyed: unsorted,
+        sorted: keyed,
+        starts,
+    } = scratch;
+    unsorted.clear();
+    if par.is_parallel() {
         par.install(|| {
-            (0..n)
-                .into_par_iter()
-                .with_min_len(1024)
-                .map(|i| sides.keyed(&rows, i))
-                .collect()
-        })
+            unsorted.par_extend(
+                (0..n)
+                    .into_par_iter()
+                    .with_min_len(1024)
+                    .map(|i| sides.keyed(&rows, i)),
+            )
+        });
     } else {
-        (0..n).map(|i| sides.keyed(&rows, i)).collect()
-    };
+        unsorted.extend((0..n).map(|i| sides.keyed(&rows, i)));
+    }
     // By contact, then producer order (`Sides::rank`); the row makes the order total.
     let vertices = sides.vertex_count();
-    let mut keyed = crate::sort::by_group(
+    crate::sort::by_group_into(
+        unsorted,
         keyed,
+        starts,
         ContactType::ALL.len() * vertices,
         |k| k.key.0 as usize * vertices + sides.dense(k.key.1[0]),
         |k| (k.key.0, crate::sort::as_one(k.key.1), k.rank, k.row),
@@ -641,7 +660,13 @@ pub(crate) fn from_rows<K: BoundingVolume>(
     let mut start = 0;
     while start < keyed.len() {
         let key = keyed[start].key;
-        let end = start + keyed[start..].partition_point(|k| k.key == key);
+        // PERF: a scan, not a binary search of the rest: runs are one to a few rows.
+        let end = start
+            + 1
+            + keyed[start + 1..]
+                .iter()
+                .take_while(|k| k.key == key)
+                .count();
         keyed[kept] = sides.producer(&rows, &keyed[start..end]);
         kept += 1;
         start = end;

@@ -134,8 +134,9 @@ pub(crate) fn push_bits(
     }
 }
 
-/// Reusable scratch of a walk (its stack and starting pairs): keep one per thread to avoid
-/// allocating every step. Also holds the smallest number of starting pairs a parallel task
+/// Reusable scratch of a walk (its stack and starting pairs) and of the queries built on
+/// walks (the contact set's keyed rows): keep one per thread to avoid allocating every
+/// step. It holds on to the memory of its largest query (see `docs/LIMITS.md`). Also holds the smallest number of starting pairs a parallel task
 /// takes (the *grain*; the result never depends on it) and the [`Control`] of the queries
 /// run with it (the most result pairs, cancellation).
 #[derive(Clone, Debug)]
@@ -145,6 +146,7 @@ pub struct Workspace {
     pub(crate) grain: usize,
     pub(crate) stack: Vec<[u32; 2]>,
     pub(crate) seeds: Vec<[u32; 2]>,
+    pub(crate) contact: crate::contact::ContactScratch,
 }
 
 /// Default smallest number of starting pairs per parallel task.
@@ -165,6 +167,7 @@ impl Workspace {
             grain: grain.max(1),
             stack: Vec::new(),
             seeds: Vec::new(),
+            contact: Default::default(),
         }
     }
 }
