@@ -268,14 +268,19 @@ type Key = (ContactType, [u32; 4]);
 
 /// A proximity row keyed by its contact, as the merge sorts them: the contact, the row's
 /// place in its contact's producer order ([`Sides::rank`]), the row (its index among the
-/// vertex-face, then face-vertex, then edge-edge rows), and whether an edge-edge row's edges
-/// are nearly parallel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// vertex-face, then face-vertex, then edge-edge rows), whether an edge-edge row's edges
+/// are nearly parallel, and what its contact takes from it: the squared distance and an
+/// edge-edge row's closest features (`None` for a vertex-triangle row).
+// PERF: the row's values travel with the key; read back from the rows (in key order, so
+// at random) they cost a cache miss a contact, an eighth of cloth-ball's contact set.
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Keyed {
     key: Key,
     rank: u64,
     row: usize,
     mollified: bool,
+    closest: Option<EdgeEdge>,
+    distance_sq: f64,
 }
 
 /// A proximity row by its index among the vertex-face, then face-vertex, then edge-edge rows
@@ -516,7 +521,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
                 vertex,
                 triangle,
                 kind,
-                ..
+                distance_sq,
             } => {
                 let key = self.vertex_face_key(side, vertex, triangle, kind);
                 let g = vertex + self.side(side).vertex_offset;
@@ -525,6 +530,8 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
                     rank: Self::rank(&key, Some((g, triangle))),
                     row: i,
                     mollified: false,
+                    closest: None,
+                    distance_sq,
                 }
             }
             Row::EdgeEdge(r) => {
@@ -543,6 +550,8 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
                     rank: Self::rank(&key, None),
                     row: i,
                     mollified,
+                    closest: Some(r.kind),
+                    distance_sq: r.distance_sq,
                 }
             }
         }
@@ -565,7 +574,7 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
     /// ([`crate::tree::MeshTables`]), so the pairs are compared.
     fn producer(&self, rows: &Proximity, run: &[Keyed]) -> Keyed {
         let first = run[0];
-        if run.len() == 1 || matches!(Row::of(rows, first.row), Row::VertexFace { .. }) {
+        if run.len() == 1 || first.closest.is_none() {
             return first;
         }
         debug_assert!(
@@ -595,12 +604,8 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
     }
 
     /// The contact of row `k`.
-    fn contact_of(&self, rows: &Proximity, k: &Keyed) -> (Contact, [[f64; 3]; 4]) {
-        let (distance_sq, closest) = match Row::of(rows, k.row) {
-            Row::VertexFace { distance_sq, .. } => (distance_sq, None),
-            Row::EdgeEdge(r) => (r.distance_sq, Some(r.kind)),
-        };
-        self.contact(k.key, distance_sq, k.mollified, closest)
+    fn contact_of(&self, k: &Keyed) -> (Contact, [[f64; 3]; 4]) {
+        self.contact(k.key, k.distance_sq, k.mollified, k.closest)
     }
 }
 
@@ -677,11 +682,11 @@ pub(crate) fn from_rows<K: BoundingVolume>(
             keyed
                 .par_iter()
                 .with_min_len(1024)
-                .map(|k| sides.contact_of(&rows, k))
+                .map(|k| sides.contact_of(k))
                 .unzip()
         })
     } else {
-        keyed.iter().map(|k| sides.contact_of(&rows, k)).unzip()
+        keyed.iter().map(|k| sides.contact_of(k)).unzip()
     };
     let mut counters = rows.counters;
     counters.contacts = contacts.len() as u64;
