@@ -182,6 +182,29 @@ fn toi_columns<const N: usize>(py: Python<'_>, rows: TimeRows<N>) -> PyResult<Ti
     Ok((idx.into_pyarray(py).unbind(), toi.into_pyarray(py).unbind()))
 }
 
+/// A row of `N` indices: the object ids `[a, b]` (if any) before each side's indices,
+/// `[a?, x.., b?, y..]`.
+// PERF: a fixed array; a row collected into a `Vec` first was a heap allocation a pair.
+fn id_row<const N: usize>(ids: Option<[u64; 2]>, x: &[u64], y: &[u64]) -> [u64; N] {
+    let mut row = [0u64; N];
+    let (a, b) = match ids {
+        Some([a, b]) => (Some(a), Some(b)),
+        None => (None, None),
+    };
+    let items = a
+        .into_iter()
+        .chain(x.iter().copied())
+        .chain(b)
+        .chain(y.iter().copied());
+    let mut n = 0;
+    for (slot, v) in row.iter_mut().zip(items) {
+        *slot = v;
+        n += 1;
+    }
+    assert_eq!(n, N, "row width");
+    row
+}
+
 /// The rows of one walk's impacts with object ids `[a, b]` in front of each side's indices
 /// (`None`: a single mesh's query, no ids): vertex-face, face-vertex, edge-edge.
 fn impact_rows<const V: usize, const E: usize>(
@@ -190,27 +213,21 @@ fn impact_rows<const V: usize, const E: usize>(
     (vf, fv, ee): &mut (TimeRows<V>, TimeRows<V>, TimeRows<E>),
 ) {
     let i = u64::from;
-    let ids: Vec<u64> = ids.map(|x| x.to_vec()).unwrap_or_default();
-    // `[a?, x, b?, y]`: the object ids (if any) before each side's indices.
-    let row = |x: &[u64], y: &[u64]| -> Vec<u64> {
-        let (a, b) = (ids.first(), ids.get(1));
-        a.into_iter().chain(x).chain(b).chain(y).copied().collect()
-    };
-    let fixed = |r: Vec<u64>| -> [u64; V] { r.try_into().expect("row width") };
     vf.extend(
         r.vertex_face
             .iter()
-            .map(|x| (fixed(row(&[i(x.vertex)], &[i(x.triangle)])), x.toi)),
+            .map(|x| (id_row(ids, &[i(x.vertex)], &[i(x.triangle)]), x.toi)),
     );
     fv.extend(
         r.face_vertex
             .iter()
-            .map(|x| (fixed(row(&[i(x.triangle)], &[i(x.vertex)])), x.toi)),
+            .map(|x| (id_row(ids, &[i(x.triangle)], &[i(x.vertex)]), x.toi)),
     );
-    ee.extend(r.edge_edge.iter().map(|x| {
-        let r = row(&x.a.map(i), &x.b.map(i));
-        (r.try_into().expect("row width"), x.toi)
-    }));
+    ee.extend(
+        r.edge_edge
+            .iter()
+            .map(|x| (id_row(ids, &x.a.map(i), &x.b.map(i)), x.toi)),
+    );
 }
 
 impl Impacts {
