@@ -610,10 +610,11 @@ impl<K: BoundingVolume> Sides<'_, '_, K> {
 }
 
 /// The scratch of [`from_rows`], kept in the caller's [`Workspace`] so that a contact set
-/// built again reuses its memory: the keyed rows, sorted, and the counting sort's starts.
+/// built again reuses its memory: the keyed rows as found, the same sorted, and the
+/// counting sort's starts.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ContactScratch {
-    keyed: Vec<Keyed>,
+    found: Vec<Keyed>,
     sorted: Vec<Keyed>,
     starts: Vec<usize>,
 }
@@ -633,14 +634,14 @@ pub(crate) fn from_rows<K: BoundingVolume>(
     let sides = Sides { a, b, self_query };
     let n = rows.vertex_face.len() + rows.face_vertex.len() + rows.edge_edge.len();
     let ContactScratch {
-        keyed: unsorted,
+        found,
         sorted: keyed,
         starts,
     } = scratch;
-    unsorted.clear();
+    found.clear();
     if par.is_parallel() {
         par.install(|| {
-            unsorted.par_extend(
+            found.par_extend(
                 (0..n)
                     .into_par_iter()
                     .with_min_len(1024)
@@ -648,12 +649,12 @@ pub(crate) fn from_rows<K: BoundingVolume>(
             )
         });
     } else {
-        unsorted.extend((0..n).map(|i| sides.keyed(&rows, i)));
+        found.extend((0..n).map(|i| sides.keyed(&rows, i)));
     }
     // By contact, then producer order (`Sides::rank`); the row makes the order total.
     let vertices = sides.vertex_count();
     crate::sort::by_group_into(
-        unsorted,
+        found,
         keyed,
         starts,
         ContactType::ALL.len() * vertices,
