@@ -105,12 +105,6 @@ pub(crate) struct MeshTables {
     edges_from: Vec<u32>,
     /// Every triangle's corners (caller's indices and order), by the caller's triangle index.
     pub(crate) triangles: Vec<[u32; 3]>,
-    /// Each vertex's edges (ids, ascending).
-    pub(crate) vertex_edges: Adjacency,
-    /// Each vertex's triangles (caller's indices, ascending).
-    pub(crate) vertex_triangles: Adjacency,
-    /// Each edge's triangles (caller's indices, ascending).
-    pub(crate) edge_triangles: Adjacency,
 }
 
 /// A list per key, flattened: key `k`'s items are `items[start[k]..start[k + 1]]`.
@@ -172,30 +166,10 @@ impl MeshTables {
         for u in 0..vertices {
             edges_from[u + 1] += edges_from[u];
         }
-        let vertex_edges = Adjacency::build(vertices, || {
-            (0u32..)
-                .zip(&edges)
-                .flat_map(|(e, &[u, v])| [(u, e), (v, e)])
-        });
-        let vertex_triangles = Adjacency::build(vertices, || {
-            (0u32..)
-                .zip(&triangles)
-                .flat_map(|(t, c)| c.map(|v| (v, t)))
-        });
-        let edge_id =
-            |u, v| edge_between(&edges, &edges_from, u, v).expect("an edge of a triangle");
-        let edge_triangles = Adjacency::build(edges.len(), || {
-            (0u32..)
-                .zip(&triangles)
-                .flat_map(move |(t, c)| (0..3).map(move |k| (edge_id(c[k], c[(k + 1) % 3]), t)))
-        });
         Self {
             edges,
             edges_from,
             triangles,
-            vertex_edges,
-            vertex_triangles,
-            edge_triangles,
         }
     }
 
