@@ -186,22 +186,17 @@ fn toi_columns<const N: usize>(py: Python<'_>, rows: TimeRows<N>) -> PyResult<Ti
 /// `[a?, x.., b?, y..]`.
 // PERF: a fixed array; a row collected into a `Vec` first was a heap allocation a pair.
 fn id_row<const N: usize>(ids: Option<[u64; 2]>, x: &[u64], y: &[u64]) -> [u64; N] {
-    let mut row = [0u64; N];
     let (a, b) = match ids {
         Some([a, b]) => (Some(a), Some(b)),
         None => (None, None),
     };
-    let items = a
+    let mut items = a
         .into_iter()
         .chain(x.iter().copied())
         .chain(b)
         .chain(y.iter().copied());
-    let mut n = 0;
-    for (slot, v) in row.iter_mut().zip(items) {
-        *slot = v;
-        n += 1;
-    }
-    assert_eq!(n, N, "row width");
+    let row = std::array::from_fn(|_| items.next().expect("row width"));
+    assert!(items.next().is_none(), "row width");
     row
 }
 
